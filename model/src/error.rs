@@ -1,0 +1,153 @@
+//! Model errors: every problem found in a description, each naming its element and,
+//! where the front end knows it, the source line.
+
+use std::fmt;
+
+/// The element of a description an error is about.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Element {
+    Robot,
+    Link(String),
+    Joint(String),
+}
+
+impl fmt::Display for Element {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Element::Robot => write!(f, "robot"),
+            Element::Link(n) => write!(f, "link `{n}`"),
+            Element::Joint(n) => write!(f, "joint `{n}`"),
+        }
+    }
+}
+
+/// One problem in a robot description.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelError {
+    pub element: Element,
+    /// 1-based line in the source file, when known.
+    pub line: Option<usize>,
+    pub kind: ErrorKind,
+}
+
+/// What is wrong, with what would be valid in the message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ErrorKind {
+    /// The file is not well-formed URDF XML.
+    Parse(String),
+    /// The file still contains xacro macros.
+    Xacro,
+    UnknownParentLink(String),
+    UnknownChildLink(String),
+    DuplicateLink,
+    DuplicateJoint,
+    /// A link is the child of more than one joint.
+    SeveralParents(Vec<String>),
+    /// More than one link has no parent joint.
+    SeveralRoots(Vec<String>),
+    /// No link is without a parent: the joints form a cycle.
+    NoRoot,
+    /// The joint closes a loop (its child is one of its ancestors).
+    Cycle,
+    UnsupportedJointType(String),
+    ZeroAxis,
+    NonFiniteValue(&'static str),
+    MissingInertial,
+    NonPositiveMass(f64),
+    NotPositiveDefinite([f64; 3]),
+    TriangleInequality([f64; 3]),
+    BadLimits { lower: f64, upper: f64 },
+    NoMovingJoint,
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(line) = self.line {
+            write!(f, "line {line}: ")?;
+        }
+        write!(f, "{}: ", self.element)?;
+        match &self.kind {
+            ErrorKind::Parse(m) => write!(f, "not valid URDF: {m}"),
+            ErrorKind::Xacro => write!(
+                f,
+                "the file contains xacro macros; expand it first (`xacro robot.urdf.xacro > robot.urdf`)"
+            ),
+            ErrorKind::UnknownParentLink(p) => {
+                write!(f, "parent link `{p}` does not exist; a joint's parent must name a <link> of this robot")
+            }
+            ErrorKind::UnknownChildLink(c) => {
+                write!(f, "child link `{c}` does not exist; a joint's child must name a <link> of this robot")
+            }
+            ErrorKind::DuplicateLink => write!(f, "defined more than once; link names must be unique"),
+            ErrorKind::DuplicateJoint => write!(f, "defined more than once; joint names must be unique"),
+            ErrorKind::SeveralParents(js) => write!(
+                f,
+                "is the child of several joints ({}); in a tree every link has at most one parent joint",
+                js.join(", ")
+            ),
+            ErrorKind::SeveralRoots(ls) => write!(
+                f,
+                "has several root links ({}); a fixed-base tree has exactly one link without a parent joint",
+                ls.join(", ")
+            ),
+            ErrorKind::NoRoot => write!(f, "every link has a parent joint, so the joints form a cycle; a tree needs one root link"),
+            ErrorKind::Cycle => write!(f, "closes a kinematic loop; only trees are supported (every link reachable from the root exactly once)"),
+            ErrorKind::UnsupportedJointType(t) => write!(
+                f,
+                "joint type `{t}` is not supported; use revolute, continuous, prismatic or fixed (the base is fixed)"
+            ),
+            ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
+            ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),
+            ErrorKind::MissingInertial => write!(
+                f,
+                "this moving body has no <inertial> (nor any fixed-attached link with one); give it a mass and inertia"
+            ),
+            ErrorKind::NonPositiveMass(m) => write!(f, "mass {m} is not positive; a moving body needs a mass > 0 kg"),
+            ErrorKind::NotPositiveDefinite(ev) => write!(
+                f,
+                "inertia is not positive definite (principal moments {:.6e}, {:.6e}, {:.6e}); all must be > 0",
+                ev[0], ev[1], ev[2]
+            ),
+            ErrorKind::TriangleInequality(ev) => write!(
+                f,
+                "principal moments {:.6e}, {:.6e}, {:.6e} break the triangle inequality; each must be at most the sum of the other two",
+                ev[0], ev[1], ev[2]
+            ),
+            ErrorKind::BadLimits { lower, upper } => {
+                write!(f, "limits lower = {lower} > upper = {upper}; the lower limit must not exceed the upper")
+            }
+            ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
+        }
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// All errors found in one description, printed one per line, each prefixed with the
+/// file name when it is known.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelErrors {
+    pub file: Option<String>,
+    pub errors: Vec<ModelError>,
+}
+
+impl fmt::Display for ModelErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (k, e) in self.errors.iter().enumerate() {
+            if k > 0 {
+                writeln!(f)?;
+            }
+            match (&self.file, e.line) {
+                (Some(file), Some(line)) => {
+                    let rest = ModelError { line: None, ..e.clone() };
+                    write!(f, "{file}:{line}: {rest}")?
+                }
+                (Some(file), None) => write!(f, "{file}: {e}")?,
+                (None, _) => write!(f, "{e}")?,
+            }
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ModelErrors {}

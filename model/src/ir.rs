@@ -1,0 +1,222 @@
+//! The checked intermediate representation: a fixed-base kinematic tree in regular
+//! labelling (joint `j` carries body `j`, its parent `λ(j) < j`), fixed joints merged.
+
+use crate::math::{self, Mat3, Vec3};
+
+/// What a joint allows. Fixed joints never reach the checked model: they are merged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum JointKind {
+    /// Rotation about `axis`, with position limits.
+    Revolute,
+    /// Rotation about `axis` without limits (a URDF `continuous` joint). Its
+    /// coordinate is the angle, not Pinocchio's `(cos, sin)` pair.
+    Continuous,
+    /// Translation along `axis`.
+    Prismatic,
+}
+
+impl JointKind {
+    pub fn is_revolute(self) -> bool {
+        matches!(self, JointKind::Revolute | JointKind::Continuous)
+    }
+
+    /// The URDF `type` attribute.
+    pub fn urdf_name(self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+        }
+    }
+}
+
+/// A rigid placement: maps child coordinates to parent coordinates,
+/// `x_parent = rotation · x_child + translation`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub rotation: Mat3,
+    pub translation: Vec3,
+}
+
+impl Placement {
+    pub const IDENTITY: Placement = Placement { rotation: math::IDENTITY, translation: [0.0; 3] };
+
+    /// From URDF `xyz` and `rpy`; quarter-turn angles give exact 0/±1 entries.
+    pub fn from_xyz_rpy(xyz: Vec3, rpy: Vec3) -> Placement {
+        Placement { rotation: math::rpy_to_matrix(rpy), translation: xyz }
+    }
+
+    pub fn rpy(&self) -> Vec3 {
+        math::matrix_to_rpy(&self.rotation)
+    }
+
+    /// `self · other`: first `other`, then `self`.
+    pub fn compose(&self, other: &Placement) -> Placement {
+        Placement {
+            rotation: math::mat_mul(&self.rotation, &other.rotation),
+            translation: math::add(&math::mat_vec(&self.rotation, &other.translation), &self.translation),
+        }
+    }
+
+    pub fn transform_point(&self, p: &Vec3) -> Vec3 {
+        math::add(&math::mat_vec(&self.rotation, p), &self.translation)
+    }
+}
+
+/// Joint position, velocity and effort limits, as URDF writes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    pub lower: f64,
+    pub upper: f64,
+    pub velocity: f64,
+    pub effort: f64,
+}
+
+/// Mass properties of one body: `inertia` is about the centre of mass `com`, in the
+/// body frame's axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertial {
+    pub mass: f64,
+    pub com: Vec3,
+    pub inertia: Mat3,
+}
+
+impl Inertial {
+    /// A body whose frame is its centroidal principal frame: `θ = (m, J1, J2, J3)`.
+    pub fn principal(mass: f64, moments: Vec3) -> Inertial {
+        Inertial {
+            mass,
+            com: [0.0; 3],
+            inertia: [[moments[0], 0.0, 0.0], [0.0, moments[1], 0.0], [0.0, 0.0, moments[2]]],
+        }
+    }
+
+    /// The 10 standard parameters in Pinocchio's order,
+    /// `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`, inertia about the
+    /// body-frame origin: `I = I_c + m(|c|²E − c cᵀ)`.
+    pub fn standard_params(&self) -> [f64; 10] {
+        let m = self.mass;
+        let c = self.com;
+        let i = math::mat_add(&self.inertia, &math::parallel_axis(m, &c));
+        [m, m * c[0], m * c[1], m * c[2], i[0][0], i[0][1], i[1][1], i[0][2], i[1][2], i[2][2]]
+    }
+
+    /// Inverse of [`Inertial::standard_params`]; `None` when the mass is not positive.
+    pub fn from_standard_params(p: &[f64; 10]) -> Option<Inertial> {
+        let m = p[0];
+        if !(m > 0.0) {
+            return None;
+        }
+        let com = [p[1] / m, p[2] / m, p[3] / m];
+        let origin = [[p[4], p[5], p[7]], [p[5], p[6], p[8]], [p[7], p[8], p[9]]];
+        let pa = math::parallel_axis(m, &com);
+        let mut inertia = origin;
+        for r in 0..3 {
+            for c in 0..3 {
+                inertia[r][c] -= pa[r][c];
+            }
+        }
+        Some(Inertial { mass: m, com, inertia })
+    }
+
+    /// The same mass properties seen from another frame: `placement` maps this
+    /// body's coordinates into the new frame.
+    pub fn transformed(&self, placement: &Placement) -> Inertial {
+        Inertial {
+            mass: self.mass,
+            com: placement.transform_point(&self.com),
+            inertia: math::rotate_inertia(&placement.rotation, &self.inertia),
+        }
+    }
+
+    /// Two bodies rigidly joined, expressed in a common frame.
+    pub fn combined(&self, other: &Inertial) -> Inertial {
+        let m = self.mass + other.mass;
+        if m == 0.0 {
+            return *self;
+        }
+        let com = math::scale(1.0 / m, &math::add(&math::scale(self.mass, &self.com), &math::scale(other.mass, &other.com)));
+        let mut inertia = [[0.0; 3]; 3];
+        for part in [self, other] {
+            let shifted = math::mat_add(&part.inertia, &math::parallel_axis(part.mass, &math::sub(&part.com, &com)));
+            inertia = math::mat_add(&inertia, &shifted);
+        }
+        Inertial { mass: m, com, inertia }
+    }
+
+    /// Principal moments about the centre of mass (ascending) and the principal axes
+    /// as the columns of a proper rotation.
+    pub fn principal_axes(&self) -> (Vec3, Mat3) {
+        math::symmetric_eigen(&self.inertia)
+    }
+}
+
+/// A joint of the checked model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    pub name: String,
+    pub kind: JointKind,
+    /// Parent body: 0 is the fixed base, otherwise the index `1..j` of a moving body.
+    pub parent: usize,
+    /// Joint frame at `q = 0` in the parent body's frame.
+    pub origin: Placement,
+    /// Unit axis in the joint (= child body) frame.
+    pub axis: Vec3,
+    pub limits: Option<Limits>,
+}
+
+/// A moving body of the checked model; its frame is its joint's frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    pub name: String,
+    pub inertial: Inertial,
+    /// Links rigidly attached through fixed joints whose inertia was lumped here.
+    pub merged: Vec<String>,
+}
+
+/// A checked fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
+/// `bodies[j - 1]` (body `j`), and `joints[j - 1].parent < j`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    pub name: String,
+    /// Gravity in the base frame, m/s².
+    pub gravity: Vec3,
+    /// Name of the fixed base (body 0).
+    pub base: String,
+    pub joints: Vec<Joint>,
+    pub bodies: Vec<Body>,
+}
+
+impl Model {
+    /// Number of moving bodies, joints and degrees of freedom (all equal).
+    pub fn dof(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Parent body of body `i` (1-based), 0 for the base.
+    pub fn parent(&self, i: usize) -> usize {
+        self.joints[i - 1].parent
+    }
+
+    /// Children of body `i` (0 = base), as 1-based body indices.
+    pub fn children(&self, i: usize) -> Vec<usize> {
+        (1..=self.dof()).filter(|&j| self.parent(j) == i).collect()
+    }
+
+    /// The nominal standard parameters of every body, 10 per body, body 1 first.
+    pub fn standard_params(&self) -> Vec<f64> {
+        self.bodies.iter().flat_map(|b| b.inertial.standard_params()).collect()
+    }
+
+    /// Whether joint `a` (1-based) lies on the path from body `i` to the base.
+    pub fn supports(&self, a: usize, i: usize) -> bool {
+        let mut k = i;
+        while k != 0 {
+            if k == a {
+                return true;
+            }
+            k = self.parent(k);
+        }
+        false
+    }
+}

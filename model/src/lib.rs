@@ -1,0 +1,33 @@
+//! # dyngen-model
+//!
+//! The robot description every other dyngen crate builds on: a checked fixed-base
+//! kinematic tree ([`Model`]) in regular labelling, the front ends that produce it
+//! (URDF here; the `robot!` DSL lives in `dyngen-codegen`), the paper's graph theory
+//! ([`graph`]), and a URDF writer so any model can be opened in standard tools.
+//!
+//! ```
+//! let urdf = r#"<robot name="pendulum">
+//!   <link name="base"/>
+//!   <link name="arm"><inertial><mass value="1"/><origin xyz="0 0 -0.5"/>
+//!     <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+//!   <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
+//!     <axis xyz="0 1 0"/></joint>
+//! </robot>"#;
+//! let model = dyngen_model::parse_urdf(urdf).unwrap();
+//! assert_eq!(model.dof(), 1);
+//! assert_eq!(dyngen_model::graph::incidence(&model), vec![vec![-1], vec![1]]);
+//! ```
+
+pub mod desc;
+pub mod error;
+pub mod graph;
+mod ir;
+pub mod math;
+pub mod urdf;
+mod write;
+
+pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, DEFAULT_GRAVITY};
+pub use error::{Element, ErrorKind, ModelError, ModelErrors};
+pub use ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
+pub use urdf::{load_urdf, parse_urdf};
+pub use write::to_urdf;

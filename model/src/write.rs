@@ -1,0 +1,2 @@
+use crate::Model;
+pub fn to_urdf(_m: &Model) -> String { todo!() }

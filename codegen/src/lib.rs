@@ -3,10 +3,25 @@
 //! Turns a robot description into specialised, unrolled Rust. One pipeline, three
 //! front doors (the `robot!` macro, `build.rs`, the command line):
 //! **front end → checked model → symbolic graph → emitted code**.
+//!
+//! In `build.rs`:
+//! ```no_run
+//! dyngen_codegen::compile_urdf("ur5.urdf", "Ur5").unwrap();
+//! ```
+//! then in the crate `include!(concat!(env!("OUT_DIR"), "/ur5.rs"));` defines `Ur5`.
 
+pub mod algo;
+mod build;
 pub mod dsl;
+pub mod emit;
+mod generate;
+pub mod sym;
+
+pub use build::{compile_urdf, write_if_changed, Config, Error};
+pub use generate::{generate, is_type_name, Generated, Options};
 
 use proc_macro2::TokenStream;
+use quote::quote;
 
 /// What a `robot!` invocation asked for.
 pub struct RobotInput {
@@ -23,8 +38,38 @@ pub enum RobotSource {
     Urdf(syn::LitStr),
 }
 
-/// The whole `robot!` macro.
+/// The whole `robot!` macro: parse, build the checked model, generate.
 pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
-    let _input = dsl::parse(input)?;
-    Err(syn::Error::new(proc_macro2::Span::call_site(), "code generation is not implemented yet"))
+    let input = dsl::parse(input)?;
+    let name = input.name.to_string();
+    let (model, rebuild_on) = match &input.source {
+        RobotSource::Dsl(desc) => {
+            let model = desc.build().map_err(|errors| {
+                let text = errors.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n");
+                syn::Error::new(input.name.span(), text)
+            })?;
+            (model, None)
+        }
+        RobotSource::Urdf(lit) => {
+            let path = manifest_path(&lit.value());
+            let model = dyngen_model::load_urdf(&path).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
+            (model, Some(path))
+        }
+    };
+    let generated = generate(&model, &name, &Options::default());
+    let tokens = generated.tokens;
+    // Make the crate rebuild when the URDF changes.
+    let watch = rebuild_on.map(|p| {
+        let p = p.to_string_lossy().into_owned();
+        quote!(const _: &[u8] = include_bytes!(#p);)
+    });
+    Ok(quote!(#tokens #watch))
+}
+
+fn manifest_path(path: &str) -> std::path::PathBuf {
+    let p = std::path::Path::new(path);
+    match std::env::var_os("CARGO_MANIFEST_DIR") {
+        Some(dir) if p.is_relative() => std::path::PathBuf::from(dir).join(p),
+        _ => p.to_path_buf(),
+    }
 }

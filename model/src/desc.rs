@@ -1,7 +1,7 @@
 //! The unchecked description every front end produces, and the one place where it is
 //! checked and turned into a [`Model`]: tree structure, joint types, axes, inertials;
-//! fixed joints merged; bodies renumbered to regular labelling (depth first, children
-//! in the order their joints were declared, as Pinocchio numbers them).
+//! fixed joints merged; bodies numbered in regular labelling (depth first; siblings in
+//! declaration order, or by joint name as Pinocchio and urdfdom number them).
 
 use crate::error::{Element, ErrorKind, ModelError};
 use crate::ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
@@ -45,6 +45,16 @@ pub struct Description {
     pub joints: Vec<JointDesc>,
 }
 
+/// The order in which the depth-first numbering visits a link's child joints.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SiblingOrder {
+    /// As declared (the `robot!` DSL: the user's own order).
+    #[default]
+    Declaration,
+    /// By joint name, as urdfdom stores them and so as Pinocchio numbers URDF trees.
+    Name,
+}
+
 /// Default gravity, m/s², in the base frame.
 pub const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 
@@ -56,9 +66,38 @@ fn finite_mat(m: &[[f64; 3]; 3]) -> bool {
     m.iter().all(finite3)
 }
 
-/// Checks one inertial: finite, mass > 0, inertia about the centre of mass positive
-/// definite and satisfying the triangle inequalities.
+/// Checks one body's inertial: finite, mass > 0, inertia about the centre of mass
+/// positive definite and satisfying the triangle inequalities.
 pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
+    check_finite(inertial)?;
+    if inertial.mass <= 0.0 {
+        return Err(ErrorKind::NonPositiveMass(inertial.mass));
+    }
+    let (ev, _) = inertial.principal_axes();
+    if ev.iter().any(|&x| x <= 0.0) {
+        return Err(ErrorKind::NotPositiveDefinite(ev));
+    }
+    check_triangle(ev)
+}
+
+/// Checks one link's share of a body before merging. A part only has to be physical
+/// (mass ≥ 0, inertia positive semi-definite, triangle inequalities): point masses
+/// and massless frames are common on fixed joints, and only the merged body needs
+/// the strict [`check_inertial`].
+fn check_part(inertial: &Inertial) -> Result<(), ErrorKind> {
+    check_finite(inertial)?;
+    if inertial.mass < 0.0 {
+        return Err(ErrorKind::NonPositiveMass(inertial.mass));
+    }
+    let (ev, _) = inertial.principal_axes();
+    // Thin and flat parts have a zero moment that rounding can make slightly negative.
+    if ev[0] < -1e-9 * (ev[0].abs() + ev[1].abs() + ev[2].abs()) {
+        return Err(ErrorKind::NotPositiveDefinite(ev));
+    }
+    check_triangle(ev)
+}
+
+fn check_finite(inertial: &Inertial) -> Result<(), ErrorKind> {
     if !inertial.mass.is_finite() {
         return Err(ErrorKind::NonFiniteValue("mass"));
     }
@@ -68,15 +107,14 @@ pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
     if !finite_mat(&inertial.inertia) {
         return Err(ErrorKind::NonFiniteValue("inertia"));
     }
-    if inertial.mass <= 0.0 {
-        return Err(ErrorKind::NonPositiveMass(inertial.mass));
-    }
-    let (ev, _) = inertial.principal_axes();
-    if ev.iter().any(|&x| x <= 0.0) {
-        return Err(ErrorKind::NotPositiveDefinite(ev));
-    }
+    Ok(())
+}
+
+/// Principal moments `ev` (ascending) of a real body: the largest is at most the sum
+/// of the other two.
+fn check_triangle(ev: [f64; 3]) -> Result<(), ErrorKind> {
     // Thin rods sit exactly on the boundary; allow rounding there.
-    let tol = 1e-9 * (ev[0] + ev[1] + ev[2]);
+    let tol = 1e-9 * (ev[0].abs() + ev[1].abs() + ev[2].abs());
     if ev[2] > ev[0] + ev[1] + tol {
         return Err(ErrorKind::TriangleInequality(ev));
     }
@@ -86,6 +124,11 @@ pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
 impl Description {
     /// Checks the description and builds the model, collecting every error.
     pub fn build(&self) -> Result<Model, Vec<ModelError>> {
+        self.build_with(SiblingOrder::Declaration)
+    }
+
+    /// [`Description::build`] with siblings numbered in the given order.
+    pub fn build_with(&self, order: SiblingOrder) -> Result<Model, Vec<ModelError>> {
         let mut errors = Vec::new();
         let err = |element: Element, line: Option<usize>, kind: ErrorKind| ModelError { element, line, kind };
 
@@ -131,7 +174,14 @@ impl Description {
                 if !(l.lower.is_finite() && l.upper.is_finite() && l.velocity.is_finite() && l.effort.is_finite()) {
                     errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("a limit")));
                 } else if l.lower > l.upper {
-                    errors.push(err(el(), j.line, ErrorKind::BadLimits { lower: l.lower, upper: l.upper }));
+                    errors.push(err(
+                        el(),
+                        j.line,
+                        ErrorKind::BadLimits {
+                            lower: l.lower,
+                            upper: l.upper,
+                        },
+                    ));
                 }
             }
         }
@@ -139,7 +189,11 @@ impl Description {
             if ps.len() > 1 {
                 let l = &self.links[c];
                 let names = ps.iter().map(|&k| self.joints[k].name.clone()).collect();
-                errors.push(err(Element::Link(l.name.clone()), l.line, ErrorKind::SeveralParents(names)));
+                errors.push(err(
+                    Element::Link(l.name.clone()),
+                    l.line,
+                    ErrorKind::SeveralParents(names),
+                ));
             }
         }
         let roots: Vec<usize> = (0..self.links.len()).filter(|&c| parent_joint[c].is_empty()).collect();
@@ -147,7 +201,16 @@ impl Description {
             let names = roots.iter().map(|&r| self.links[r].name.clone()).collect();
             errors.push(err(Element::Robot, None, ErrorKind::SeveralRoots(names)));
         } else if roots.is_empty() && !self.links.is_empty() {
-            errors.push(err(Element::Robot, None, ErrorKind::NoRoot));
+            // Point at the joints of the loop (they have lines) when it can be traced.
+            match self.trace_loop(&parent_joint, &link_index) {
+                Some(joints) => {
+                    for k in joints {
+                        let j = &self.joints[k];
+                        errors.push(err(Element::Joint(j.name.clone()), j.line, ErrorKind::Cycle));
+                    }
+                }
+                None => errors.push(err(Element::Robot, None, ErrorKind::NoRoot)),
+            }
         }
         if !errors.is_empty() {
             return Err(errors);
@@ -162,8 +225,16 @@ impl Description {
         for (k, j) in self.joints.iter().enumerate() {
             child_joints[link_index[j.parent.as_str()]].push(k);
         }
+        if order == SiblingOrder::Name {
+            for children in &mut child_joints {
+                children.sort_by(|&a, &b| self.joints[a].name.cmp(&self.joints[b].name));
+            }
+        }
 
-        // Depth-first walk from the root; joints never reached close a loop.
+        // Depth-first walk from the root. A moving joint is numbered when the walk
+        // reaches it, so bodies come out in preorder (parent before child, siblings in
+        // declaration order) even when fixed joints sit between them. Joints never
+        // reached close a loop.
         let mut model = Model {
             name: self.name.clone(),
             gravity: self.gravity,
@@ -173,9 +244,38 @@ impl Description {
         };
         let mut body_inertial: Vec<Option<Inertial>> = Vec::new();
         let mut visited = vec![false; self.joints.len()];
-        // (link, owning body index 0..n, placement of the link in the owning body frame)
-        let mut stack = vec![(root, 0usize, Placement::IDENTITY)];
-        while let Some((link, body, placement)) = stack.pop() {
+        // (joint, body owning its parent link, placement of that link in the body frame)
+        let mut stack: Vec<(usize, usize, Placement)> = child_joints[root]
+            .iter()
+            .rev()
+            .map(|&k| (k, 0, Placement::IDENTITY))
+            .collect();
+        // Each link has at most one parent joint by now, so each joint is pushed once.
+        while let Some((k, owner, placement)) = stack.pop() {
+            visited[k] = true;
+            let j = &self.joints[k];
+            let link = link_index[j.child.as_str()];
+            let origin = placement.compose(&j.origin);
+            let (body, placement) = match &j.kind {
+                DeclaredJointType::Moving(kind) => {
+                    model.joints.push(Joint {
+                        name: j.name.clone(),
+                        kind: *kind,
+                        parent: owner,
+                        origin,
+                        axis: math::scale(1.0 / math::norm(&j.axis), &j.axis),
+                        limits: if *kind == JointKind::Continuous { None } else { j.limits },
+                    });
+                    model.bodies.push(Body {
+                        name: self.links[link].name.clone(),
+                        inertial: Inertial::principal(0.0, [0.0; 3]),
+                        merged: Vec::new(),
+                    });
+                    body_inertial.push(None);
+                    (model.joints.len(), Placement::IDENTITY)
+                }
+                _ => (owner, origin),
+            };
             // Lump this link's inertial into its owning body (the base's is ignored).
             if body > 0 {
                 if let Some(inertial) = &self.links[link].inertial {
@@ -186,7 +286,7 @@ impl Description {
                         None => moved,
                     });
                     if !is_massless_marker(inertial) {
-                        if let Err(kind) = check_inertial(inertial) {
+                        if let Err(kind) = check_part(inertial) {
                             let l = &self.links[link];
                             errors.push(err(Element::Link(l.name.clone()), l.line, kind));
                         }
@@ -196,36 +296,8 @@ impl Description {
                     model.bodies[body - 1].merged.push(self.links[link].name.clone());
                 }
             }
-            // Number children in declaration order; push them in reverse so the
-            // first declared is also walked first.
-            let mut pushes = Vec::new();
-            for &k in &child_joints[link] {
-                if visited[k] {
-                    continue;
-                }
-                visited[k] = true;
-                let j = &self.joints[k];
-                let child = link_index[j.child.as_str()];
-                let origin = placement.compose(&j.origin);
-                match &j.kind {
-                    DeclaredJointType::Moving(kind) => {
-                        // Placeholder order: renumbered below once the walk is done.
-                        model.joints.push(Joint {
-                            name: j.name.clone(),
-                            kind: *kind,
-                            parent: body,
-                            origin,
-                            axis: math::scale(1.0 / math::norm(&j.axis), &j.axis),
-                            limits: if *kind == JointKind::Continuous { None } else { j.limits },
-                        });
-                        model.bodies.push(Body { name: self.links[child].name.clone(), inertial: Inertial::principal(0.0, [0.0; 3]), merged: Vec::new() });
-                        body_inertial.push(None);
-                        pushes.push((child, model.joints.len(), Placement::IDENTITY));
-                    }
-                    _ => pushes.push((child, body, origin)),
-                }
-            }
-            stack.extend(pushes.into_iter().rev());
+            // Pushed in reverse so that the first declared child is walked first.
+            stack.extend(child_joints[link].iter().rev().map(|&c| (c, body, placement)));
         }
         for (k, j) in self.joints.iter().enumerate() {
             if !visited[k] {
@@ -243,7 +315,11 @@ impl Description {
                     if let Err(kind) = check_inertial(i) {
                         // Per-link value errors were reported above; report the
                         // combined body only when each part was fine on its own.
-                        if !errors.iter().any(|e| matches!(&e.element, Element::Link(n) if *n == body.name)) {
+                        let reported = |n: &String| *n == body.name || body.merged.contains(n);
+                        if !errors
+                            .iter()
+                            .any(|e| matches!(&e.element, Element::Link(n) if reported(n)))
+                        {
                             errors.push(err(Element::Link(body.name.clone()), line, kind));
                         }
                     }
@@ -255,8 +331,25 @@ impl Description {
         if !errors.is_empty() {
             return Err(errors);
         }
-        renumber_depth_first(&mut model);
         Ok(model)
+    }
+
+    /// Follows parent joints up from the first link until a link repeats; returns the
+    /// joints of that loop in declaration order, or `None` if an unknown parent link
+    /// or a parentless link interrupts the trail.
+    fn trace_loop(&self, parent_joint: &[Vec<usize>], link_index: &HashMap<&str, usize>) -> Option<Vec<usize>> {
+        let mut trail: Vec<(usize, usize)> = Vec::new();
+        let mut link = 0;
+        loop {
+            if let Some(pos) = trail.iter().position(|&(l, _)| l == link) {
+                let mut joints: Vec<usize> = trail[pos..].iter().map(|&(_, k)| k).collect();
+                joints.sort_unstable();
+                return Some(joints);
+            }
+            let &k = parent_joint.get(link)?.first()?;
+            trail.push((link, k));
+            link = *link_index.get(self.joints[k].parent.as_str())?;
+        }
     }
 }
 
@@ -264,35 +357,4 @@ impl Description {
 /// markers: treated as no inertial at all.
 fn is_massless_marker(inertial: &Inertial) -> bool {
     inertial.mass == 0.0 && inertial.inertia.iter().flatten().all(|&x| x == 0.0)
-}
-
-/// The stack walk above numbers bodies in discovery order, which is depth first with
-/// children in declaration order already; this re-derives the order explicitly so
-/// that `parent < child` holds by construction.
-fn renumber_depth_first(model: &mut Model) {
-    let n = model.dof();
-    let mut order = Vec::with_capacity(n);
-    let mut stack = vec![0usize];
-    while let Some(b) = stack.pop() {
-        if b > 0 {
-            order.push(b);
-        }
-        let children = model.children(b);
-        stack.extend(children.into_iter().rev());
-    }
-    let mut new_index = vec![0usize; n + 1];
-    for (k, &old) in order.iter().enumerate() {
-        new_index[old] = k + 1;
-    }
-    let joints: Vec<Joint> = order
-        .iter()
-        .map(|&old| {
-            let mut j = model.joints[old - 1].clone();
-            j.parent = new_index[j.parent];
-            j
-        })
-        .collect();
-    let bodies: Vec<Body> = order.iter().map(|&old| model.bodies[old - 1].clone()).collect();
-    model.joints = joints;
-    model.bodies = bodies;
 }

@@ -33,6 +33,8 @@ pub struct ModelError {
 /// What is wrong, with what would be valid in the message.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ErrorKind {
+    /// The file could not be read.
+    Io(String),
     /// The file is not well-formed URDF XML.
     Parse(String),
     /// The file still contains xacro macros.
@@ -56,7 +58,10 @@ pub enum ErrorKind {
     NonPositiveMass(f64),
     NotPositiveDefinite([f64; 3]),
     TriangleInequality([f64; 3]),
-    BadLimits { lower: f64, upper: f64 },
+    BadLimits {
+        lower: f64,
+        upper: f64,
+    },
     NoMovingJoint,
 }
 
@@ -67,6 +72,7 @@ impl fmt::Display for ModelError {
         }
         write!(f, "{}: ", self.element)?;
         match &self.kind {
+            ErrorKind::Io(m) => write!(f, "cannot read the file: {m}"),
             ErrorKind::Parse(m) => write!(f, "not valid URDF: {m}"),
             ErrorKind::Xacro => write!(
                 f,
@@ -139,7 +145,10 @@ impl fmt::Display for ModelErrors {
             }
             match (&self.file, e.line) {
                 (Some(file), Some(line)) => {
-                    let rest = ModelError { line: None, ..e.clone() };
+                    let rest = ModelError {
+                        line: None,
+                        ..e.clone()
+                    };
                     write!(f, "{file}:{line}: {rest}")?
                 }
                 (Some(file), None) => write!(f, "{file}: {e}")?,

@@ -75,7 +75,11 @@ pub fn check_incidence(s: &[Vec<i64>]) -> Result<IncidenceTree, Vec<IncidenceErr
     }
     for (row, r) in s.iter().enumerate() {
         if r.len() != cols {
-            errors.push(IncidenceError::RowLength { row, len: r.len(), expected: cols });
+            errors.push(IncidenceError::RowLength {
+                row,
+                len: r.len(),
+                expected: cols,
+            });
         }
         for (col, &value) in r.iter().enumerate() {
             if !(-1..=1).contains(&value) {
@@ -91,7 +95,11 @@ pub fn check_incidence(s: &[Vec<i64>]) -> Result<IncidenceTree, Vec<IncidenceErr
         let plus: Vec<usize> = (0..rows).filter(|&r| s[r][col] == 1).collect();
         let minus: Vec<usize> = (0..rows).filter(|&r| s[r][col] == -1).collect();
         if plus.len() != 1 || minus.len() != 1 {
-            errors.push(IncidenceError::Column { col, plus: plus.len(), minus: minus.len() });
+            errors.push(IncidenceError::Column {
+                col,
+                plus: plus.len(),
+                minus: minus.len(),
+            });
         } else {
             ends.push((col, plus[0], minus[0]));
         }
@@ -135,7 +143,11 @@ pub fn check_incidence(s: &[Vec<i64>]) -> Result<IncidenceTree, Vec<IncidenceErr
         }
     }
     for (col, &u) in used.iter().enumerate() {
-        if !u && !errors.iter().any(|e| matches!(e, IncidenceError::Loop { col: c } if *c == col)) {
+        if !u
+            && !errors
+                .iter()
+                .any(|e| matches!(e, IncidenceError::Loop { col: c } if *c == col))
+        {
             // Joints among disconnected bodies: a loop there, or a separate tree.
             let (_, p, m) = ends.iter().find(|e| e.0 == col).copied().unwrap_or((col, 0, 0));
             if depth[p] != usize::MAX || depth[m] != usize::MAX {
@@ -146,7 +158,11 @@ pub fn check_incidence(s: &[Vec<i64>]) -> Result<IncidenceTree, Vec<IncidenceErr
     if !errors.is_empty() {
         return Err(errors);
     }
-    Ok(IncidenceTree { inboard, outboard, reversed })
+    Ok(IncidenceTree {
+        inboard,
+        outboard,
+        reversed,
+    })
 }
 
 /// `S` with its base row: (n+1) × n, rows bodies 0..=n, columns joints 1..=n.
@@ -182,7 +198,13 @@ pub fn check_path_matrix(s: &[Vec<i8>], t: &[Vec<i8>]) -> bool {
     for i in 0..=n {
         for j in 0..n {
             let v: i32 = (0..n).map(|a| i32::from(s[i][a]) * i32::from(t[a][j])).sum();
-            let want = if i == 0 { -1 } else if i == j + 1 { 1 } else { 0 };
+            let want = if i == 0 {
+                -1
+            } else if i == j + 1 {
+                1
+            } else {
+                0
+            };
             if v != want {
                 return false;
             }
@@ -200,7 +222,11 @@ pub fn body_joint_vectors(model: &Model) -> Vec<Vec<Vec3>> {
     for a in 1..=n {
         let joint = &model.joints[a - 1];
         let p = joint.parent;
-        let parent_com = if p == 0 { [0.0; 3] } else { model.bodies[p - 1].inertial.com };
+        let parent_com = if p == 0 {
+            [0.0; 3]
+        } else {
+            model.bodies[p - 1].inertial.com
+        };
         c[p][a - 1] = math::sub(&joint.origin.translation, &parent_com);
         c[a][a - 1] = math::scale(-1.0, &model.bodies[a - 1].inertial.com);
     }
@@ -262,7 +288,17 @@ mod tests {
     fn bad_column_and_loop_and_disconnected() {
         let s = vec![vec![-1, 0], vec![1, 1], vec![0, 0]];
         let e = check_incidence(&s).unwrap_err();
-        assert!(matches!(e[0], IncidenceError::Column { col: 1, plus: 2, minus: 0 }), "{e:?}");
+        assert!(
+            matches!(
+                e[0],
+                IncidenceError::Column {
+                    col: 1,
+                    plus: 1,
+                    minus: 0
+                }
+            ),
+            "{e:?}"
+        );
         // Two joints between the same two bodies: a loop, and body 2 unreachable.
         let s = vec![vec![-1, -1], vec![1, 1], vec![0, 0]];
         let e = check_incidence(&s).unwrap_err();

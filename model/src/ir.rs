@@ -39,11 +39,17 @@ pub struct Placement {
 }
 
 impl Placement {
-    pub const IDENTITY: Placement = Placement { rotation: math::IDENTITY, translation: [0.0; 3] };
+    pub const IDENTITY: Placement = Placement {
+        rotation: math::IDENTITY,
+        translation: [0.0; 3],
+    };
 
     /// From URDF `xyz` and `rpy`; quarter-turn angles give exact 0/±1 entries.
     pub fn from_xyz_rpy(xyz: Vec3, rpy: Vec3) -> Placement {
-        Placement { rotation: math::rpy_to_matrix(rpy), translation: xyz }
+        Placement {
+            rotation: math::rpy_to_matrix(rpy),
+            translation: xyz,
+        }
     }
 
     pub fn rpy(&self) -> Vec3 {
@@ -98,13 +104,24 @@ impl Inertial {
         let m = self.mass;
         let c = self.com;
         let i = math::mat_add(&self.inertia, &math::parallel_axis(m, &c));
-        [m, m * c[0], m * c[1], m * c[2], i[0][0], i[0][1], i[1][1], i[0][2], i[1][2], i[2][2]]
+        [
+            m,
+            m * c[0],
+            m * c[1],
+            m * c[2],
+            i[0][0],
+            i[0][1],
+            i[1][1],
+            i[0][2],
+            i[1][2],
+            i[2][2],
+        ]
     }
 
     /// Inverse of [`Inertial::standard_params`]; `None` when the mass is not positive.
     pub fn from_standard_params(p: &[f64; 10]) -> Option<Inertial> {
         let m = p[0];
-        if !(m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             return None;
         }
         let com = [p[1] / m, p[2] / m, p[3] / m];
@@ -135,10 +152,16 @@ impl Inertial {
         if m == 0.0 {
             return *self;
         }
-        let com = math::scale(1.0 / m, &math::add(&math::scale(self.mass, &self.com), &math::scale(other.mass, &other.com)));
+        let com = math::scale(
+            1.0 / m,
+            &math::add(&math::scale(self.mass, &self.com), &math::scale(other.mass, &other.com)),
+        );
         let mut inertia = [[0.0; 3]; 3];
         for part in [self, other] {
-            let shifted = math::mat_add(&part.inertia, &math::parallel_axis(part.mass, &math::sub(&part.com, &com)));
+            let shifted = math::mat_add(
+                &part.inertia,
+                &math::parallel_axis(part.mass, &math::sub(&part.com, &com)),
+            );
             inertia = math::mat_add(&inertia, &shifted);
         }
         Inertial { mass: m, com, inertia }

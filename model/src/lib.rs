@@ -26,7 +26,7 @@ pub mod math;
 pub mod urdf;
 mod write;
 
-pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, DEFAULT_GRAVITY};
+pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
 pub use urdf::{load_urdf, parse_urdf};

@@ -1,4 +1,578 @@
-//! URDF front end (helper writes this).
-use crate::{Model, ModelErrors};
-pub fn parse_urdf(_text: &str) -> Result<Model, ModelErrors> { todo!() }
-pub fn load_urdf(_path: &std::path::Path) -> Result<Model, ModelErrors> { todo!() }
+//! URDF front end: reads a URDF with `urdf-rs` into a [`Description`] and checks it
+//! into a [`Model`]. `urdf-rs` keeps no source positions, so a light scan of the raw
+//! text supplies line numbers, spots unexpanded xacro, and tells which optional
+//! elements (`<inertial>`, `<limit>`) were actually written.
+
+use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
+use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
+use crate::ir::{Inertial, JointKind, Limits, Model, Placement};
+use crate::math;
+use std::path::Path;
+
+/// Parses and checks URDF text; errors carry line numbers but no file name.
+pub fn parse_urdf(text: &str) -> Result<Model, ModelErrors> {
+    build(text).map_err(|errors| ModelErrors { file: None, errors })
+}
+
+/// Reads, parses and checks a URDF file; errors are prefixed with its path.
+pub fn load_urdf(path: &Path) -> Result<Model, ModelErrors> {
+    let file = Some(path.display().to_string());
+    let text = std::fs::read_to_string(path).map_err(|e| ModelErrors {
+        file: file.clone(),
+        errors: vec![robot_error(None, ErrorKind::Io(e.to_string()))],
+    })?;
+    build(&text).map_err(|errors| ModelErrors { file, errors })
+}
+
+/// The unchecked description of URDF text, before [`Description::build`]: for
+/// callers that want to adjust it (gravity, say) before checking.
+pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
+    read(text)
+        .map(|(desc, _)| desc)
+        .map_err(|errors| ModelErrors { file: None, errors })
+}
+
+fn build(text: &str) -> Result<Model, Vec<ModelError>> {
+    let (desc, robot_line) = read(text)?;
+    // Siblings by joint name, as urdfdom and so Pinocchio number them.
+    desc.build_with(SiblingOrder::Name).map_err(|mut errors| {
+        // Robot-wide errors (several roots, nothing moves) point at `<robot>`.
+        for e in &mut errors {
+            if e.element == Element::Robot && e.line.is_none() {
+                e.line = robot_line;
+            }
+        }
+        // In file order, as a compiler lists them; the sort is stable for ties.
+        errors.sort_by_key(|e| e.line.unwrap_or(usize::MAX));
+        errors
+    })
+}
+
+fn robot_error(line: Option<usize>, kind: ErrorKind) -> ModelError {
+    ModelError {
+        element: Element::Robot,
+        line,
+        kind,
+    }
+}
+
+/// Reads URDF text into a description and the line of its `<robot>` element.
+fn read(text: &str) -> Result<(Description, Option<usize>), Vec<ModelError>> {
+    let outline = scan(text);
+    if let Ok(tags) = &outline {
+        if let Some(line) = xacro_line(tags) {
+            return Err(vec![robot_error(Some(line), ErrorKind::Xacro)]);
+        }
+    }
+    let dynamics_only = match &outline {
+        Ok(tags) => without_geometry(text, tags),
+        Err(_) => text.to_string(),
+    };
+    let robot = match urdf_rs::read_from_string(&dynamics_only) {
+        Ok(robot) => robot,
+        Err(e) => return Err(parse_errors(&outline, &e.to_string())),
+    };
+    // Without an outline (only if the scan disagrees with urdf-rs about the syntax)
+    // the model is still read, just without line numbers.
+    let outline = outline.as_deref().map(Outline::new).unwrap_or_default();
+
+    let links = robot
+        .links
+        .iter()
+        .enumerate()
+        .map(|(k, link)| {
+            let source = outline.link(k, &link.name);
+            let has_inertial = match source {
+                Some(s) => s.has_child("inertial"),
+                // urdf-rs fills a missing <inertial> with zeros.
+                None => link.inertial.mass.value != 0.0 || inertia_matrix(&link.inertial.inertia) != [[0.0; 3]; 3],
+            };
+            LinkDesc {
+                name: link.name.clone(),
+                inertial: has_inertial.then(|| convert_inertial(&link.inertial)),
+                line: source.map(|s| s.tag.line),
+            }
+        })
+        .collect();
+
+    let joints = robot
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(k, joint)| {
+            let source = outline.joint(k, &joint.name);
+            let kind = convert_type(&joint.joint_type);
+            // urdf-rs fills a missing <limit> with zeros, which would lock the joint.
+            let has_limit = source.map_or(true, |s| s.has_child("limit"));
+            let limits = match kind {
+                DeclaredJointType::Moving(JointKind::Revolute | JointKind::Prismatic) if has_limit => Some(Limits {
+                    lower: joint.limit.lower,
+                    upper: joint.limit.upper,
+                    velocity: joint.limit.velocity,
+                    effort: joint.limit.effort,
+                }),
+                _ => None,
+            };
+            JointDesc {
+                name: joint.name.clone(),
+                kind,
+                parent: joint.parent.link.clone(),
+                child: joint.child.link.clone(),
+                origin: Placement::from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0),
+                axis: joint.axis.xyz.0,
+                limits,
+                line: source.map(|s| s.tag.line),
+            }
+        })
+        .collect();
+
+    let desc = Description {
+        name: robot.name.clone(),
+        gravity: DEFAULT_GRAVITY,
+        links,
+        joints,
+    };
+    Ok((desc, outline.robot_line))
+}
+
+/// Turns a failure of urdf-rs into errors. urdf-rs stops at the first problem and
+/// gives no position, so the scan's own findings come first when it has any.
+fn parse_errors(outline: &Result<Vec<Tag>, SyntaxError>, message: &str) -> Vec<ModelError> {
+    match outline {
+        Err(e) => vec![robot_error(Some(e.line), ErrorKind::Parse(e.message.clone()))],
+        Ok(tags) => {
+            let unknown_types: Vec<ModelError> = Outline::new(tags)
+                .joints
+                .iter()
+                .filter_map(|j| {
+                    let t = j.tag.attr("type")?;
+                    (!KNOWN_JOINT_TYPES.contains(&t)).then(|| ModelError {
+                        element: Element::Joint(j.tag.attr("name").unwrap_or_default().to_string()),
+                        line: Some(j.tag.line),
+                        kind: ErrorKind::UnsupportedJointType(t.to_string()),
+                    })
+                })
+                .collect();
+            if unknown_types.is_empty() {
+                // serde's "custom: " prefix says nothing to a URDF author.
+                let message = message.strip_prefix("custom: ").unwrap_or(message);
+                vec![robot_error(None, ErrorKind::Parse(message.to_string()))]
+            } else {
+                unknown_types
+            }
+        }
+    }
+}
+
+/// Joint types urdf-rs can read; any other is rejected by it without a position.
+const KNOWN_JOINT_TYPES: [&str; 7] = [
+    "revolute",
+    "continuous",
+    "prismatic",
+    "fixed",
+    "floating",
+    "planar",
+    "spherical",
+];
+
+fn convert_type(t: &urdf_rs::JointType) -> DeclaredJointType {
+    use urdf_rs::JointType as T;
+    match t {
+        T::Revolute => DeclaredJointType::Moving(JointKind::Revolute),
+        T::Continuous => DeclaredJointType::Moving(JointKind::Continuous),
+        T::Prismatic => DeclaredJointType::Moving(JointKind::Prismatic),
+        T::Fixed => DeclaredJointType::Fixed,
+        T::Floating => DeclaredJointType::Unsupported("floating".into()),
+        T::Planar => DeclaredJointType::Unsupported("planar".into()),
+        T::Spherical => DeclaredJointType::Unsupported("spherical".into()),
+    }
+}
+
+fn inertia_matrix(i: &urdf_rs::Inertia) -> math::Mat3 {
+    [[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]]
+}
+
+/// URDF gives the inertia about the centre of mass in the axes of the inertial
+/// `<origin>`; the model wants it in the link axes: `R I Rᵀ`.
+fn convert_inertial(i: &urdf_rs::Inertial) -> Inertial {
+    let local = Inertial {
+        mass: i.mass.value,
+        com: [0.0; 3],
+        inertia: inertia_matrix(&i.inertia),
+    };
+    let mut inertial = local.transformed(&Placement::from_xyz_rpy(i.origin.xyz.0, i.origin.rpy.0));
+    // Rounding in the rotation can leave the tensor a few ulps off symmetric.
+    let m = inertial.inertia;
+    for (r, row) in inertial.inertia.iter_mut().enumerate() {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x = 0.5 * (m[r][c] + m[c][r]);
+        }
+    }
+    inertial
+}
+
+/// The text with every `<visual>`, `<collision>` and `<material>` blanked out (newlines
+/// kept, so lines still match). Dynamics never needs them, and urdf-rs rejects some
+/// geometry that urdfdom accepts, such as a `<texture/>` without a file name.
+fn without_geometry(text: &str, tags: &[Tag]) -> String {
+    let mut spans: Vec<std::ops::Range<usize>> = tags
+        .iter()
+        .filter(|t| matches!(t.name.as_str(), "visual" | "collision" | "material"))
+        .map(|t| t.span.clone())
+        .collect();
+    if spans.is_empty() {
+        return text.to_string();
+    }
+    spans.sort_by_key(|r| r.start);
+    let mut out = String::with_capacity(text.len());
+    let mut spans = spans.into_iter().peekable();
+    for (k, c) in text.char_indices() {
+        // Spans nest (a <material> inside a <visual>); drop those already passed.
+        while spans.peek().is_some_and(|r| r.end <= k) {
+            spans.next();
+        }
+        let blank = spans.peek().is_some_and(|r| r.contains(&k));
+        out.push(if blank && c != '\n' { ' ' } else { c });
+    }
+    out
+}
+
+/// The line of the first xacro element, or of the first attribute that still holds
+/// a `${...}` expression or `$(...)` substitution. Only markup counts: shipped URDFs
+/// often keep xacro in comments, or a leftover `xmlns:xacro` on `<robot>`.
+fn xacro_line(tags: &[Tag]) -> Option<usize> {
+    tags.iter()
+        .find(|t| t.name.starts_with("xacro:") || t.attrs.iter().any(|(_, v)| v.contains("${") || v.contains("$(")))
+        .map(|t| t.line)
+}
+
+// ---------------------------------------------------------------------------------
+// A minimal XML scan: start tags with their attributes, lines and nesting. It is not
+// a validating parser; urdf-rs decides what is valid. It only has to be right on
+// files urdf-rs accepts, and to name a line when a file is plainly malformed.
+
+/// A start tag (or empty-element tag) of the source.
+#[derive(Debug)]
+struct Tag {
+    name: String,
+    attrs: Vec<(String, String)>,
+    line: usize,
+    /// Bytes of the whole element, from `<` of its start tag to `>` of its end tag.
+    span: std::ops::Range<usize>,
+    /// Index of the enclosing tag, `None` for the document element.
+    parent: Option<usize>,
+}
+
+impl Tag {
+    fn attr(&self, name: &str) -> Option<&str> {
+        self.attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
+    }
+}
+
+#[derive(Debug)]
+struct SyntaxError {
+    line: usize,
+    message: String,
+}
+
+/// One `<link>` or `<joint>` directly under `<robot>`.
+#[derive(Debug)]
+struct Source<'a> {
+    tag: &'a Tag,
+    children: Vec<&'a str>,
+}
+
+impl Source<'_> {
+    fn has_child(&self, name: &str) -> bool {
+        self.children.contains(&name)
+    }
+
+    fn name(&self) -> &str {
+        self.tag.attr("name").unwrap_or_default()
+    }
+}
+
+/// The links and joints of the document in source order, which is also urdf-rs's
+/// order, so the k-th link read is the k-th `<link>` here.
+#[derive(Debug, Default)]
+struct Outline<'a> {
+    robot_line: Option<usize>,
+    links: Vec<Source<'a>>,
+    joints: Vec<Source<'a>>,
+}
+
+impl<'a> Outline<'a> {
+    fn new(tags: &'a [Tag]) -> Outline<'a> {
+        let mut outline = Outline::default();
+        let Some(root) = tags.iter().position(|t| t.parent.is_none()) else {
+            return outline;
+        };
+        outline.robot_line = Some(tags[root].line);
+        // Only direct children of <robot>: a <transmission> holds <joint> elements too.
+        let mut index = vec![None; tags.len()];
+        for (k, t) in tags.iter().enumerate() {
+            if t.parent != Some(root) {
+                continue;
+            }
+            let list = match t.name.as_str() {
+                "link" => &mut outline.links,
+                "joint" => &mut outline.joints,
+                _ => continue,
+            };
+            index[k] = Some((t.name == "link", list.len()));
+            list.push(Source {
+                tag: t,
+                children: Vec::new(),
+            });
+        }
+        for t in tags {
+            if let Some((is_link, k)) = t.parent.and_then(|p| index[p]) {
+                let list = if is_link {
+                    &mut outline.links
+                } else {
+                    &mut outline.joints
+                };
+                list[k].children.push(t.name.as_str());
+            }
+        }
+        outline
+    }
+
+    fn link(&self, k: usize, name: &str) -> Option<&Source<'a>> {
+        Self::find(&self.links, k, name)
+    }
+
+    fn joint(&self, k: usize, name: &str) -> Option<&Source<'a>> {
+        Self::find(&self.joints, k, name)
+    }
+
+    /// The k-th element if its name agrees, else the first of that name.
+    fn find<'s>(list: &'s [Source<'a>], k: usize, name: &str) -> Option<&'s Source<'a>> {
+        list.get(k)
+            .filter(|s| s.name() == name)
+            .or_else(|| list.iter().find(|s| s.name() == name))
+    }
+}
+
+/// Scans `text` into its start tags, checking only that tags are closed and nested.
+fn scan(text: &str) -> Result<Vec<Tag>, SyntaxError> {
+    let mut tags: Vec<Tag> = Vec::new();
+    // Open elements: (name, tag index).
+    let mut open: Vec<(String, usize)> = Vec::new();
+    let mut lines = LineCounter::new(text);
+    let mut pos = 0;
+    while let Some(offset) = text[pos..].find('<') {
+        pos += offset;
+        let line = lines.line_at(pos);
+        let rest = &text[pos..];
+        let fail = |message: String| SyntaxError { line, message };
+        let skip_to = |end: &str, what: &str| {
+            rest.find(end)
+                .map(|k| pos + k + end.len())
+                .ok_or_else(|| fail(format!("{what} is never closed")))
+        };
+        if rest.starts_with("<!--") {
+            pos = skip_to("-->", "comment")?;
+        } else if rest.starts_with("<![CDATA[") {
+            pos = skip_to("]]>", "CDATA section")?;
+        } else if rest.starts_with("<?") {
+            pos = skip_to("?>", "processing instruction")?;
+        } else if rest.starts_with("<!") {
+            // A DOCTYPE, possibly with an internal subset in brackets.
+            let end = if rest.find('[').is_some_and(|b| rest.find('>').is_some_and(|g| b < g)) {
+                "]>"
+            } else {
+                ">"
+            };
+            pos = skip_to(end, "declaration")?;
+        } else if let Some(after) = rest.strip_prefix("</") {
+            let end = after.find('>').ok_or_else(|| fail("end tag is never closed".into()))?;
+            let name = after[..end].trim();
+            match open.pop() {
+                Some((opened, k)) if opened == name => tags[k].span.end = pos + 2 + end + 1,
+                Some((opened, k)) => {
+                    return Err(fail(format!(
+                        "</{name}> closes <{opened}> opened on line {}",
+                        tags_line(&tags, k)
+                    )))
+                }
+                None => return Err(fail(format!("</{name}> has no matching start tag"))),
+            }
+            pos += 2 + end + 1;
+        } else {
+            let (tag, self_closing, len) = start_tag(rest).map_err(fail)?;
+            let name = tag.0;
+            let k = tags.len();
+            let parent = open.last().map(|&(_, p)| p);
+            tags.push(Tag {
+                name: name.clone(),
+                attrs: tag.1,
+                line,
+                span: pos..pos + len,
+                parent,
+            });
+            if !self_closing {
+                open.push((name, k));
+            }
+            pos += len;
+        }
+    }
+    match open.pop() {
+        Some((name, k)) => Err(SyntaxError {
+            line: tags_line(&tags, k),
+            message: format!("<{name}> is never closed"),
+        }),
+        None if tags.is_empty() => Err(SyntaxError {
+            line: 1,
+            message: "no XML element found".into(),
+        }),
+        None => Ok(tags),
+    }
+}
+
+fn tags_line(tags: &[Tag], k: usize) -> usize {
+    tags.get(k).map_or(0, |t| t.line)
+}
+
+type StartTag = (String, Vec<(String, String)>);
+
+/// Reads a start tag at the beginning of `s` (which starts with `<`): its name and
+/// attributes, whether it is self-closing, and its length in bytes.
+fn start_tag(s: &str) -> Result<(StartTag, bool, usize), String> {
+    let is_delim = |c: char| c.is_whitespace() || c == '/' || c == '>';
+    let body = &s[1..];
+    let name_len = body.find(is_delim).unwrap_or(body.len());
+    let name = &body[..name_len];
+    if name.is_empty() {
+        return Err("a `<` that starts no tag (write `&lt;` for a literal `<`)".into());
+    }
+    let unclosed = || format!("tag <{name}> is never closed");
+    let mut attrs = Vec::new();
+    let mut i = 1 + name_len;
+    loop {
+        let rest = &s[i..];
+        let trimmed = rest.trim_start();
+        i += rest.len() - trimmed.len();
+        if trimmed.starts_with("/>") {
+            return Ok(((name.to_string(), attrs), true, i + 2));
+        }
+        if trimmed.starts_with('>') {
+            return Ok(((name.to_string(), attrs), false, i + 1));
+        }
+        if trimmed.is_empty() {
+            return Err(unclosed());
+        }
+        let eq = trimmed.find('=').ok_or_else(unclosed)?;
+        let attr = trimmed[..eq].trim();
+        if attr.is_empty() || attr.contains(is_delim) {
+            return Err(format!("malformed attribute in <{name}>"));
+        }
+        let value = trimmed[eq + 1..].trim_start();
+        let quote = value.chars().next().filter(|&c| c == '"' || c == '\'');
+        let quote = quote.ok_or_else(|| format!("attribute `{attr}` of <{name}> needs a quoted value"))?;
+        let close = value[1..].find(quote).ok_or_else(unclosed)?;
+        attrs.push((attr.to_string(), unescape(&value[1..1 + close])));
+        i += trimmed.len() - value.len() + 1 + close + 1;
+    }
+}
+
+/// Resolves the predefined XML entities and character references, so that names
+/// compare equal to what urdf-rs reads.
+fn unescape(s: &str) -> String {
+    if !s.contains('&') {
+        return s.to_string();
+    }
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(k) = rest.find('&') {
+        out.push_str(&rest[..k]);
+        rest = &rest[k..];
+        let resolved = rest.find(';').and_then(|end| {
+            let c = match &rest[1..end] {
+                "lt" => Some('<'),
+                "gt" => Some('>'),
+                "amp" => Some('&'),
+                "quot" => Some('"'),
+                "apos" => Some('\''),
+                e => e
+                    .strip_prefix("#x")
+                    .map(|h| u32::from_str_radix(h, 16))
+                    .or_else(|| e.strip_prefix('#').map(str::parse))
+                    .and_then(Result::ok)
+                    .and_then(char::from_u32),
+            }?;
+            Some((c, end + 1))
+        });
+        match resolved {
+            Some((c, len)) => {
+                out.push(c);
+                rest = &rest[len..];
+            }
+            None => {
+                out.push('&');
+                rest = &rest[1..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// 1-based line numbers of byte offsets, for offsets visited in increasing order.
+struct LineCounter<'a> {
+    text: &'a str,
+    pos: usize,
+    line: usize,
+}
+
+impl<'a> LineCounter<'a> {
+    fn new(text: &'a str) -> Self {
+        LineCounter { text, pos: 0, line: 1 }
+    }
+
+    fn line_at(&mut self, pos: usize) -> usize {
+        self.line += self.text[self.pos..pos].bytes().filter(|&b| b == b'\n').count();
+        self.pos = pos;
+        self.line
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scan_reads_tags_lines_and_nesting() {
+        let text = "<?xml version='1.0'?>\n<!-- <link name='ghost'/> -->\n<robot name = \"r\">\n  <link\n    name='a&amp;b' ><inertial/></link>\n</robot>\n";
+        let tags = scan(text).unwrap();
+        let names: Vec<&str> = tags.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["robot", "link", "inertial"]);
+        assert_eq!(tags[0].line, 3);
+        assert_eq!(tags[1].line, 4);
+        assert_eq!(tags[1].attr("name"), Some("a&b"));
+        assert_eq!(tags[2].parent, Some(1));
+        let outline = Outline::new(&tags);
+        assert_eq!(outline.robot_line, Some(3));
+        assert!(outline.links[0].has_child("inertial"));
+    }
+
+    #[test]
+    fn scan_reports_bad_nesting_with_lines() {
+        let e = scan("<robot>\n<link name='a'>\n</robot>").unwrap_err();
+        assert_eq!(e.line, 3);
+        assert!(
+            e.message.contains("</robot> closes <link> opened on line 2"),
+            "{}",
+            e.message
+        );
+        let e = scan("<robot>\n<!-- open\n</robot>").unwrap_err();
+        assert_eq!((e.line, e.message.as_str()), (2, "comment is never closed"));
+        let e = scan("<robot>\n<link name='a\n/></robot>").unwrap_err();
+        assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn unescape_entities() {
+        assert_eq!(unescape("a&lt;b&gt;&#65;&#x42;&amp;&bogus;"), "a<b>AB&&bogus;");
+    }
+}

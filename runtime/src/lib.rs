@@ -14,5 +14,32 @@ mod scalar;
 pub use dyngen_macros::robot;
 pub use dyngen_model as model;
 pub use nalgebra;
-pub use robot::{Pose, Robot, Wrench};
+pub use reference::Reference;
+pub use robot::{OpCount, Pose, Robot, Wrench};
 pub use scalar::Scalar;
+
+/// Support for generated code; not a public API.
+#[doc(hidden)]
+pub mod __private {
+    /// A slice as a fixed-size array, with a message naming the argument when the
+    /// length is wrong.
+    #[inline(always)]
+    #[track_caller]
+    pub fn as_array<'a, S, const N: usize>(x: &'a [S], what: &str) -> &'a [S; N] {
+        match x.try_into() {
+            Ok(a) => a,
+            Err(_) => panic!("dyngen: `{what}` has length {}, expected {N}", x.len()),
+        }
+    }
+
+    /// Mutable variant of [`as_array`].
+    #[inline(always)]
+    #[track_caller]
+    pub fn as_array_mut<'a, S, const N: usize>(x: &'a mut [S], what: &str) -> &'a mut [S; N] {
+        let len = x.len();
+        match x.try_into() {
+            Ok(a) => a,
+            Err(_) => panic!("dyngen: `{what}` has length {len}, expected {N}"),
+        }
+    }
+}

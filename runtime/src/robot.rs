@@ -56,8 +56,13 @@ pub trait Robot {
     fn parents() -> &'static [usize];
     /// The nominal standard parameters of the description, length `NPARAMS`.
     fn nominal_params() -> &'static [f64];
-    /// The robot as URDF text, from which the reference model is rebuilt.
+    /// The robot as URDF text (fixed joints already merged), from which the
+    /// reference model is rebuilt: `dyngen_model::parse_urdf(R::urdf())`.
     fn urdf() -> &'static str;
+    /// Gravity in the base frame the generated code was specialised for, m/s².
+    fn gravity() -> [f64; 3];
+    /// Operation counts of each generated function, by function name.
+    fn op_counts() -> &'static [(&'static str, OpCount)];
 
     /// Inverse dynamics by the generated Newton–Euler recursion:
     /// `tau = M(q) a + C(q, v) v + g(q)`. `q, v, a, tau`: `NV`; `params`: `NPARAMS`.
@@ -70,4 +75,27 @@ pub trait Robot {
     /// frame origin), in body `j`'s frame: Pinocchio's `data.f[j]` after `rnea`.
     /// `wrenches`: `NBODIES`.
     fn joint_wrenches<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], wrenches: &mut [Wrench<S>]);
+}
+
+/// Operation counts of one generated function, as the generator measured them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    pub muls: usize,
+    /// Additions and subtractions.
+    pub adds: usize,
+    pub negs: usize,
+    /// `sin` and `cos` evaluations (a fused `sin_cos` counts as two).
+    pub trig: usize,
+    /// `let` statements emitted.
+    pub statements: usize,
+}
+
+impl core::fmt::Display for OpCount {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "{} mul, {} add, {} neg, {} trig ({} statements)",
+            self.muls, self.adds, self.negs, self.trig, self.statements
+        )
+    }
 }

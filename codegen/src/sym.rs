@@ -1,0 +1,382 @@
+//! The symbolic expression graph the algorithms run through. Nodes are hash-consed
+//! (an expression built twice is one node, computed once), constants are folded, and
+//! the exact 0 and ±1 that axis-aligned joints produce make whole terms vanish.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// Index of a node in its graph. Operands always have smaller ids than their users,
+/// so id order is a valid evaluation order.
+pub type NodeId = u32;
+
+/// One operation. Constants are stored by bit pattern so nodes can be hashed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Node {
+    Const(u64),
+    /// Element `index` of function argument `arg`.
+    Input { arg: u8, index: u32 },
+    Add(NodeId, NodeId),
+    Sub(NodeId, NodeId),
+    Mul(NodeId, NodeId),
+    Neg(NodeId),
+    Sin(NodeId),
+    Cos(NodeId),
+}
+
+/// A hash-consed expression graph.
+#[derive(Default)]
+pub struct Graph {
+    nodes: RefCell<Vec<Node>>,
+    index: RefCell<HashMap<Node, NodeId>>,
+}
+
+/// A handle to a node: cheap to copy, with arithmetic operators that fold as they
+/// build.
+#[derive(Clone, Copy)]
+pub struct Expr<'g> {
+    graph: &'g Graph,
+    id: NodeId,
+}
+
+impl std::fmt::Debug for Expr<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Expr({}: {:?})", self.id, self.graph.node(self.id))
+    }
+}
+
+impl Graph {
+    pub fn new() -> Graph {
+        Graph::default()
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.borrow().len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.borrow().is_empty()
+    }
+
+    pub fn node(&self, id: NodeId) -> Node {
+        self.nodes.borrow()[id as usize]
+    }
+
+    fn intern(&self, node: Node) -> Expr<'_> {
+        if let Some(&id) = self.index.borrow().get(&node) {
+            return Expr { graph: self, id };
+        }
+        let mut nodes = self.nodes.borrow_mut();
+        let id = NodeId::try_from(nodes.len()).expect("expression graph exceeds 2^32 nodes");
+        nodes.push(node);
+        self.index.borrow_mut().insert(node, id);
+        Expr { graph: self, id }
+    }
+
+    pub fn constant(&self, x: f64) -> Expr<'_> {
+        // One zero: -0.0 and 0.0 are the same constant for folding purposes.
+        let x = if x == 0.0 { 0.0 } else { x };
+        self.intern(Node::Const(x.to_bits()))
+    }
+
+    pub fn zero(&self) -> Expr<'_> {
+        self.constant(0.0)
+    }
+
+    pub fn one(&self) -> Expr<'_> {
+        self.constant(1.0)
+    }
+
+    pub fn input(&self, arg: u8, index: u32) -> Expr<'_> {
+        self.intern(Node::Input { arg, index })
+    }
+
+    pub fn expr(&self, id: NodeId) -> Expr<'_> {
+        Expr { graph: self, id }
+    }
+
+    /// Evaluates every node reachable from `outputs`, reading inputs through `input`.
+    pub fn eval(&self, outputs: &[NodeId], input: impl Fn(u8, u32) -> f64) -> Vec<f64> {
+        let nodes = self.nodes.borrow();
+        let live = self.live(outputs);
+        let mut val = vec![0.0; nodes.len()];
+        for (id, node) in nodes.iter().enumerate() {
+            if !live[id] {
+                continue;
+            }
+            val[id] = match *node {
+                Node::Const(b) => f64::from_bits(b),
+                Node::Input { arg, index } => input(arg, index),
+                Node::Add(a, b) => val[a as usize] + val[b as usize],
+                Node::Sub(a, b) => val[a as usize] - val[b as usize],
+                Node::Mul(a, b) => val[a as usize] * val[b as usize],
+                Node::Neg(a) => -val[a as usize],
+                Node::Sin(a) => val[a as usize].sin(),
+                Node::Cos(a) => val[a as usize].cos(),
+            };
+        }
+        outputs.iter().map(|&o| val[o as usize]).collect()
+    }
+
+    /// Which nodes the outputs depend on.
+    pub fn live(&self, outputs: &[NodeId]) -> Vec<bool> {
+        let nodes = self.nodes.borrow();
+        let mut live = vec![false; nodes.len()];
+        for &o in outputs {
+            live[o as usize] = true;
+        }
+        for id in (0..nodes.len()).rev() {
+            if !live[id] {
+                continue;
+            }
+            match nodes[id] {
+                Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => {
+                    live[a as usize] = true;
+                    live[b as usize] = true;
+                }
+                Node::Neg(a) | Node::Sin(a) | Node::Cos(a) => live[a as usize] = true,
+                Node::Const(_) | Node::Input { .. } => {}
+            }
+        }
+        live
+    }
+}
+
+impl<'g> Expr<'g> {
+    pub fn id(self) -> NodeId {
+        self.id
+    }
+
+    pub fn graph(self) -> &'g Graph {
+        self.graph
+    }
+
+    pub fn node(self) -> Node {
+        self.graph.node(self.id)
+    }
+
+    /// The constant value, if this is a constant.
+    pub fn as_const(self) -> Option<f64> {
+        match self.node() {
+            Node::Const(b) => Some(f64::from_bits(b)),
+            _ => None,
+        }
+    }
+
+    pub fn is_zero(self) -> bool {
+        self.as_const() == Some(0.0)
+    }
+
+    fn is_const(self, v: f64) -> bool {
+        self.as_const() == Some(v)
+    }
+
+    pub fn sin(self) -> Expr<'g> {
+        match self.as_const() {
+            Some(c) => self.graph.constant(c.sin()),
+            None => self.graph.intern(Node::Sin(self.id)),
+        }
+    }
+
+    pub fn cos(self) -> Expr<'g> {
+        match self.as_const() {
+            Some(c) => self.graph.constant(c.cos()),
+            None => self.graph.intern(Node::Cos(self.id)),
+        }
+    }
+
+    /// The operand of a negation.
+    fn negated(self) -> Option<Expr<'g>> {
+        match self.node() {
+            Node::Neg(a) => Some(self.graph.expr(a)),
+            _ => None,
+        }
+    }
+}
+
+impl<'g> Add for Expr<'g> {
+    type Output = Expr<'g>;
+    fn add(self, rhs: Expr<'g>) -> Expr<'g> {
+        let g = self.graph;
+        if let (Some(a), Some(b)) = (self.as_const(), rhs.as_const()) {
+            return g.constant(a + b);
+        }
+        if self.is_zero() {
+            return rhs;
+        }
+        if rhs.is_zero() {
+            return self;
+        }
+        if let Some(b) = rhs.negated() {
+            return self - b;
+        }
+        if let Some(a) = self.negated() {
+            return rhs - a;
+        }
+        let (x, y) = if self.id <= rhs.id { (self.id, rhs.id) } else { (rhs.id, self.id) };
+        g.intern(Node::Add(x, y))
+    }
+}
+
+impl<'g> Sub for Expr<'g> {
+    type Output = Expr<'g>;
+    fn sub(self, rhs: Expr<'g>) -> Expr<'g> {
+        let g = self.graph;
+        if let (Some(a), Some(b)) = (self.as_const(), rhs.as_const()) {
+            return g.constant(a - b);
+        }
+        if rhs.is_zero() {
+            return self;
+        }
+        if self.is_zero() {
+            return -rhs;
+        }
+        if self.id == rhs.id {
+            return g.zero();
+        }
+        if let Some(b) = rhs.negated() {
+            return self + b;
+        }
+        if let Some(a) = self.negated() {
+            // −a − b = −(a + b)
+            return -(a + rhs);
+        }
+        g.intern(Node::Sub(self.id, rhs.id))
+    }
+}
+
+impl<'g> Mul for Expr<'g> {
+    type Output = Expr<'g>;
+    fn mul(self, rhs: Expr<'g>) -> Expr<'g> {
+        let g = self.graph;
+        if let (Some(a), Some(b)) = (self.as_const(), rhs.as_const()) {
+            return g.constant(a * b);
+        }
+        if self.is_zero() || rhs.is_zero() {
+            return g.zero();
+        }
+        if self.is_const(1.0) {
+            return rhs;
+        }
+        if rhs.is_const(1.0) {
+            return self;
+        }
+        if self.is_const(-1.0) {
+            return -rhs;
+        }
+        if rhs.is_const(-1.0) {
+            return -self;
+        }
+        // Pull signs out so that (−a)·b and a·(−b) share the node a·b.
+        match (self.negated(), rhs.negated()) {
+            (Some(a), Some(b)) => return a * b,
+            (Some(a), None) => return -(a * rhs),
+            (None, Some(b)) => return -(self * b),
+            (None, None) => {}
+        }
+        // Constants with a negative sign become a negation of the positive constant.
+        if let Some(c) = self.as_const().filter(|c| *c < 0.0) {
+            return -(g.constant(-c) * rhs);
+        }
+        if let Some(c) = rhs.as_const().filter(|c| *c < 0.0) {
+            return -(self * g.constant(-c));
+        }
+        let (x, y) = if self.id <= rhs.id { (self.id, rhs.id) } else { (rhs.id, self.id) };
+        g.intern(Node::Mul(x, y))
+    }
+}
+
+impl<'g> Neg for Expr<'g> {
+    type Output = Expr<'g>;
+    fn neg(self) -> Expr<'g> {
+        if let Some(c) = self.as_const() {
+            return self.graph.constant(-c);
+        }
+        if let Some(a) = self.negated() {
+            return a;
+        }
+        if let Node::Sub(a, b) = self.node() {
+            return self.graph.expr(b) - self.graph.expr(a);
+        }
+        self.graph.intern(Node::Neg(self.id))
+    }
+}
+
+/// Operation counts of a set of outputs: what the emitted code computes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub adds: usize,
+    pub muls: usize,
+    pub negs: usize,
+    /// `sin` and `cos` calls; a `sin`/`cos` pair of one angle counts as two.
+    pub trig: usize,
+}
+
+impl OpCount {
+    pub fn of(graph: &Graph, outputs: &[NodeId]) -> OpCount {
+        let live = graph.live(outputs);
+        let mut c = OpCount::default();
+        for (id, &l) in live.iter().enumerate() {
+            if !l {
+                continue;
+            }
+            match graph.node(id as NodeId) {
+                Node::Add(..) | Node::Sub(..) => c.adds += 1,
+                Node::Mul(..) => c.muls += 1,
+                Node::Neg(_) => c.negs += 1,
+                Node::Sin(_) | Node::Cos(_) => c.trig += 1,
+                Node::Const(_) | Node::Input { .. } => {}
+            }
+        }
+        c
+    }
+
+    /// Floating-point operations: adds + muls (negations are sign flips, trig apart).
+    pub fn flops(&self) -> usize {
+        self.adds + self.muls
+    }
+}
+
+impl std::fmt::Display for OpCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} mul, {} add, {} neg, {} trig", self.muls, self.adds, self.negs, self.trig)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folding_and_sharing() {
+        let g = Graph::new();
+        let x = g.input(0, 0);
+        let y = g.input(0, 1);
+        assert_eq!((x * g.one()).id(), x.id());
+        assert!((x * g.zero()).is_zero());
+        assert_eq!((x + y).id(), (y + x).id());
+        assert_eq!((-(-x)).id(), x.id());
+        assert_eq!((x - x).as_const(), Some(0.0));
+        assert_eq!(((-x) * (-y)).id(), (x * y).id());
+        assert_eq!((g.constant(2.0) * g.constant(3.0)).as_const(), Some(6.0));
+        assert_eq!((x + (-y)).id(), (x - y).id());
+        let before = g.len();
+        let _again = x * y + g.constant(2.0) * x;
+        let _again2 = x * y + g.constant(2.0) * x;
+        assert_eq!(g.len(), before + 3);
+    }
+
+    #[test]
+    fn eval_matches_direct_arithmetic() {
+        let g = Graph::new();
+        let q = g.input(0, 0);
+        let p = g.input(1, 0);
+        let e = q.sin() * p - q.cos() * g.constant(0.5) + (-p);
+        let out = g.eval(&[e.id()], |arg, _| if arg == 0 { 0.7 } else { 1.3 });
+        let want = 0.7f64.sin() * 1.3 - 0.7f64.cos() * 0.5 - 1.3;
+        assert!((out[0] - want).abs() < 1e-15);
+        let c = OpCount::of(&g, &[e.id()]);
+        assert_eq!(c.trig, 2);
+    }
+}

@@ -1,0 +1,899 @@
+//! The URDF front end and writer: one test per user-facing error (each checks that
+//! the message names the element and its line), fixed-joint merging against a hand
+//! computation, depth-first numbering, and `to_urdf` → `parse_urdf` round trips.
+
+use dyngen_model::math;
+use dyngen_model::urdf::urdf_description;
+use dyngen_model::{load_urdf, parse_urdf, to_urdf, Element, ErrorKind, JointKind, Model, ModelError, ModelErrors};
+use std::path::PathBuf;
+
+/// A robot whose body is `lines`, so that `lines[k]` sits on line `k + 2`.
+fn robot(lines: &[&str]) -> String {
+    let mut text = String::from("<robot name=\"t\">\n");
+    for l in lines {
+        text.push_str(l);
+        text.push('\n');
+    }
+    text.push_str("</robot>\n");
+    text
+}
+
+/// A link with a valid inertial, on one line.
+fn link(name: &str) -> String {
+    format!(
+        r#"<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>"#
+    )
+}
+
+/// A link with the given mass and principal moments, on one line.
+fn link_with(name: &str, mass: &str, moments: [&str; 3]) -> String {
+    let [x, y, z] = moments;
+    format!(
+        r#"<link name="{name}"><inertial><mass value="{mass}"/><inertia ixx="{x}" iyy="{y}" izz="{z}" ixy="0" ixz="0" iyz="0"/></inertial></link>"#
+    )
+}
+
+/// A joint with optional extra elements, on one line.
+fn joint(name: &str, kind: &str, parent: &str, child: &str, extra: &str) -> String {
+    format!(r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>{extra}</joint>"#)
+}
+
+fn errors(text: &str) -> Vec<ModelError> {
+    match parse_urdf(text) {
+        Ok(m) => panic!("expected errors, got a model of {} bodies", m.dof()),
+        Err(e) => {
+            assert_eq!(e.file, None);
+            e.errors
+        }
+    }
+}
+
+/// Exactly one error; its message names `element` and `line`.
+fn single(text: &str, element: Element, line: usize) -> ModelError {
+    let errs = errors(text);
+    assert_eq!(errs.len(), 1, "{errs:#?}");
+    let e = errs.into_iter().next().unwrap();
+    assert_named(&e, &element, line);
+    e
+}
+
+fn assert_named(e: &ModelError, element: &Element, line: usize) {
+    assert_eq!(&e.element, element, "{e}");
+    assert_eq!(e.line, Some(line), "{e}");
+    let message = e.to_string();
+    assert!(message.starts_with(&format!("line {line}: {element}: ")), "{message}");
+}
+
+// ---------------------------------------------------------------------------------
+// Structure errors
+
+#[test]
+fn unknown_parent_link() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "nope", "a", ""),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnknownParentLink("nope".into()));
+    assert!(e.to_string().contains("parent link `nope` does not exist"), "{e}");
+}
+
+#[test]
+fn unknown_child_link() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "nope", ""),
+    ]);
+    let errs = errors(&text);
+    // `a` then has no parent joint, so it is a second root (reported first, on line 1).
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_eq!(errs[0].kind, ErrorKind::SeveralRoots(vec!["base".into(), "a".into()]));
+    assert_named(&errs[1], &Element::Joint("j".into()), 4);
+    assert_eq!(errs[1].kind, ErrorKind::UnknownChildLink("nope".into()));
+    assert!(
+        errs[1].to_string().contains("child link `nope` does not exist"),
+        "{}",
+        errs[1]
+    );
+}
+
+#[test]
+fn several_roots() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("stray"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Robot, 1);
+    assert_eq!(e.kind, ErrorKind::SeveralRoots(vec!["base".into(), "stray".into()]));
+    assert!(e.to_string().contains("several root links (base, stray)"), "{e}");
+}
+
+#[test]
+fn detached_loop_is_a_cycle() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &link("c"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("jbc", "continuous", "b", "c", ""),
+        &joint("jcb", "continuous", "c", "b", ""),
+    ]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_named(&errs[0], &Element::Joint("jbc".into()), 7);
+    assert_named(&errs[1], &Element::Joint("jcb".into()), 8);
+    for e in &errs {
+        assert_eq!(e.kind, ErrorKind::Cycle);
+        assert!(e.to_string().contains("closes a kinematic loop"), "{e}");
+    }
+}
+
+#[test]
+fn joint_into_the_root_is_a_cycle() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("up", "continuous", "base", "a", ""),
+        &joint("back", "continuous", "a", "base", ""),
+    ]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_named(&errs[0], &Element::Joint("up".into()), 4);
+    assert_named(&errs[1], &Element::Joint("back".into()), 5);
+    assert!(errs.iter().all(|e| e.kind == ErrorKind::Cycle));
+}
+
+#[test]
+fn joint_into_an_ancestor_gives_two_parents() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("jb", "continuous", "a", "b", ""),
+        &joint("loop", "continuous", "b", "a", ""),
+    ]);
+    let e = single(&text, Element::Link("a".into()), 3);
+    assert_eq!(e.kind, ErrorKind::SeveralParents(vec!["ja".into(), "loop".into()]));
+}
+
+#[test]
+fn link_with_two_parent_joints() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("j1", "continuous", "base", "a", ""),
+        &joint("j2", "continuous", "base", "b", ""),
+        &joint("j3", "continuous", "a", "b", ""),
+    ]);
+    let e = single(&text, Element::Link("b".into()), 4);
+    assert!(e.to_string().contains("is the child of several joints (j2, j3)"), "{e}");
+}
+
+#[test]
+fn duplicate_names() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let errs = errors(&text);
+    let find = |kind: ErrorKind| {
+        errs.iter()
+            .find(|e| e.kind == kind)
+            .unwrap_or_else(|| panic!("{errs:#?}"))
+    };
+    assert_named(find(ErrorKind::DuplicateLink), &Element::Link("a".into()), 4);
+    assert_named(find(ErrorKind::DuplicateJoint), &Element::Joint("j".into()), 6);
+}
+
+#[test]
+fn nothing_moves() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "fixed", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Robot, 1);
+    assert_eq!(e.kind, ErrorKind::NoMovingJoint);
+}
+
+// ---------------------------------------------------------------------------------
+// Joint errors
+
+#[test]
+fn zero_axis() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", r#"<axis xyz="0 0 0"/>"#),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::ZeroAxis);
+    assert!(e.to_string().contains("the axis is zero"), "{e}");
+}
+
+#[test]
+fn unsupported_joint_types() {
+    for kind in ["floating", "planar", "spherical"] {
+        let text = robot(&[r#"<link name="base"/>"#, &link("a"), &joint("j", kind, "base", "a", "")]);
+        let e = single(&text, Element::Joint("j".into()), 4);
+        assert_eq!(e.kind, ErrorKind::UnsupportedJointType(kind.into()));
+        assert!(
+            e.to_string().contains(&format!("joint type `{kind}` is not supported")),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn unknown_joint_type_is_named_with_its_line() {
+    // urdf-rs rejects this without a position; the scan supplies it.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "screw", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnsupportedJointType("screw".into()));
+}
+
+#[test]
+fn bad_limits() {
+    let limit = r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#;
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "revolute", "base", "a", limit),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(
+        e.kind,
+        ErrorKind::BadLimits {
+            lower: 1.0,
+            upper: -1.0
+        }
+    );
+}
+
+#[test]
+fn non_finite_origin() {
+    let origin = r#"<origin xyz="nan 0 0"/>"#;
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", origin),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::NonFiniteValue("origin"));
+}
+
+// ---------------------------------------------------------------------------------
+// Inertial errors
+
+fn one_body(link_line: &str) -> String {
+    robot(&[
+        r#"<link name="base"/>"#,
+        link_line,
+        &joint("j", "continuous", "base", "a", ""),
+    ])
+}
+
+#[test]
+fn moving_body_without_inertial() {
+    let e = single(&one_body(r#"<link name="a"/>"#), Element::Link("a".into()), 3);
+    assert_eq!(e.kind, ErrorKind::MissingInertial);
+    assert!(e.to_string().contains("has no <inertial>"), "{e}");
+}
+
+#[test]
+fn all_zero_inertial_counts_as_missing() {
+    let e = single(
+        &one_body(&link_with("a", "0", ["0", "0", "0"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert_eq!(e.kind, ErrorKind::MissingInertial);
+}
+
+#[test]
+fn zero_and_negative_mass() {
+    for (mass, value) in [("0", 0.0), ("-1.5", -1.5)] {
+        let e = single(
+            &one_body(&link_with("a", mass, ["1", "1", "1"])),
+            Element::Link("a".into()),
+            3,
+        );
+        assert_eq!(e.kind, ErrorKind::NonPositiveMass(value));
+        assert!(e.to_string().contains(&format!("mass {mass} is not positive")), "{e}");
+    }
+}
+
+#[test]
+fn non_finite_mass() {
+    // urdf-rs reads `NaN` and `inf` as numbers, so the check is ours.
+    for mass in ["NaN", "inf", "-inf"] {
+        let e = single(
+            &one_body(&link_with("a", mass, ["1", "1", "1"])),
+            Element::Link("a".into()),
+            3,
+        );
+        assert_eq!(e.kind, ErrorKind::NonFiniteValue("mass"), "{mass}");
+        assert!(e.to_string().contains("mass is not a finite number"), "{e}");
+    }
+}
+
+#[test]
+fn unreadable_number_is_a_parse_error() {
+    let errs = errors(&one_body(&link_with("a", "heavy", ["1", "1", "1"])));
+    assert_eq!(errs.len(), 1);
+    assert!(
+        matches!(&errs[0].kind, ErrorKind::Parse(m) if m.contains("invalid float")),
+        "{errs:?}"
+    );
+    assert!(errs[0].to_string().starts_with("robot: not valid URDF"), "{}", errs[0]);
+}
+
+#[test]
+fn inertia_not_positive_definite() {
+    let e = single(
+        &one_body(&link_with("a", "1", ["1", "1", "0"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert!(matches!(e.kind, ErrorKind::NotPositiveDefinite(_)), "{e:?}");
+    assert!(e.to_string().contains("inertia is not positive definite"), "{e}");
+}
+
+#[test]
+fn triangle_inequality_violated() {
+    let e = single(
+        &one_body(&link_with("a", "1", ["1", "1", "3"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert!(matches!(e.kind, ErrorKind::TriangleInequality(_)), "{e:?}");
+    assert!(e.to_string().contains("break the triangle inequality"), "{e}");
+}
+
+#[test]
+fn merged_link_error_is_reported_once() {
+    // The bad fixed child spoils its body too; only the link at fault is named.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link_with("tool", "-3", ["1", "1", "1"]),
+        &joint("j", "continuous", "base", "a", ""),
+        &joint("f", "fixed", "a", "tool", ""),
+    ]);
+    let e = single(&text, Element::Link("tool".into()), 4);
+    assert_eq!(e.kind, ErrorKind::NonPositiveMass(-3.0));
+}
+
+#[test]
+fn point_masses_and_massless_frames_on_fixed_joints_are_merged() {
+    // Each part need only be physical; the merged body must be strictly positive.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link_with("camera", "0.01", ["0", "0", "0"]),
+        &link_with("foot", "0", ["1e-6", "1e-6", "1e-6"]),
+        &joint("j", "continuous", "base", "a", ""),
+        &joint("cam", "fixed", "a", "camera", r#"<origin xyz="0 0 1"/>"#),
+        &joint("ankle", "fixed", "a", "foot", ""),
+    ]);
+    let m = parse_urdf(&text).unwrap();
+    // Siblings are walked by joint name (`ankle` before `cam`), as Pinocchio does.
+    assert_eq!(m.bodies[0].merged, ["foot", "camera"]);
+    assert_close(m.bodies[0].inertial.mass, 1.01, 1e-15, "mass");
+}
+
+// ---------------------------------------------------------------------------------
+// File-level errors
+
+#[test]
+fn raw_xacro_is_rejected() {
+    let text = "<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <link name=\"base\"/>\n  <xacro:property name=\"l\" value=\"0.5\"/>\n</robot>\n";
+    let e = single(text, Element::Robot, 3);
+    assert_eq!(e.kind, ErrorKind::Xacro);
+    assert!(e.to_string().contains("expand it first"), "{e}");
+
+    let text = one_body(&link("a")).replace(r#"<parent link="base"/>"#, r#"<parent link="${prefix}base"/>"#);
+    let e = single(&text, Element::Robot, 4);
+    assert_eq!(e.kind, ErrorKind::Xacro);
+}
+
+#[test]
+fn expanded_urdf_with_xacro_leftovers_is_accepted() {
+    // Shipped URDFs keep `xmlns:xacro` and commented-out xacro; neither is a macro.
+    let text = one_body(&link("a"))
+        .replace(
+            "<robot name=\"t\">",
+            "<robot name=\"t\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">",
+        )
+        .replace(
+            "</robot>",
+            "<!-- <xacro:macro name=\"m\" params=\"${x}\"/> -->\n</robot>",
+        );
+    assert_eq!(parse_urdf(&text).map(|m| m.dof()), Ok(1));
+}
+
+#[test]
+fn malformed_xml() {
+    let text = "<robot name=\"r\">\n  <link name=\"base\">\n  <link name=\"a\"/>\n</robot>\n";
+    let e = single(text, Element::Robot, 4);
+    assert!(
+        matches!(&e.kind, ErrorKind::Parse(m) if m.contains("</robot> closes <link> opened on line 2")),
+        "{e:?}"
+    );
+
+    let errs = errors("this is not xml");
+    assert_eq!(errs.len(), 1);
+    assert!(matches!(errs[0].kind, ErrorKind::Parse(_)), "{errs:?}");
+}
+
+#[test]
+fn unreadable_file() {
+    let path = PathBuf::from("/nonexistent/dyngen/robot.urdf");
+    let e = load_urdf(&path).unwrap_err();
+    assert_eq!(e.file.as_deref(), Some("/nonexistent/dyngen/robot.urdf"));
+    assert!(matches!(e.errors[0].kind, ErrorKind::Io(_)), "{e:?}");
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/dyngen/robot.urdf: robot: cannot read the file"),
+        "{e}"
+    );
+
+    // A directory is not readable as text either.
+    let e = load_urdf(&std::env::temp_dir()).unwrap_err();
+    assert!(matches!(e.errors[0].kind, ErrorKind::Io(_)), "{e:?}");
+}
+
+/// A scratch file that removes itself.
+struct TempFile(PathBuf);
+
+impl TempFile {
+    fn new(name: &str, text: &str) -> TempFile {
+        let path = std::env::temp_dir().join(format!("dyngen-{}-{name}", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        TempFile(path)
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+#[test]
+fn display_prints_file_and_line() {
+    let file = TempFile::new("display.urdf", &one_body(r#"<link name="a"/>"#));
+    let e: ModelErrors = load_urdf(&file.0).unwrap_err();
+    let shown = e.to_string();
+    let expected = format!("{}:3: link `a`: this moving body has no <inertial>", file.0.display());
+    assert!(shown.starts_with(&expected), "{shown}");
+}
+
+#[test]
+fn all_errors_of_a_file_are_reported_together() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &link("c"),
+        &joint("ja", "continuous", "bsae", "a", ""),
+        &joint("jb", "continuous", "base", "b", r#"<axis xyz="0 0 0"/>"#),
+        &joint("jc", "floating", "base", "c", ""),
+    ]);
+    let e = parse_urdf(&text).unwrap_err();
+    let kinds: Vec<(&Element, Option<usize>, &ErrorKind)> =
+        e.errors.iter().map(|e| (&e.element, e.line, &e.kind)).collect();
+    assert_eq!(
+        kinds,
+        [
+            (
+                &Element::Joint("ja".into()),
+                Some(6),
+                &ErrorKind::UnknownParentLink("bsae".into())
+            ),
+            (&Element::Joint("jb".into()), Some(7), &ErrorKind::ZeroAxis),
+            (
+                &Element::Joint("jc".into()),
+                Some(8),
+                &ErrorKind::UnsupportedJointType("floating".into())
+            ),
+        ]
+    );
+    assert_eq!(e.to_string().lines().count(), 3);
+
+    // Value errors are collected across bodies too.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link_with("a", "0", ["1", "1", "1"]),
+        &link_with("b", "1", ["1", "1", "5"]),
+        r#"<link name="c"/>"#,
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("jb", "continuous", "a", "b", ""),
+        &joint("jc", "continuous", "b", "c", ""),
+    ]);
+    let lines: Vec<Option<usize>> = errors(&text).iter().map(|e| e.line).collect();
+    assert_eq!(lines, [Some(3), Some(4), Some(5)]);
+}
+
+// ---------------------------------------------------------------------------------
+// Reading
+
+#[test]
+fn lines_found_across_quote_and_whitespace_styles() {
+    let text = "<?xml version=\"1.0\"?>\n<!-- <link name=\"a\"/> is not here -->\n<robot name='t'>\n  <link name='base'/>\n  <link\n     name = \"a\" >\n  </link>\n  <joint name='j' type=\"continuous\">\n    <parent link=\"base\"/><child link='a'/>\n  </joint>\n</robot>\n";
+    let e = single(text, Element::Link("a".into()), 5);
+    assert_eq!(e.kind, ErrorKind::MissingInertial);
+}
+
+#[test]
+fn transmission_joints_are_not_joints() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        r#"<transmission name="t"><joint name="j"><hardwareInterface>x</hardwareInterface></joint></transmission>"#,
+        r#"<link name="a"/>"#,
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    assert_eq!(errors(&text)[0].line, Some(4));
+}
+
+#[test]
+fn geometry_is_ignored_and_lines_still_hold() {
+    // urdf-rs would reject the file-less <texture/>; dynamics never reads it.
+    let text = robot(&[
+        r#"<material name="skin"><texture/></material>"#,
+        r#"<link name="base"><visual><geometry><capsule radius="-1"/></geometry>"#,
+        r#"  <material name="m"><color rgba="1 0 0 1"/></material></visual>"#,
+        r#"  <collision><geometry><mesh/></geometry></collision></link>"#,
+        r#"<link name="a"/>"#,
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Link("a".into()), 6);
+    assert_eq!(e.kind, ErrorKind::MissingInertial);
+}
+
+#[test]
+fn limits_only_when_written() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &link("c"),
+        &joint(
+            "ja",
+            "revolute",
+            "base",
+            "a",
+            r#"<limit lower="-1.5" upper="2" effort="30" velocity="4"/>"#,
+        ),
+        &joint("jb", "revolute", "a", "b", ""),
+        &joint("jc", "continuous", "b", "c", r#"<limit effort="1" velocity="2"/>"#),
+    ]);
+    let m = parse_urdf(&text).unwrap();
+    let l = m.joints[0].limits.unwrap();
+    assert_eq!((l.lower, l.upper, l.effort, l.velocity), (-1.5, 2.0, 30.0, 4.0));
+    assert_eq!(m.joints[1].limits, None);
+    assert_eq!(m.joints[2].limits, None);
+}
+
+#[test]
+fn description_keeps_what_was_written() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        r#"<link name="tip"/>"#,
+        &joint("ja", "revolute", "base", "a", r#"<axis xyz="0 0 2"/>"#),
+        &joint("tip", "fixed", "a", "tip", ""),
+    ]);
+    let d = urdf_description(&text).unwrap();
+    assert_eq!(d.name, "t");
+    assert_eq!(d.gravity, dyngen_model::DEFAULT_GRAVITY);
+    assert_eq!(
+        d.links.iter().map(|l| l.line).collect::<Vec<_>>(),
+        [Some(2), Some(3), Some(4)]
+    );
+    assert!(d.links[0].inertial.is_none() && d.links[2].inertial.is_none());
+    assert_eq!(d.joints[0].axis, [0.0, 0.0, 2.0]);
+    assert_eq!(d.joints[0].limits, None);
+    assert_eq!(d.joints[1].kind, dyngen_model::DeclaredJointType::Fixed);
+}
+
+fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs())),
+        "{what}: {a} vs {b}"
+    );
+}
+
+fn assert_mat_close(a: &math::Mat3, b: &math::Mat3, tol: f64, what: &str) {
+    for r in 0..3 {
+        for c in 0..3 {
+            assert_close(a[r][c], b[r][c], tol, what);
+        }
+    }
+}
+
+#[test]
+fn inertial_origin_rotation_is_applied() {
+    let inertial = |rpy: &str| {
+        format!(
+            r#"<link name="a"><inertial><origin xyz="0.1 0.2 0.3" rpy="{rpy}"/><mass value="2"/><inertia ixx="1" iyy="2" izz="2.5" ixy="0.1" ixz="-0.2" iyz="0.05"/></inertial></link>"#
+        )
+    };
+    // A quarter turn about z swaps the x and y axes.
+    let m = parse_urdf(&one_body(&inertial("0 0 1.5707963267948966"))).unwrap();
+    let i = m.bodies[0].inertial;
+    assert_eq!(i.com, [0.1, 0.2, 0.3]);
+    assert_eq!(i.inertia, [[2.0, -0.1, -0.05], [-0.1, 1.0, -0.2], [-0.05, -0.2, 2.5]]);
+
+    let rpy = [0.3, -0.4, 1.1];
+    let m = parse_urdf(&one_body(&inertial("0.3 -0.4 1.1"))).unwrap();
+    let local = [[1.0, 0.1, -0.2], [0.1, 2.0, 0.05], [-0.2, 0.05, 2.5]];
+    let expected = math::rotate_inertia(&math::rpy_to_matrix(rpy), &local);
+    assert_mat_close(&m.bodies[0].inertial.inertia, &expected, 1e-15, "R I Rᵀ");
+    let i = m.bodies[0].inertial.inertia;
+    assert_eq!((i[0][1], i[0][2], i[1][2]), (i[1][0], i[2][0], i[2][1]), "symmetric");
+}
+
+// ---------------------------------------------------------------------------------
+// Fixed joints and numbering
+
+#[test]
+fn fixed_joint_merging_matches_hand_computation() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        r#"<link name="arm"><inertial><origin xyz="0 0 0.1"/><mass value="2"/><inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        r#"<link name="tool"><inertial><origin xyz="0.02 0 0"/><mass value="0.5"/><inertia ixx="0.001" iyy="0.002" izz="0.003" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        &link("finger"),
+        &joint("shoulder", "continuous", "base", "arm", ""),
+        &joint(
+            "mount",
+            "fixed",
+            "arm",
+            "tool",
+            r#"<origin xyz="0.1 0 0.3" rpy="0 0 1.5707963267948966"/>"#,
+        ),
+        &joint(
+            "grip",
+            "prismatic",
+            "tool",
+            "finger",
+            r#"<origin xyz="0 0 0.05"/><axis xyz="1 0 0"/><limit lower="0" upper="0.04" effort="10" velocity="0.1"/>"#,
+        ),
+    ]);
+    let m = parse_urdf(&text).unwrap();
+    assert_eq!(m.dof(), 2);
+    let arm = &m.bodies[0];
+    assert_eq!(arm.merged, ["tool"]);
+    // Tool in arm axes: Rz(90°) turns its com (0.02, 0, 0) into (0, 0.02, 0), then
+    // the mount offset adds (0.1, 0, 0.3); its moments swap to (0.002, 0.001, 0.003).
+    // Mass 2.5; first moment 2·(0, 0, 0.1) + 0.5·(0.1, 0.02, 0.3) = (0.05, 0.01, 0.35).
+    // Inertia about the arm origin, part by part (I_c + m(|c|²E − ccᵀ)):
+    //   arm  diag(0.01, 0.02, 0.03) + 2·diag(0.01, 0.01, 0)         = diag(0.03, 0.04, 0.03)
+    //   tool diag(0.002, 0.001, 0.003) + 0.5·(0.1004 E − c cᵀ):
+    //        xx 0.0472, yy 0.051, zz 0.0082, xy −0.001, xz −0.015, yz −0.003
+    let expected = [2.5, 0.05, 0.01, 0.35, 0.0772, -0.001, 0.091, -0.015, -0.003, 0.0382];
+    let got = arm.inertial.standard_params();
+    for (k, (g, e)) in got.iter().zip(expected).enumerate() {
+        assert_close(*g, e, 1e-14, &format!("standard parameter {k}"));
+    }
+    for (g, e) in arm.inertial.com.iter().zip([0.02, 0.004, 0.14]) {
+        assert_close(*g, e, 1e-15, "com");
+    }
+    // The finger hangs off the tool, so off the arm body, through the mount.
+    let grip = &m.joints[1];
+    assert_eq!((grip.parent, grip.kind), (1, JointKind::Prismatic));
+    assert_eq!(
+        grip.origin.rotation,
+        [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    for (g, e) in grip.origin.translation.iter().zip([0.1, 0.0, 0.35]) {
+        assert_close(*g, e, 1e-15, "grip origin");
+    }
+}
+
+#[test]
+fn depth_first_numbering_of_a_branched_tree() {
+    // Declaration order interleaves branches; siblings are walked by joint name (as
+    // urdfdom and Pinocchio do), and a fixed joint (`ja0`) sorts before its moving
+    // sibling `ja1`: the body behind it (`fx`) must be numbered first.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("f"),
+        &link("fx"),
+        &link("a1"),
+        &link("a11"),
+        &link("b"),
+        &link("b1"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("ja0", "fixed", "a", "f", ""),
+        &joint("ja1", "continuous", "a", "a1", ""),
+        &joint("jb", "continuous", "base", "b", ""),
+        &joint("jfx", "continuous", "f", "fx", ""),
+        &joint("ja11", "continuous", "a1", "a11", ""),
+        &joint("jb1", "continuous", "b", "b1", ""),
+    ]);
+    let m = parse_urdf(&text).unwrap();
+    let names: Vec<&str> = m.bodies.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(names, ["a", "fx", "a1", "a11", "b", "b1"]);
+    let joints: Vec<&str> = m.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(joints, ["ja", "jfx", "ja1", "ja11", "jb", "jb1"]);
+    let parents: Vec<usize> = (1..=m.dof()).map(|i| m.parent(i)).collect();
+    assert_eq!(parents, [0, 1, 1, 3, 0, 5]);
+    assert!((1..=m.dof()).all(|i| m.parent(i) < i));
+    assert_eq!(m.bodies[0].merged, ["f"]);
+    assert_eq!(m.base, "base");
+    assert_eq!(m.name, "t");
+}
+
+// ---------------------------------------------------------------------------------
+// Writing
+
+/// A branched tree with every moving joint type, rotated joint and inertial
+/// origins, off-diagonal inertias and numbers that need all 17 digits.
+fn branched_urdf() -> String {
+    let body = |name: &str, rpy: &str| {
+        format!(
+            r#"<link name="{name}"><inertial><origin xyz="0.013 -0.021 0.1" rpy="{rpy}"/><mass value="1.2345678901234567"/><inertia ixx="0.011" iyy="0.012" izz="0.0135" ixy="0.0003" ixz="-0.0002" iyz="0.0001"/></inertial></link>"#
+        )
+    };
+    robot(&[
+        r#"<link name="world"/>"#,
+        &body("torso", "0.1 0.2 0.3"),
+        &body("left", "0 0 0"),
+        &body("left_tip", "-1.2 0.4 2.9"),
+        &body("right", "0 1.5707963267948966 0"),
+        &body("slide", "0.7 -0.1 0"),
+        r#"<link name="marker"/>"#,
+        &joint(
+            "waist",
+            "continuous",
+            "world",
+            "torso",
+            r#"<origin xyz="0 0 0.8" rpy="0 0 0.7853981633974483"/><axis xyz="0 0 1"/>"#,
+        ),
+        &joint(
+            "l1",
+            "revolute",
+            "torso",
+            "left",
+            r#"<origin xyz="0.1 0.2 -1e-7" rpy="0.3 -0.2 1.1"/><axis xyz="0 0.6 0.8"/><limit lower="-2.5" upper="1.0000000000000002" effort="50" velocity="3.3"/>"#,
+        ),
+        &joint(
+            "l2",
+            "prismatic",
+            "left",
+            "left_tip",
+            r#"<origin xyz="0 0 0.35" rpy="-2.0 1.2 0.4"/><axis xyz="1 1 0"/><limit lower="0" upper="0.2" effort="100" velocity="0.5"/>"#,
+        ),
+        &joint(
+            "r1",
+            "revolute",
+            "torso",
+            "right",
+            r#"<origin xyz="0.1 -0.2 0" rpy="3.141592653589793 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="5" velocity="6"/>"#,
+        ),
+        &joint("mark", "fixed", "right", "marker", r#"<origin xyz="0 0 0.1"/>"#),
+        &joint(
+            "r2",
+            "prismatic",
+            "torso",
+            "slide",
+            r#"<origin xyz="-0.3 0 0.25" rpy="0 0.5 0"/><axis xyz="0 0 -1"/><limit lower="-0.1" upper="0.1" effort="20" velocity="1"/>"#,
+        ),
+    ])
+}
+
+/// Models equal up to `tol` relative on every number, and exactly on structure.
+/// Merged link names are not compared: URDF output only lists them in a comment.
+fn assert_models_close(a: &Model, b: &Model, tol: f64) {
+    assert_eq!(
+        (&a.name, &a.base, a.gravity, a.dof()),
+        (&b.name, &b.base, b.gravity, b.dof())
+    );
+    for (ja, jb) in a.joints.iter().zip(&b.joints) {
+        assert_eq!((&ja.name, ja.kind, ja.parent), (&jb.name, jb.kind, jb.parent));
+        assert_mat_close(&ja.origin.rotation, &jb.origin.rotation, tol, &ja.name);
+        for k in 0..3 {
+            assert_close(ja.origin.translation[k], jb.origin.translation[k], tol, &ja.name);
+            assert_close(ja.axis[k], jb.axis[k], tol, &ja.name);
+        }
+        assert_eq!(ja.limits, jb.limits, "{}", ja.name);
+    }
+    for (ba, bb) in a.bodies.iter().zip(&b.bodies) {
+        assert_eq!(ba.name, bb.name);
+        let (ia, ib) = (ba.inertial, bb.inertial);
+        assert_close(ia.mass, ib.mass, tol, &ba.name);
+        for k in 0..3 {
+            assert_close(ia.com[k], ib.com[k], tol, &ba.name);
+        }
+        assert_mat_close(&ia.inertia, &ib.inertia, tol, &ba.name);
+    }
+}
+
+#[test]
+fn to_urdf_round_trips() {
+    let model = parse_urdf(&branched_urdf()).unwrap();
+    assert_eq!(model.dof(), 5);
+    let kinds: Vec<JointKind> = model.joints.iter().map(|j| j.kind).collect();
+    use JointKind::*;
+    assert_eq!(kinds, [Continuous, Revolute, Prismatic, Revolute, Prismatic]);
+
+    let written = to_urdf(&model);
+    assert!(
+        written.contains("<!-- generated by dyngen from model t -->"),
+        "{written}"
+    );
+    assert!(written.contains("<!-- includes fixed links: marker -->"), "{written}");
+    assert!(written.contains(r#"xyz="0.1 0.2 -1e-7""#), "{written}");
+    let back = parse_urdf(&written).unwrap_or_else(|e| panic!("{e}\n{written}"));
+    assert_models_close(&model, &back, 1e-15);
+    assert!(back.bodies.iter().all(|b| b.merged.is_empty()));
+
+    // Numbers that were not rotated come back bit for bit.
+    assert_eq!(back.bodies[1].inertial.mass, 1.2345678901234567);
+    assert_eq!(back.joints[1].limits, model.joints[1].limits);
+    assert_eq!(back.joints[0].origin.translation, [0.0, 0.0, 0.8]);
+
+    // Writing again changes nothing but rounding in re-derived angles.
+    let again = parse_urdf(&to_urdf(&back)).unwrap();
+    assert_models_close(&back, &again, 1e-15);
+}
+
+#[test]
+fn to_urdf_gives_unlimited_joints_wide_limits() {
+    // urdfdom insists on a <limit> for these types, so "no limits" is written wide.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &link("c"),
+        &joint("r", "revolute", "base", "a", ""),
+        &joint("p", "prismatic", "a", "b", ""),
+        &joint("c", "continuous", "b", "c", ""),
+    ]);
+    let m = parse_urdf(&text).unwrap();
+    assert!(m.joints.iter().all(|j| j.limits.is_none()));
+    let written = to_urdf(&m);
+    let back = parse_urdf(&written).unwrap();
+    let wide = 1e6;
+    for j in &back.joints[..2] {
+        let l = j.limits.unwrap();
+        assert_eq!(
+            (l.lower, l.upper, l.effort, l.velocity),
+            (-wide, wide, wide, wide),
+            "{}",
+            j.name
+        );
+    }
+    assert_eq!(back.joints[2].limits, None);
+    assert_eq!(
+        written.matches("<limit").count(),
+        2,
+        "continuous joints get none:\n{written}"
+    );
+}
+
+#[test]
+fn to_urdf_escapes_names() {
+    let mut m = parse_urdf(&one_body(&link("a"))).unwrap();
+    m.name = "r&d <1> \"q\"".into();
+    m.bodies[0].name = "a'b".into();
+    let back = parse_urdf(&to_urdf(&m)).unwrap();
+    assert_eq!(back.name, m.name);
+    assert_eq!(back.bodies[0].name, "a'b");
+}

@@ -1,0 +1,17 @@
+// A required keyword left out: reported at the robot's name.
+fn main() {}
+
+dyngen::robot! {
+    name: Planar2,
+    gravity: [0.0, -9.81, 0.0],
+    incidence: [
+        [-1,  0],
+        [ 1, -1],
+        [ 0,  1],
+    ],
+    joints: [revolute(z), revolute(z)],
+    bodies: {
+        1: cylinder(mass: 10.0, radius: 0.05, length: 1.0, axis: x),
+        2: principal(mass: 5.0, moments: [0.005, 0.4, 0.4]),
+    },
+}

@@ -1,0 +1,69 @@
+//! Generated against reference dynamics, per robot. Each call takes the next of 1,000
+//! random states (as Pinocchio's own benchmark does), so nothing is constant-folded.
+//! Ratios against Pinocchio are measured in the same sitting; see docs/benchmarks.md.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use dyngen::reference::{sample_states, State};
+use dyngen::{Pose, Robot, Wrench};
+use dyngen_tests::reference_of;
+use robot_gripper_arm::GripperArm;
+use robot_paper6::Paper6;
+use robot_planar2::Planar2;
+use robot_ur5::Ur5;
+
+fn states<R: Robot>() -> Vec<State> {
+    sample_states(reference_of::<R>().model(), 1000, 7)
+}
+
+fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
+    let states = states::<R>();
+    let params = R::nominal_params().to_vec();
+    let reference = reference_of::<R>();
+    let mut group = c.benchmark_group(name);
+    let mut k = 0;
+    let mut tau = vec![0.0; R::NV];
+    group.bench_function("rnea/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::rnea(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(&params), &mut tau);
+            black_box(&tau);
+        })
+    });
+    group.bench_function("rnea/reference", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            black_box(reference.rnea(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(&params)))
+        })
+    });
+    let mut poses = vec![Pose::default(); R::NBODIES];
+    group.bench_function("forward_kinematics/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::forward_kinematics(black_box(&s.q), &mut poses);
+            black_box(&poses);
+        })
+    });
+    let mut wrenches = vec![Wrench::default(); R::NBODIES];
+    group.bench_function("joint_wrenches/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::joint_wrenches(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(&params), &mut wrenches);
+            black_box(&wrenches);
+        })
+    });
+    group.finish();
+}
+
+fn dynamics(c: &mut Criterion) {
+    bench_robot::<Ur5>(c, "ur5");
+    bench_robot::<GripperArm>(c, "gripper_arm");
+    bench_robot::<Paper6>(c, "paper6");
+    bench_robot::<Planar2>(c, "planar2");
+}
+
+criterion_group!(benches, dynamics);
+criterion_main!(benches);

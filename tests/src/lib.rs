@@ -1,0 +1,90 @@
+//! Shared helpers of dyngen's cross-crate tests: the reference model of a generated
+//! robot, Pinocchio fixtures, and error measures.
+
+use dyngen::reference::Reference;
+use dyngen::Robot;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The reference implementation of a generated robot, rebuilt from its URDF.
+pub fn reference_of<R: Robot>() -> Reference {
+    let mut model = dyngen_model::parse_urdf(R::urdf()).unwrap_or_else(|e| panic!("{}: URDF does not parse back:\n{e}", R::NAME));
+    model.gravity = R::gravity();
+    Reference::new(&model)
+}
+
+/// Normwise relative error `‖x − y‖∞ / max(‖y‖∞, floor)`.
+pub fn rel_err(x: &[f64], y: &[f64], floor: f64) -> f64 {
+    assert_eq!(x.len(), y.len());
+    let diff = x.iter().zip(y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let scale = y.iter().map(|b| b.abs()).fold(floor, f64::max);
+    diff / scale
+}
+
+/// A pose as 12 numbers: rotation row-major, then translation.
+pub fn pose_vec(p: &dyngen::Pose<f64>) -> Vec<f64> {
+    let mut v = Vec::with_capacity(12);
+    for r in 0..3 {
+        for c in 0..3 {
+            v.push(p.rotation[(r, c)]);
+        }
+    }
+    v.extend(p.translation.iter());
+    v
+}
+
+/// A wrench as 6 numbers: force, then torque (Pinocchio's order).
+pub fn wrench_vec(w: &dyngen::Wrench<f64>) -> Vec<f64> {
+    w.force.iter().chain(w.torque.iter()).copied().collect()
+}
+
+#[derive(Deserialize)]
+pub struct Fixture {
+    pub name: String,
+    pub pinocchio_version: String,
+    pub model: FixtureModel,
+    pub gravity: [f64; 3],
+    pub samples: Vec<FixtureSample>,
+}
+
+#[derive(Deserialize)]
+pub struct FixtureModel {
+    pub joint_names: Vec<String>,
+    pub parents: Vec<usize>,
+    pub dyn_params: Vec<[f64; 10]>,
+}
+
+#[derive(Deserialize)]
+pub struct FixturePose {
+    pub rotation: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+}
+
+#[derive(Deserialize)]
+pub struct FixtureSample {
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    pub tau: Vec<f64>,
+    pub f: Vec<[f64; 6]>,
+    #[serde(rename = "oMi")]
+    pub o_m_i: Vec<FixturePose>,
+}
+
+impl FixturePose {
+    pub fn to_vec(&self) -> Vec<f64> {
+        self.rotation.iter().flatten().chain(self.translation.iter()).copied().collect()
+    }
+}
+
+/// The workspace root.
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
+}
+
+/// Loads `tests/fixtures/<name>.json`.
+pub fn load_fixture(name: &str) -> Fixture {
+    let path = workspace_root().join("tests/fixtures").join(format!("{name}.json"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}

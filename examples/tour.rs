@@ -53,14 +53,24 @@ fn tour<R: Robot>() {
     }
     let generated = time_ns(|k| {
         let s = &states[k];
-        R::rnea(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(params), &mut tau);
+        R::rnea(
+            black_box(&s.q),
+            black_box(&s.v),
+            black_box(&s.a),
+            black_box(params),
+            &mut tau,
+        );
         black_box(&tau);
     });
     let refd = time_ns(|k| {
         let s = &states[k];
         black_box(reference.rnea(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(params)));
     });
-    let ops = R::op_counts().iter().find(|(n, _)| *n == "rnea").map(|(_, o)| *o).unwrap_or_default();
+    let ops = R::op_counts()
+        .iter()
+        .find(|(n, _)| *n == "rnea")
+        .map(|(_, o)| *o)
+        .unwrap_or_default();
     println!(
         "{:<12} {:>3} dof  max rel. error {:>8.1e}  rnea {:>7.1} ns generated, {:>8.1} ns reference ({:>5.1}x)  {:>5} flops",
         R::NAME,

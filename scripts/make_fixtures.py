@@ -33,9 +33,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FIXTURE_DIR = os.path.join(ROOT, "tests", "fixtures")
 
 # Every fixture the project ships: (URDF relative to the project root, name, samples, seed).
+# (urdf, name, samples, seed, gravity). The DSL robots' URDFs are written by
+# `cargo run -p dyngen-tests --example export_urdfs`; URDF cannot carry gravity.
 FIXTURES = [
-    ("robots/ur5/ur5.urdf", "ur5", 50, 0),
-    ("robots/gripper_arm/gripper_arm.urdf", "gripper_arm", 50, 0),
+    ("robots/ur5/ur5.urdf", "ur5", 50, 0, None),
+    ("robots/gripper_arm/gripper_arm.urdf", "gripper_arm", 50, 0, None),
+    ("tests/fixtures/planar2.urdf", "planar2", 50, 0, [0.0, -9.81, 0.0]),
+    ("tests/fixtures/paper6.urdf", "paper6", 50, 0, None),
 ]
 
 SCHEMA_VERSION = 1
@@ -60,7 +64,9 @@ def coord_range(model, j):
     lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
     if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
         return -math.pi, math.pi
-    return float(lo), float(hi)
+    # Wide or placeholder limits: sample one turn (revolute) or +-0.5 m (prismatic).
+    reach = 0.5 if "P" in j.shortname() else math.pi
+    return max(float(lo), -reach), min(float(hi), reach)
 
 
 def to_pin_q(model, theta):
@@ -88,9 +94,11 @@ def check_model(model):
                      f"(mass {I.mass}, principal moments {ev})")
 
 
-def make_fixture(urdf, name, samples, seed):
+def make_fixture(urdf, name, samples, seed, gravity=None):
     urdf = os.path.abspath(urdf)
     model = pin.buildModelFromUrdf(urdf)
+    if gravity is not None:
+        model.gravity.linear = np.array(gravity, dtype=float)
     check_model(model)
     data = model.createData()
     nj = model.njoints
@@ -183,20 +191,22 @@ def main():
     ap.add_argument("--samples", type=int, default=50)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out-dir", default=FIXTURE_DIR, help="default: tests/fixtures of the project")
+    ap.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
+                    help="gravity in the base frame (default Pinocchio's 0 0 -9.81)")
     args = ap.parse_args()
 
     if args.all == bool(args.urdf or args.name):
         ap.error("give either --all or both --urdf and --name")
     if args.all:
-        jobs = [(os.path.join(ROOT, u), n, s, seed) for u, n, s, seed in FIXTURES]
+        jobs = [(os.path.join(ROOT, u), n, s, seed, g) for u, n, s, seed, g in FIXTURES]
     else:
         if not (args.urdf and args.name):
             ap.error("--urdf and --name go together")
         if not os.path.isfile(args.urdf):
             ap.error(f"URDF not found: {args.urdf}")
-        jobs = [(args.urdf, args.name, args.samples, args.seed)]
-    for urdf, name, samples, seed in jobs:
-        write(make_fixture(urdf, name, samples, seed), args.out_dir)
+        jobs = [(args.urdf, args.name, args.samples, args.seed, args.gravity)]
+    for urdf, name, samples, seed, gravity in jobs:
+        write(make_fixture(urdf, name, samples, seed, gravity), args.out_dir)
 
 
 if __name__ == "__main__":

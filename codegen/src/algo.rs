@@ -6,6 +6,7 @@
 
 use crate::sym::{Expr, Graph};
 use dyngen_model::{JointKind, Model};
+use std::ops::{Add, Sub};
 
 pub const ARG_Q: u8 = 0;
 pub const ARG_V: u8 = 1;
@@ -29,14 +30,6 @@ impl<'g> V3<'g> {
         V3(v.map(|x| g.constant(x)))
     }
 
-    pub fn add(self, o: V3<'g>) -> V3<'g> {
-        V3([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
-    }
-
-    pub fn sub(self, o: V3<'g>) -> V3<'g> {
-        V3([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
-    }
-
     pub fn scale(self, s: Expr<'g>) -> V3<'g> {
         V3(self.0.map(|x| x * s))
     }
@@ -49,6 +42,20 @@ impl<'g> V3<'g> {
 
     pub fn dot(self, o: V3<'g>) -> Expr<'g> {
         self.0[0] * o.0[0] + self.0[1] * o.0[1] + self.0[2] * o.0[2]
+    }
+}
+
+impl<'g> Add for V3<'g> {
+    type Output = V3<'g>;
+    fn add(self, o: V3<'g>) -> V3<'g> {
+        V3([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
+    }
+}
+
+impl<'g> Sub for V3<'g> {
+    type Output = V3<'g>;
+    fn sub(self, o: V3<'g>) -> V3<'g> {
+        V3([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
     }
 }
 
@@ -98,7 +105,7 @@ impl<'g> JointTransform<'g> {
             JointKind::Prismatic => JointTransform {
                 origin,
                 motion: M3::constant(g, dyngen_model::math::IDENTITY),
-                translation: t0.add(origin.mul_vec(V3::constant(g, axis).scale(q))),
+                translation: t0 + origin.mul_vec(V3::constant(g, axis).scale(q)),
             },
         }
     }
@@ -142,7 +149,7 @@ pub fn forward_kinematics<'g>(g: &'g Graph, model: &Model) -> Vec<(M3<'g>, V3<'g
             0 => (x.rotation(), x.translation),
             p => {
                 let (rp, tp) = poses[p - 1];
-                (rp.mul(&x.origin).mul(&x.motion), tp.add(rp.mul_vec(x.translation)))
+                (rp.mul(&x.origin).mul(&x.motion), tp + rp.mul_vec(x.translation))
             }
         };
         poses.push(pose);
@@ -196,17 +203,17 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model) -> Rnea<'g> {
         let qdd = g.input(ARG_A, (j - 1) as u32);
         let t = xj.translation;
         // Acceleration of the joint-frame origin, still in parent axes.
-        let a_origin = acc[p].add(wd[p].cross(t)).add(w[p].cross(w[p].cross(t)));
+        let a_origin = acc[p] + wd[p].cross(t) + w[p].cross(w[p].cross(t));
         let w_in = xj.to_child(w[p]);
         let wd_in = xj.to_child(wd[p]);
         let a_in = xj.to_child(a_origin);
         let (wj, wdj, aj) = if joint.kind.is_revolute() {
             let wq = axis.scale(qd);
-            (w_in.add(wq), wd_in.add(axis.scale(qdd)).add(w_in.cross(wq)), a_in)
+            (w_in + wq, wd_in + axis.scale(qdd) + w_in.cross(wq), a_in)
         } else {
             let vq = axis.scale(qd);
             let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
-            (w_in, wd_in, a_in.add(two_w_vq).add(axis.scale(qdd)))
+            (w_in, wd_in, a_in + two_w_vq + axis.scale(qdd))
         };
         w.push(wj);
         wd.push(wdj);
@@ -219,8 +226,8 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model) -> Rnea<'g> {
     for j in 1..=n {
         let b = BodyParams::input(g, j);
         let (wj, wdj, aj) = (w[j], wd[j], acc[j]);
-        f.push(aj.scale(b.m).add(wdj.cross(b.h)).add(wj.cross(wj.cross(b.h))));
-        nm.push(b.inertia.mul_vec(wdj).add(wj.cross(b.inertia.mul_vec(wj))).add(b.h.cross(aj)));
+        f.push(aj.scale(b.m) + wdj.cross(b.h) + wj.cross(wj.cross(b.h)));
+        nm.push(b.inertia.mul_vec(wdj) + wj.cross(b.inertia.mul_vec(wj)) + b.h.cross(aj));
     }
     // Backward pass: children first (regular labelling: higher index first).
     for j in (1..=n).rev() {
@@ -230,9 +237,9 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model) -> Rnea<'g> {
         }
         let xj = &x[j - 1];
         let fp = xj.to_parent(f[j - 1]);
-        let np = xj.to_parent(nm[j - 1]).add(xj.translation.cross(fp));
-        f[p - 1] = f[p - 1].add(fp);
-        nm[p - 1] = nm[p - 1].add(np);
+        let np = xj.to_parent(nm[j - 1]) + xj.translation.cross(fp);
+        f[p - 1] = f[p - 1] + fp;
+        nm[p - 1] = nm[p - 1] + np;
     }
     let tau = (1..=n)
         .map(|j| {
@@ -245,5 +252,8 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model) -> Rnea<'g> {
             }
         })
         .collect();
-    Rnea { tau, wrenches: f.into_iter().zip(nm).collect() }
+    Rnea {
+        tau,
+        wrenches: f.into_iter().zip(nm).collect(),
+    }
 }

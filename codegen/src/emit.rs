@@ -17,6 +17,9 @@ pub struct Arg {
     pub len: usize,
 }
 
+/// Builds a function's returned value from one expression per output.
+pub type Assemble<'a> = Box<dyn Fn(&[TokenStream]) -> TokenStream + 'a>;
+
 /// A function to emit: its signature pieces and symbolic outputs.
 pub struct FnSpec<'a> {
     pub name: &'a str,
@@ -26,7 +29,7 @@ pub struct FnSpec<'a> {
     pub ret: TokenStream,
     pub outputs: Vec<NodeId>,
     /// Builds the returned value from one expression per output.
-    pub assemble: Box<dyn Fn(&[TokenStream]) -> TokenStream + 'a>,
+    pub assemble: Assemble<'a>,
 }
 
 /// What was emitted for one function, for reports and docs.
@@ -49,36 +52,48 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let stmts = schedule(graph, &spec.outputs);
     let ops = OpCount::of(graph, &spec.outputs);
     let fname = format_ident!("{}", spec.name);
-    let doc = &spec.doc;
+    let doc = spec.doc.lines();
     let ret = &spec.ret;
     let params: Vec<TokenStream> = spec
         .args
         .iter()
         .map(|a| {
             let n = format_ident!("{}", a.name);
-            let len = a.len;
+            let len = usize_lit(a.len);
             quote!(#n: &[S; #len])
         })
         .collect();
     let arg_names: Vec<Ident> = spec.args.iter().map(|a| format_ident!("{}", a.name)).collect();
     let op_doc = format!(
         " Generated: {} multiplications, {} additions, {} negations, {} sin/cos; {} statements.",
-        ops.muls, ops.adds, ops.negs, ops.trig, stmts.len()
+        ops.muls,
+        ops.adds,
+        ops.negs,
+        ops.trig,
+        stmts.len()
     );
     let chunks: Vec<&[Stmt]> = if stmts.len() <= max_statements.max(1) {
         vec![&stmts[..]]
     } else {
         stmts.chunks(max_statements.max(1)).collect()
     };
-    let report = FnReport { name: spec.name.to_string(), ops, statements: stmts.len(), parts: chunks.len() };
+    let report = FnReport {
+        name: spec.name.to_string(),
+        ops,
+        statements: stmts.len(),
+        parts: chunks.len(),
+    };
 
     if chunks.len() == 1 {
-        let names = Names { spill: &HashMap::new(), args: &spec.args };
+        let names = Names {
+            spill: &HashMap::new(),
+            args: &spec.args,
+        };
         let body = chunks[0].iter().map(|s| emit_stmt(graph, s, &names));
         let outs: Vec<TokenStream> = spec.outputs.iter().map(|&o| names.operand(graph, o)).collect();
         let value = (spec.assemble)(&outs);
         let tokens = quote! {
-            #[doc = #doc]
+            #(#[doc = #doc])*
             #[doc = ""]
             #[doc = #op_doc]
             #[inline]
@@ -118,13 +133,16 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             mark(o, &mut spill);
         }
     }
-    let width = spill.len().max(1);
+    let width = usize_lit(spill.len().max(1));
     let mut parts = Vec::new();
     let mut calls = Vec::new();
     for (c, chunk) in chunks.iter().enumerate() {
         let part = format_ident!("__{}_part{}", spec.name, c);
         let local: HashMap<NodeId, usize> = HashMap::new();
-        let names = Names { spill: &local, args: &spec.args };
+        let names = Names {
+            spill: &local,
+            args: &spec.args,
+        };
         // Loads of values defined in earlier parts.
         let mut loads: Vec<NodeId> = chunk
             .iter()
@@ -135,12 +153,13 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         loads.dedup();
         let load_stmts = loads.iter().map(|&id| {
             let x = var(id);
-            let k = spill[&id];
+            let k = usize_lit(spill[&id]);
             quote!(let #x = w[#k];)
         });
         let body = chunk.iter().map(|s| emit_stmt(graph, s, &names));
         let stores = chunk.iter().flat_map(|s| s.defines.iter()).filter_map(|id| {
             spill.get(id).map(|&k| {
+                let k = usize_lit(k);
                 let x = var(*id);
                 quote!(w[#k] = #x;)
             })
@@ -157,18 +176,24 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         });
         calls.push(quote!(Self::#part(#(#arg_names,)* &mut w);));
     }
-    let names = Names { spill: &spill, args: &spec.args };
+    let names = Names {
+        spill: &spill,
+        args: &spec.args,
+    };
     let outs: Vec<TokenStream> = spec
         .outputs
         .iter()
         .map(|&o| match spill.get(&o) {
-            Some(&k) => quote!(w[#k]),
+            Some(&k) => {
+                let k = usize_lit(k);
+                quote!(w[#k])
+            }
             None => names.operand(graph, o),
         })
         .collect();
     let value = (spec.assemble)(&outs);
     let tokens = quote! {
-        #[doc = #doc]
+        #(#[doc = #doc])*
         #[doc = ""]
         #[doc = #op_doc]
         pub fn #fname<S: ::dyngen::Scalar>(#(#params),*) -> #ret {
@@ -212,12 +237,21 @@ fn schedule(graph: &Graph, outputs: &[NodeId]) -> Vec<Stmt> {
             Node::Const(_) | Node::Input { .. } => {}
             Node::Sin(a) | Node::Cos(a) => match trig[&a] {
                 (Some(s), Some(c)) if id == s.min(c) => {
-                    stmts.push(Stmt { defines: vec![s, c], node: Node::Sin(a) });
+                    stmts.push(Stmt {
+                        defines: vec![s, c],
+                        node: Node::Sin(a),
+                    });
                 }
                 (Some(_), Some(_)) => {}
-                _ => stmts.push(Stmt { defines: vec![id], node }),
+                _ => stmts.push(Stmt {
+                    defines: vec![id],
+                    node,
+                }),
             },
-            _ => stmts.push(Stmt { defines: vec![id], node }),
+            _ => stmts.push(Stmt {
+                defines: vec![id],
+                node,
+            }),
         }
     }
     stmts
@@ -238,11 +272,14 @@ impl Names<'_> {
             Node::Const(bits) => constant(f64::from_bits(bits)),
             Node::Input { arg, index } => {
                 let a = format_ident!("{}", self.args[arg as usize].name);
-                let i = index as usize;
+                let i = usize_lit(index as usize);
                 quote!(#a[#i])
             }
             _ => match self.spill.get(&id) {
-                Some(&k) => quote!(w[#k]),
+                Some(&k) => {
+                    let k = usize_lit(k);
+                    quote!(w[#k])
+                }
                 None => {
                     let x = var(id);
                     quote!(#x)

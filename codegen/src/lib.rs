@@ -61,7 +61,9 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
     // Make the crate rebuild when the URDF changes.
     let watch = rebuild_on.map(|p| {
         let p = p.to_string_lossy().into_owned();
-        quote!(const _: &[u8] = include_bytes!(#p);)
+        quote!(
+            const _: &[u8] = include_bytes!(#p);
+        )
     });
     Ok(quote!(#tokens #watch))
 }

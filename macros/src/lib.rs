@@ -7,5 +7,7 @@ use proc_macro::TokenStream;
 /// the two forms (inline graph-theoretic description, or `urdf: "path"`).
 #[proc_macro]
 pub fn robot(input: TokenStream) -> TokenStream {
-    dyngen_codegen::expand_robot_macro(input.into()).unwrap_or_else(syn::Error::into_compile_error).into()
+    dyngen_codegen::expand_robot_macro(input.into())
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
 }

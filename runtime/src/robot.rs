@@ -13,7 +13,10 @@ pub struct Pose<S: Scalar> {
 
 impl<S: Scalar> Default for Pose<S> {
     fn default() -> Self {
-        Pose { rotation: Matrix3::from_element(S::ZERO), translation: Vector3::from_element(S::ZERO) }
+        Pose {
+            rotation: Matrix3::from_element(S::ZERO),
+            translation: Vector3::from_element(S::ZERO),
+        }
     }
 }
 
@@ -26,7 +29,10 @@ pub struct Wrench<S: Scalar> {
 
 impl<S: Scalar> Default for Wrench<S> {
     fn default() -> Self {
-        Wrench { force: Vector3::from_element(S::ZERO), torque: Vector3::from_element(S::ZERO) }
+        Wrench {
+            force: Vector3::from_element(S::ZERO),
+            torque: Vector3::from_element(S::ZERO),
+        }
     }
 }
 

@@ -26,7 +26,13 @@ fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
         b.iter(|| {
             let s = &states[k % states.len()];
             k += 1;
-            R::rnea(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(&params), &mut tau);
+            R::rnea(
+                black_box(&s.q),
+                black_box(&s.v),
+                black_box(&s.a),
+                black_box(&params),
+                &mut tau,
+            );
             black_box(&tau);
         })
     });
@@ -51,7 +57,13 @@ fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
         b.iter(|| {
             let s = &states[k % states.len()];
             k += 1;
-            R::joint_wrenches(black_box(&s.q), black_box(&s.v), black_box(&s.a), black_box(&params), &mut wrenches);
+            R::joint_wrenches(
+                black_box(&s.q),
+                black_box(&s.v),
+                black_box(&s.a),
+                black_box(&params),
+                &mut wrenches,
+            );
             black_box(&wrenches);
         })
     });

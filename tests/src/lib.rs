@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 
 /// The reference implementation of a generated robot, rebuilt from its URDF.
 pub fn reference_of<R: Robot>() -> Reference {
-    let mut model = dyngen_model::parse_urdf(R::urdf()).unwrap_or_else(|e| panic!("{}: URDF does not parse back:\n{e}", R::NAME));
+    let mut model =
+        dyngen_model::parse_urdf(R::urdf()).unwrap_or_else(|e| panic!("{}: URDF does not parse back:\n{e}", R::NAME));
     model.gravity = R::gravity();
     Reference::new(&model)
 }
@@ -73,13 +74,21 @@ pub struct FixtureSample {
 
 impl FixturePose {
     pub fn to_vec(&self) -> Vec<f64> {
-        self.rotation.iter().flatten().chain(self.translation.iter()).copied().collect()
+        self.rotation
+            .iter()
+            .flatten()
+            .chain(self.translation.iter())
+            .copied()
+            .collect()
     }
 }
 
 /// The workspace root.
 pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
 }
 
 /// Loads `tests/fixtures/<name>.json`.

@@ -21,7 +21,11 @@ fn check<R: Robot>(seed: u64) -> [f64; 3] {
     for (k, s) in sample_states(&model, STATES, seed).iter().enumerate() {
         // Every other state uses parameters that are not the nominal ones, so that
         // the parameters really are a runtime input.
-        let params = if k % 2 == 0 { R::nominal_params().to_vec() } else { perturbed_params(&model, seed + k as u64, 0.3) };
+        let params = if k % 2 == 0 {
+            R::nominal_params().to_vec()
+        } else {
+            perturbed_params(&model, seed + k as u64, 0.3)
+        };
         let mut tau = vec![0.0; n];
         R::rnea(&s.q, &s.v, &s.a, &params, &mut tau);
         let e = rel_err(&tau, &reference.rnea(&s.q, &s.v, &s.a, &params), 1e-9);
@@ -39,12 +43,22 @@ fn check<R: Robot>(seed: u64) -> [f64; 3] {
         let mut wrenches = vec![Wrench::default(); n];
         R::joint_wrenches(&s.q, &s.v, &s.a, &params, &mut wrenches);
         let got: Vec<f64> = wrenches.iter().flat_map(wrench_vec).collect();
-        let want: Vec<f64> = reference.joint_wrenches(&s.q, &s.v, &s.a, &params).iter().flat_map(wrench_vec).collect();
+        let want: Vec<f64> = reference
+            .joint_wrenches(&s.q, &s.v, &s.a, &params)
+            .iter()
+            .flat_map(wrench_vec)
+            .collect();
         let e = rel_err(&got, &want, 1e-9);
         assert!(e < TOL, "{}: joint wrenches state {k}: relative error {e:e}", R::NAME);
         worst[2] = worst[2].max(e);
     }
-    eprintln!("{}: max relative error rnea {:.2e}, kinematics {:.2e}, wrenches {:.2e}", R::NAME, worst[0], worst[1], worst[2]);
+    eprintln!(
+        "{}: max relative error rnea {:.2e}, kinematics {:.2e}, wrenches {:.2e}",
+        R::NAME,
+        worst[0],
+        worst[1],
+        worst[2]
+    );
     worst
 }
 

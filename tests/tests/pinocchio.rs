@@ -13,14 +13,23 @@ const TOL: f64 = 1e-10;
 fn check<R: Robot>(fixture: &str) -> [f64; 4] {
     let fx = load_fixture(fixture);
     let names: Vec<&str> = fx.model.joint_names.iter().map(String::as_str).collect();
-    assert_eq!(names, R::joint_names(), "{}: joint order differs from Pinocchio's", fx.name);
+    assert_eq!(
+        names,
+        R::joint_names(),
+        "{}: joint order differs from Pinocchio's",
+        fx.name
+    );
     let parents: Vec<usize> = fx.model.parents.clone();
     assert_eq!(parents, R::parents(), "{}: parents differ from Pinocchio's", fx.name);
     assert_eq!(fx.gravity, R::gravity());
     let ours: Vec<f64> = R::nominal_params().to_vec();
     let theirs: Vec<f64> = fx.model.dyn_params.iter().flatten().copied().collect();
     let e_params = rel_err(&ours, &theirs, 1e-9);
-    assert!(e_params < TOL, "{}: parameters differ from Pinocchio's: {e_params:e}", fx.name);
+    assert!(
+        e_params < TOL,
+        "{}: parameters differ from Pinocchio's: {e_params:e}",
+        fx.name
+    );
 
     let n = R::NV;
     let mut worst = [e_params, 0.0, 0.0, 0.0];
@@ -28,7 +37,12 @@ fn check<R: Robot>(fixture: &str) -> [f64; 4] {
         let mut tau = vec![0.0; n];
         R::rnea(&s.q, &s.v, &s.a, R::nominal_params(), &mut tau);
         let e = rel_err(&tau, &s.tau, 1e-9);
-        assert!(e < TOL, "{}: rnea sample {k}: {tau:?} vs Pinocchio {:?} (rel {e:e})", fx.name, s.tau);
+        assert!(
+            e < TOL,
+            "{}: rnea sample {k}: {tau:?} vs Pinocchio {:?} (rel {e:e})",
+            fx.name,
+            s.tau
+        );
         worst[1] = worst[1].max(e);
 
         let mut poses = vec![Pose::default(); n];
@@ -85,7 +99,9 @@ fn paper6_matches_pinocchio() {
 #[test]
 fn dsl_robot_urdfs_are_current() {
     for (name, urdf) in [("planar2", Planar2::URDF), ("paper6", Paper6::URDF)] {
-        let path = dyngen_tests::workspace_root().join("tests/fixtures").join(format!("{name}.urdf"));
+        let path = dyngen_tests::workspace_root()
+            .join("tests/fixtures")
+            .join(format!("{name}.urdf"));
         let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert_eq!(
             committed,

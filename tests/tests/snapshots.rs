@@ -7,14 +7,19 @@ use dyngen_codegen::{generate, Generated, Options};
 
 /// Generates the robot declared by the `robot!` invocation in a robot crate's source.
 fn generate_from_crate(dir: &str) -> Generated {
-    let path = dyngen_tests::workspace_root().join("robots").join(dir).join("src/lib.rs");
+    let path = dyngen_tests::workspace_root()
+        .join("robots")
+        .join(dir)
+        .join("src/lib.rs");
     let source = std::fs::read_to_string(&path).expect("robot crate source");
     let file = syn::parse_file(&source).expect("robot crate parses");
     let tokens = file
         .items
         .iter()
         .find_map(|item| match item {
-            syn::Item::Macro(m) if m.mac.path.segments.last().is_some_and(|s| s.ident == "robot") => Some(m.mac.tokens.clone()),
+            syn::Item::Macro(m) if m.mac.path.segments.last().is_some_and(|s| s.ident == "robot") => {
+                Some(m.mac.tokens.clone())
+            }
             _ => None,
         })
         .expect("a robot! invocation");

@@ -1,5 +1,414 @@
-//! The `robot!` front end (to be written).
-use proc_macro2::TokenStream;
-pub fn parse(input: TokenStream) -> syn::Result<crate::RobotInput> {
-    Err(syn::Error::new_spanned(input, "not yet"))
+//! The `robot!` front end: tokens → syntax tree ([`parse`](self::parse())) → rules
+//! (`check`) → [`Description`](dyngen_model::Description) (`lower`), every error
+//! collected with its span and reported together.
+//!
+//! # Two forms
+//!
+//! ```text
+//! dyngen::robot! { name: Ur5, urdf: "robots/ur5.urdf" }   // path relative to Cargo.toml
+//!
+//! dyngen::robot! {
+//!     name: Planar2,
+//!     gravity: [0.0, -9.81, 0.0],            // optional; default [0, 0, -9.81]
+//!     incidence: [                            // rows: bodies 0 (base), 1..n; columns: joints 1..n
+//!         [-1,  0],
+//!         [ 1, -1],
+//!         [ 0,  1],
+//!     ],
+//!     joints: [revolute(z), revolute(z)],     // one per column, in column order
+//!     body_joint_vectors: {                   // c_ia for every nonzero S_ia: (body, joint): [x, y, z]
+//!         (0, 1): [0.0, 0.0, 0.0],
+//!         (1, 1): [-0.5, 0.0, 0.0], (1, 2): [0.5, 0.0, 0.0],
+//!         (2, 2): [-0.5, 0.0, 0.0],
+//!     },
+//!     bodies: {
+//!         1: cylinder(mass: 10.0, radius: 0.05, length: 1.0, axis: x),
+//!         2: principal(mass: 5.0, moments: [0.005, 0.4, 0.4]),
+//!     },
+//! }
+//! ```
+//!
+//! # Grammar
+//!
+//! ```text
+//! robot     := field (',' field)* ','?            each keyword at most once, any order
+//! field     := 'name' ':' IDENT | 'urdf' ':' STRING | 'gravity' ':' vec3
+//!            | 'incidence' ':' '[' row,* ']'      row := '[' INTEGER,* ']'
+//!            | 'joints' ':' '[' joint,* ']'
+//!            | 'body_joint_vectors' ':' '{' ('(' INTEGER ',' INTEGER ')' ':' vec3),* '}'
+//!            | 'bodies' ':' '{' (INTEGER ':' body),* '}'
+//! joint     := ('revolute' | 'continuous' | 'prismatic') '(' axis (',' option)* ','? ')'
+//! option    := 'rest' ':' vec3                    [roll, pitch, yaw], rad
+//!            | 'limits' ':' '[' num ',' num ']'   [lower, upper]; not on continuous joints
+//! axis      := '-'? ('x' | 'y' | 'z') | vec3      nonzero
+//! body      := 'cylinder' '(' 'mass' ':' num ',' 'radius' ':' num ',' 'length' ':' num
+//!                             ',' 'axis' ':' ('x' | 'y' | 'z') ')'     (arguments in any order)
+//!            | 'principal' '(' 'mass' ':' num ',' 'moments' ':' vec3 ')'
+//! vec3      := '[' num ',' num ',' num ']'
+//! num       := '-'? (INTEGER | FLOAT)             e.g. -1, 0.5, -9.81, 1e-3; finite
+//! ```
+//!
+//! Trailing commas are allowed in every list.
+//!
+//! # Meaning
+//!
+//! The paper's conventions (DESIGN §4): every body frame is that body's centroidal
+//! principal frame. `S_ia` is +1/−1 where joint `a` touches body `i`; a column may
+//! be oriented either way. `c_ia`, in body `i`'s frame, goes from body `i`'s centre of
+//! mass (for body 0: the base frame origin) to the point of joint `a` on body `i`; it
+//! is given exactly for the nonzero `S_ia`. A joint's frame sits at its joint point
+//! with the outboard body's axes, and its axis is expressed there. `rest` is the
+//! rotation of the outboard body frame relative to the inboard one at `q = 0` (URDF
+//! roll-pitch-yaw, `R = Rz(yaw) Ry(pitch) Rx(roll)`); identity when omitted.
+//!
+//! The description produced has links `body0` (the base, no inertial) and
+//! `body1..bodyn` in the user's numbering, and joints `joint1..jointn`. For joint `a`
+//! from inboard body `p` to outboard body `c`: origin translation `c_pa − c_pb`, `b`
+//! being the joint whose outboard body is `p` (for `p = 0`: `c_0a`), origin rotation
+//! from `rest`. Body `c` gets mass `m`, centre of mass `−c_ca` (its frame is at joint
+//! `a`'s point) and inertia `diag(J1, J2, J3)`. `principal(mass: m, moments: [J1, J2,
+//! J3])` gives them directly; `cylinder(mass, radius, length, axis)` is a homogeneous
+//! cylinder along that body axis: `J_axis = m r²/2`, the other two `m (3r² + l²)/12`.
+//! Limits carry velocity and effort 0.0, meaning "not specified". The model then
+//! renumbers bodies to regular labelling if the user's numbering is not (names keep
+//! the user's numbers).
+//!
+//! # Checks
+//!
+//! Each is a compile error at the offending token, all reported at once: unknown,
+//! duplicate or missing keywords (and mixing `urdf` with inline keywords); malformed
+//! values (not a name, not a number, not 3 numbers, a non-integer incidence entry,
+//! non-finite numbers); the incidence matrix's shape, entries, columns (one +1 and one
+//! −1), connectivity and loops; the number of joints against the columns; unknown
+//! joint types, axes and options, zero axes, `lower > upper`, limits on a continuous
+//! joint; `c_ia` missing where `S_ia ≠ 0`, given where `S_ia = 0`, duplicated or out
+//! of range; bodies missing, duplicated, out of range or body 0; unknown body kinds
+//! or arguments, missing arguments; mass, radius, length or moments not positive;
+//! moments breaking the triangle inequality.
+
+mod ast;
+mod check;
+mod ctxt;
+mod lower;
+mod parse;
+mod symbol;
+
+use crate::{RobotInput, RobotSource};
+use ctxt::Ctxt;
+use proc_macro2::{Span, TokenStream};
+
+/// Parses and checks one `robot!` invocation.
+pub fn parse(input: TokenStream) -> syn::Result<RobotInput> {
+    let cx = Ctxt::new();
+    let robot = parse::robot(&cx, input);
+    let tree = check::check(&cx, &robot);
+    cx.check()?;
+
+    let internal = || {
+        syn::Error::new(
+            Span::call_site(),
+            "internal error in the robot! front end: a checked part is missing; please report \
+             this with the invocation",
+        )
+    };
+    let name = robot.name.value.clone().ok_or_else(internal)?;
+    if let Some(path) = &robot.urdf.value {
+        return Ok(RobotInput {
+            name,
+            source: RobotSource::Urdf(path.clone()),
+        });
+    }
+    let tree = tree.ok_or_else(internal)?;
+    let description = lower::lower(&robot, &tree).ok_or_else(internal)?;
+    // The checks above should leave nothing for the model to find; if they do, the
+    // model's message (naming the link or joint) is still better than none.
+    if let Err(errors) = description.build() {
+        let mut all = errors.iter().map(|e| syn::Error::new(Span::call_site(), e.to_string()));
+        let mut first = all.next().ok_or_else(internal)?;
+        for e in all {
+            first.combine(e);
+        }
+        return Err(first);
+    }
+    Ok(RobotInput {
+        name,
+        source: RobotSource::Dsl(Box::new(description)),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dyngen_model::{JointKind, Model};
+    use quote::quote;
+
+    fn planar2() -> TokenStream {
+        quote! {
+            name: Planar2,
+            gravity: [0.0, -9.81, 0.0],
+            incidence: [
+                [-1,  0],
+                [ 1, -1],
+                [ 0,  1],
+            ],
+            joints: [revolute(z), revolute(z)],
+            body_joint_vectors: {
+                (0, 1): [0.0, 0.0, 0.0],
+                (1, 1): [-0.5, 0.0, 0.0], (1, 2): [0.5, 0.0, 0.0],
+                (2, 2): [-0.5, 0.0, 0.0],
+            },
+            bodies: {
+                1: cylinder(mass: 10.0, radius: 0.05, length: 1.0, axis: x),
+                2: principal(mass: 5.0, moments: [0.005, 0.4, 0.4]),
+            },
+        }
+    }
+
+    fn description(input: TokenStream) -> dyngen_model::Description {
+        match parse(input) {
+            Ok(RobotInput {
+                source: RobotSource::Dsl(d),
+                ..
+            }) => *d,
+            Ok(_) => panic!("expected the inline form"),
+            Err(e) => panic!("{:#?}", e.into_iter().map(|e| e.to_string()).collect::<Vec<_>>()),
+        }
+    }
+
+    fn messages(input: TokenStream) -> Vec<String> {
+        match parse(input) {
+            Ok(_) => Vec::new(),
+            Err(e) => e.into_iter().map(|e| e.to_string()).collect(),
+        }
+    }
+
+    fn close(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12)
+    }
+
+    #[test]
+    fn planar2_lowers_to_the_expected_description() {
+        let d = description(planar2());
+        assert_eq!(d.name, "Planar2");
+        assert_eq!(d.gravity, [0.0, -9.81, 0.0]);
+        let names: Vec<&str> = d.links.iter().map(|l| l.name.as_str()).collect();
+        assert_eq!(names, ["body0", "body1", "body2"]);
+        assert!(d.links[0].inertial.is_none());
+        let j2 = &d.joints[1];
+        assert_eq!(
+            (j2.name.as_str(), j2.parent.as_str(), j2.child.as_str()),
+            ("joint2", "body1", "body2")
+        );
+        // c_12 - c_11 = 0.5 - (-0.5).
+        assert!(close(&j2.origin.translation, &[1.0, 0.0, 0.0]));
+        assert!(close(&d.joints[0].origin.translation, &[0.0; 3]));
+        assert_eq!(j2.origin.rotation, dyngen_model::math::IDENTITY);
+        assert_eq!(j2.axis, [0.0, 0.0, 1.0]);
+        assert_eq!(j2.limits, None);
+
+        let b1 = d.links[1].inertial.unwrap();
+        assert_eq!(b1.mass, 10.0);
+        assert!(close(&b1.com, &[0.5, 0.0, 0.0]));
+        let across = 10.0 * (3.0 * 0.05 * 0.05 + 1.0) / 12.0;
+        let diag = [b1.inertia[0][0], b1.inertia[1][1], b1.inertia[2][2]];
+        assert!(close(&diag, &[10.0 * 0.05 * 0.05 / 2.0, across, across]));
+        let b2 = d.links[2].inertial.unwrap();
+        assert!(close(&b2.com, &[0.5, 0.0, 0.0]));
+        assert!(close(
+            &[b2.inertia[0][0], b2.inertia[1][1], b2.inertia[2][2]],
+            &[0.005, 0.4, 0.4]
+        ));
+    }
+
+    #[test]
+    fn planar2_builds_a_model_whose_graph_matches_the_input() {
+        let model: Model = description(planar2()).build().unwrap();
+        assert_eq!(model.dof(), 2);
+        assert_eq!((model.parent(1), model.parent(2)), (0, 1));
+        assert!(model.joints.iter().all(|j| j.kind == JointKind::Revolute));
+        assert_eq!(
+            dyngen_model::graph::incidence(&model),
+            vec![vec![-1, 0], vec![1, -1], vec![0, 1]]
+        );
+        // The model's own c_ia are the ones written.
+        let c = dyngen_model::graph::body_joint_vectors(&model);
+        assert!(close(&c[1][0], &[-0.5, 0.0, 0.0]));
+        assert!(close(&c[1][1], &[0.5, 0.0, 0.0]));
+        assert!(close(&c[2][1], &[-0.5, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn urdf_form() {
+        let input = parse(quote!(name: Ur5, urdf: "robots/ur5.urdf",)).unwrap();
+        assert_eq!(input.name, "Ur5");
+        assert!(matches!(input.source, RobotSource::Urdf(ref p) if p.value() == "robots/ur5.urdf"));
+    }
+
+    /// A branched robot, a reversed column, a non-regular numbering, rest rotations,
+    /// limits and default gravity.
+    #[test]
+    fn branched_reversed_and_renumbered() {
+        let d = description(quote! {
+            name: Branch,
+            incidence: [
+                [ 0, -1,  0],
+                [ 0,  1,  1],   // joint 3 written reversed: +1 on the inboard body 1
+                [ 1,  0,  0],
+                [-1,  0, -1],
+            ],
+            joints: [
+                prismatic([0, 0, 2], limits: [-0.1, 0.2]),
+                continuous(-y, rest: [0.0, 0.0, 1.5707963267948966]),
+                revolute(x, limits: [-1, 1]),
+            ],
+            body_joint_vectors: {
+                (0, 2): [0, 0, 1],
+                (1, 2): [0, 0, -0.25], (1, 3): [0, 0, 0.25],
+                (3, 3): [0, 0, -0.1], (3, 1): [0.1, 0, 0],
+                (2, 1): [-0.2, 0, 0],
+            },
+            bodies: {
+                3: principal(mass: 1, moments: [1, 1, 1]),
+                1: principal(mass: 2, moments: [1, 2, 2]),
+                2: cylinder(mass: 3, radius: 0.1, length: 0.4, axis: z),
+            },
+        });
+        assert_eq!(d.gravity, dyngen_model::DEFAULT_GRAVITY);
+        let ends: Vec<(&str, &str)> = d.joints.iter().map(|j| (j.parent.as_str(), j.child.as_str())).collect();
+        assert_eq!(ends, [("body3", "body2"), ("body0", "body1"), ("body1", "body3")]);
+        // Joint 1 from body 3: c_31 - c_33.
+        assert!(close(&d.joints[0].origin.translation, &[0.1, 0.0, 0.1]));
+        assert!(close(&d.joints[1].origin.translation, &[0.0, 0.0, 1.0]));
+        assert!(close(&d.joints[2].origin.translation, &[0.0, 0.0, 0.5]));
+        assert_eq!(d.joints[1].origin.rotation[0], [0.0, -1.0, 0.0]);
+        assert_eq!(d.joints[0].limits.map(|l| (l.lower, l.upper)), Some((-0.1, 0.2)));
+        let model = d.build().unwrap();
+        let order: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(order, ["body1", "body3", "body2"]);
+        assert_eq!((model.parent(1), model.parent(2), model.parent(3)), (0, 1, 2));
+        assert_eq!(model.joints[2].axis, [0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn every_mistake_of_one_invocation_is_reported() {
+        let e = messages(quote! {
+            name: Planar2,
+            incidence: [[-1, 0], [1, -1], [0, 1]],
+            joints: [revolute(z)],
+            body_joint_vectors: {
+                (0, 1): [0.0, 0.0, 0.0],
+                (1, 1): [-0.5, 0.0, 0.0],
+                (2, 1): [0.0, 0.0, 0.0],
+                (2, 2): [-0.5, 0.0, 0.0],
+            },
+            bodies: { 1: principal(mass: -1, moments: [1, 1, 3]) },
+        });
+        let want = [
+            "1 joint given but the incidence matrix has 2 columns",
+            "body 2 does not touch joint 1",
+            "missing body-joint vector (1, 2)",
+            "missing body 2",
+            "mass -1 is not positive",
+            "J3 = 3 exceeds J1 + J2 = 2",
+        ];
+        assert_eq!(e.len(), want.len(), "{e:#?}");
+        for (got, want) in e.iter().zip(want) {
+            assert!(got.contains(want), "{got:?} should contain {want:?}");
+        }
+    }
+
+    #[test]
+    fn incidence_errors() {
+        let robot = |s: TokenStream| {
+            quote! {
+                name: R, incidence: #s, joints: [revolute(z), revolute(z)],
+                body_joint_vectors: {}, bodies: {},
+            }
+        };
+        let e = messages(robot(quote!([[-1, -1], [1, 1], [0, 0]])));
+        assert!(
+            e.iter()
+                .any(|m| m.contains("joint 2 between bodies 0 and 1 closes a loop")),
+            "{e:#?}"
+        );
+        assert!(e.iter().any(|m| m.starts_with("body 2 is not connected")), "{e:#?}");
+        let e = messages(robot(quote!([[-1, 0], [1, 1], [0, 1]])));
+        assert!(
+            e[0].contains("joint 2's column has 2 entries +1 and 0 entries -1"),
+            "{e:#?}"
+        );
+        let e = messages(robot(quote!([[-1, 0], [1, -1, 0], [0, 1]])));
+        assert_eq!(e.len(), 1, "{e:#?}");
+        assert!(
+            e[0].starts_with("row 1 (body 1) has 3 entries but row 0 has 2"),
+            "{e:#?}"
+        );
+        let e = messages(robot(quote!([[-1, 0], [2, -1], [0, 1.0]])));
+        assert!(e[0].contains("integers"), "{e:#?}");
+        let e = messages(robot(quote!([[-1, 0], [1, -1]])));
+        assert!(e[0].contains("has 2 rows and 2 columns"), "{e:#?}");
+        let e = messages(robot(quote!([[-1, 0], [2, -1], [0, 1]])));
+        assert!(e[0].contains("entry 2 (body 1, joint 1)"), "{e:#?}");
+    }
+
+    #[test]
+    fn missing_keywords() {
+        let e = messages(quote!());
+        assert_eq!(e.len(), 1);
+        assert!(e[0].starts_with("missing `name` and the robot's source"), "{e:?}");
+        let e = messages(quote!(name: R, incidence: [[-1], [1]]));
+        assert!(
+            e[0].starts_with("missing `joints`, `body_joint_vectors` and `bodies`"),
+            "{e:?}"
+        );
+        let e = messages(quote!(name: R, urdf: "r.urdf", joints: []));
+        assert!(e[0].starts_with("`joints` cannot be combined with `urdf`"), "{e:?}");
+    }
+
+    #[test]
+    fn joint_rules() {
+        let e = messages(quote! {
+            name: R,
+            incidence: [[-1, 0, 0], [1, -1, 0], [0, 1, -1], [0, 0, 1]],
+            joints: [revolute([0, 0, 0]), continuous(z, limits: [-1, 1]), prismatic(x, limits: [1, -1])],
+            body_joint_vectors: { (0, 1): [0, 0, 0], (1, 1): [0, 0, 0], (1, 2): [0, 0, 0],
+                (2, 2): [0, 0, 0], (2, 3): [0, 0, 0], (3, 3): [0, 0, 0] },
+            bodies: { 1: principal(mass: 1, moments: [1, 1, 1]), 2: principal(mass: 1, moments: [1, 1, 1]),
+                3: cylinder(mass: 1, radius: 0, length: 1, axis: y) },
+        });
+        let want = [
+            "the joint axis is zero",
+            "a `continuous` joint has no limits",
+            "lower limit 1 is above upper limit -1",
+            "cylinder radius 0 is not positive",
+        ];
+        assert_eq!(e.len(), want.len(), "{e:#?}");
+        for (got, want) in e.iter().zip(want) {
+            assert!(got.contains(want), "{got:?} should contain {want:?}");
+        }
+    }
+
+    #[test]
+    fn body_and_vector_indices() {
+        let e = messages(quote! {
+            name: R,
+            incidence: [[-1], [1]],
+            joints: [revolute(z)],
+            body_joint_vectors: { (0, 1): [0, 0, 0], (1, 1): [0, 0, 0], (1, 1): [0, 0, 0], (2, 1): [0, 0, 0], (1, 0): [0, 0, 0] },
+            bodies: { 0: principal(mass: 1, moments: [1, 1, 1]), 1: principal(mass: 1, moments: [1, 1, 1]),
+                1: principal(mass: 1, moments: [1, 1, 1]), 5: principal(mass: 1, moments: [1, 1, 1]) },
+        });
+        let want = [
+            "body 2 does not exist; bodies are 0 (the base) to 1",
+            "joint 0 does not exist; joints are 1 to 1",
+            "duplicate body-joint vector (1, 1)",
+            "body 0 is the fixed base",
+            "body 5 does not exist",
+            "duplicate body 1",
+        ];
+        assert_eq!(e.len(), want.len(), "{e:#?}");
+        for (got, want) in e.iter().zip(want) {
+            assert!(got.contains(want), "{got:?} should contain {want:?}");
+        }
+    }
 }

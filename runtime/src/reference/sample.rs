@@ -49,9 +49,9 @@ pub struct State {
     pub a: Vec<f64>,
 }
 
-/// `count` states drawn from [`SplitMix64`] seeded with `seed`: `q_i` uniform
-/// within joint `i`'s limits when it has them, else in `[−π, π]` (rotation) or
-/// `[−0.5, 0.5]` m (translation); `v_i` and `a_i` uniform in `[−2, 2]`.
+/// `count` states drawn from [`SplitMix64`] seeded with `seed`: `q_i` uniform in
+/// `[−π, π]` (rotation) or `[−0.5, 0.5]` m (translation), narrowed to joint `i`'s
+/// limits when it has them; `v_i` and `a_i` uniform in `[−2, 2]`.
 ///
 /// The draw order is fixed (per state: all `q`, then all `v`, then all `a`), so
 /// the same model, count and seed give the same states in every version.
@@ -62,10 +62,14 @@ pub fn sample_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
             let q = model
                 .joints
                 .iter()
-                .map(|j| match (j.limits, j.kind) {
-                    (Some(l), _) => rng.uniform(l.lower, l.upper),
-                    (None, JointKind::Prismatic) => rng.uniform(-0.5, 0.5),
-                    (None, _) => rng.uniform(-PI, PI),
+                .map(|j| {
+                    // One turn, or ±0.5 m, within the limits when there are any (a
+                    // model written without limits carries wide placeholders).
+                    let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
+                    match j.limits {
+                        Some(l) => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
+                        None => rng.uniform(-reach, reach),
+                    }
                 })
                 .collect();
             let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();

@@ -1,6 +1,12 @@
 //! Shared helpers of dyngen's cross-crate tests: the reference model of a generated
 //! robot, Pinocchio fixtures, and error measures.
 
+/// UR5 generated with every function split into parts of at most 100 statements
+/// (see `build.rs`).
+pub mod split {
+    include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
+}
+
 use dyngen::reference::Reference;
 use dyngen::Robot;
 use serde::Deserialize;

@@ -1,0 +1,27 @@
+//! Functions split into `#[inline(never)]` parts compute exactly what the unsplit
+//! ones do: the same operations in the same order, only passed through an array.
+
+use dyngen::reference::sample_states;
+use dyngen_tests::{reference_of, split::Ur5Split};
+use robot_ur5::Ur5;
+
+#[test]
+fn every_function_is_split() {
+    for (name, ops) in Ur5Split::OP_COUNTS {
+        assert!(ops.statements > 100, "{name} has only {} statements", ops.statements);
+    }
+    assert_eq!(Ur5Split::OP_COUNTS, Ur5::OP_COUNTS);
+}
+
+#[test]
+fn split_code_is_bit_identical_to_unsplit() {
+    let model = reference_of::<Ur5>().model().clone();
+    for s in sample_states(&model, 200, 11) {
+        let (q, v, a): ([f64; 6], [f64; 6], [f64; 6]) =
+            (s.q.try_into().unwrap(), s.v.try_into().unwrap(), s.a.try_into().unwrap());
+        let p = &Ur5::NOMINAL_PARAMS;
+        assert_eq!(Ur5Split::rnea(&q, &v, &a, p), Ur5::rnea(&q, &v, &a, p));
+        assert_eq!(Ur5Split::joint_wrenches(&q, &v, &a, p), Ur5::joint_wrenches(&q, &v, &a, p));
+        assert_eq!(Ur5Split::forward_kinematics(&q), Ur5::forward_kinematics(&q));
+    }
+}

@@ -23,11 +23,13 @@ pub mod error;
 pub mod graph;
 mod ir;
 pub mod math;
+pub mod principal;
 pub mod urdf;
 mod write;
 
 pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
+pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, parse_urdf};
 pub use write::to_urdf;

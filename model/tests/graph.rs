@@ -51,7 +51,10 @@ fn incidence_and_path_matrix_of_a_branched_tree() {
     );
     let t = path_matrix(&m);
     // T_ai = 1 iff joint a is on the path from body i to the base.
-    assert_eq!(t, vec![vec![1, 1, 1, 1], vec![0, 1, 0, 0], vec![0, 0, 1, 1], vec![0, 0, 0, 1]]);
+    assert_eq!(
+        t,
+        vec![vec![1, 1, 1, 1], vec![0, 1, 0, 0], vec![0, 0, 1, 1], vec![0, 0, 0, 1]]
+    );
     assert!(check_path_matrix(&s, &t), "S T = I and S0 T = -1");
     let mut wrong = t.clone();
     wrong[1][3] = 1;
@@ -93,5 +96,12 @@ fn body_joint_vectors_and_d() {
         }
     }
     // Body 4's column: D_i4 sums the weighted vectors along its path to the base.
-    assert_eq!(d[3][3], [cw[3][2][0] + cw[3][3][0], cw[3][2][1] + cw[3][3][1], cw[3][2][2] + cw[3][3][2]]);
+    assert_eq!(
+        d[3][3],
+        [
+            cw[3][2][0] + cw[3][3][0],
+            cw[3][2][1] + cw[3][3][1],
+            cw[3][2][2] + cw[3][3][2]
+        ]
+    );
 }

@@ -17,11 +17,17 @@ fn every_function_is_split() {
 fn split_code_is_bit_identical_to_unsplit() {
     let model = reference_of::<Ur5>().model().clone();
     for s in sample_states(&model, 200, 11) {
-        let (q, v, a): ([f64; 6], [f64; 6], [f64; 6]) =
-            (s.q.try_into().unwrap(), s.v.try_into().unwrap(), s.a.try_into().unwrap());
+        let (q, v, a): ([f64; 6], [f64; 6], [f64; 6]) = (
+            s.q.try_into().unwrap(),
+            s.v.try_into().unwrap(),
+            s.a.try_into().unwrap(),
+        );
         let p = &Ur5::NOMINAL_PARAMS;
         assert_eq!(Ur5Split::rnea(&q, &v, &a, p), Ur5::rnea(&q, &v, &a, p));
-        assert_eq!(Ur5Split::joint_wrenches(&q, &v, &a, p), Ur5::joint_wrenches(&q, &v, &a, p));
+        assert_eq!(
+            Ur5Split::joint_wrenches(&q, &v, &a, p),
+            Ur5::joint_wrenches(&q, &v, &a, p)
+        );
         assert_eq!(Ur5Split::forward_kinematics(&q), Ur5::forward_kinematics(&q));
     }
 }

@@ -2,7 +2,8 @@
 //! This is the classical 3D Newton–Euler formulation (Luh, Walker, Paul), written
 //! independently of the runtime's 6D spatial reference so the two check each other.
 //!
-//! Function arguments are numbered: `q` = 0, `v` = 1, `a` = 2, `params` = 3.
+//! Function arguments are numbered: `q` = 0, `v` = 1, `a` = 2 (or `tau` for `aba`),
+//! `params` = 3.
 
 use crate::sym::{Expr, Graph};
 use dyngen_model::{JointKind, Model};
@@ -12,6 +13,8 @@ pub const ARG_Q: u8 = 0;
 pub const ARG_V: u8 = 1;
 pub const ARG_A: u8 = 2;
 pub const ARG_PARAMS: u8 = 3;
+/// `aba` reads joint torques in the slot of `a`.
+pub const ARG_TAU: u8 = ARG_A;
 
 /// A 3-vector of expressions.
 #[derive(Clone, Copy, Debug)]
@@ -60,6 +63,63 @@ impl<'g> Sub for V3<'g> {
 }
 
 impl<'g> M3<'g> {
+    pub fn zero(g: &'g Graph) -> M3<'g> {
+        M3([[g.zero(); 3]; 3])
+    }
+
+    /// `s · E`.
+    pub fn diagonal(g: &'g Graph, s: Expr<'g>) -> M3<'g> {
+        let z = g.zero();
+        M3([[s, z, z], [z, s, z], [z, z, s]])
+    }
+
+    /// The cross-product matrix `S(v)`, `S(v) x = v × x`.
+    pub fn skew(v: V3<'g>) -> M3<'g> {
+        let [x, y, z] = v.0;
+        let o = x.graph().zero();
+        M3([[o, -z, y], [z, o, -x], [-y, x, o]])
+    }
+
+    pub fn transpose(&self) -> M3<'g> {
+        let m = &self.0;
+        M3([0, 1, 2].map(|r| [0, 1, 2].map(|c| m[c][r])))
+    }
+
+    pub fn add(&self, o: &M3<'g>) -> M3<'g> {
+        M3([0, 1, 2].map(|r| [0, 1, 2].map(|c| self.0[r][c] + o.0[r][c])))
+    }
+
+    pub fn sub(&self, o: &M3<'g>) -> M3<'g> {
+        M3([0, 1, 2].map(|r| [0, 1, 2].map(|c| self.0[r][c] - o.0[r][c])))
+    }
+
+    /// `R · self · Rᵀ` for a symmetric `self`: the upper triangle is computed and
+    /// mirrored, so both halves are the same nodes.
+    pub fn rotate_sym(&self, r: &M3<'g>) -> M3<'g> {
+        let full = r.mul(self).mul(&r.transpose());
+        let mut m = full.0;
+        for a in 0..3 {
+            for b in 0..a {
+                m[a][b] = m[b][a];
+            }
+        }
+        M3(m)
+    }
+
+    /// `R · self · Rᵀ` for a general `self`.
+    pub fn rotate(&self, r: &M3<'g>) -> M3<'g> {
+        r.mul(self).mul(&r.transpose())
+    }
+
+    /// `u vᵀ`.
+    pub fn outer(u: V3<'g>, v: V3<'g>) -> M3<'g> {
+        M3([0, 1, 2].map(|r| [0, 1, 2].map(|c| u.0[r] * v.0[c])))
+    }
+
+    pub fn scale(&self, s: Expr<'g>) -> M3<'g> {
+        M3(self.0.map(|row| row.map(|x| x * s)))
+    }
+
     pub fn constant(g: &'g Graph, m: [[f64; 3]; 3]) -> M3<'g> {
         M3(m.map(|row| row.map(|x| g.constant(x))))
     }
@@ -157,23 +217,191 @@ pub fn forward_kinematics<'g>(g: &'g Graph, model: &Model) -> Vec<(M3<'g>, V3<'g
     poses
 }
 
-/// The standard parameters of body `j` as symbols: mass, first moment `h = m c`,
-/// and the inertia about the body-frame origin.
-struct BodyParams<'g> {
-    m: Expr<'g>,
-    h: V3<'g>,
-    inertia: M3<'g>,
+/// One body's standard parameters as expressions: mass, first moment `h = m c`, and
+/// the inertia about the body-frame origin. Inputs for the dynamics; constants
+/// (unit vectors, columns of `P`) for the regressors, where folding then yields each
+/// column of the regressor directly.
+#[derive(Clone, Copy)]
+pub struct BodyParams<'g> {
+    pub m: Expr<'g>,
+    pub h: V3<'g>,
+    pub inertia: M3<'g>,
 }
 
 impl<'g> BodyParams<'g> {
-    fn input(g: &'g Graph, j: usize) -> BodyParams<'g> {
+    /// Body `j`'s 10 parameters read from `params`.
+    pub fn input(g: &'g Graph, j: usize) -> BodyParams<'g> {
         let p = |k: usize| g.input(ARG_PARAMS, (10 * (j - 1) + k) as u32);
+        BodyParams::from_standard([0, 1, 2, 3, 4, 5, 6, 7, 8, 9].map(p))
+    }
+
+    /// Constant parameters (Pinocchio order).
+    pub fn constant(g: &'g Graph, p: [f64; 10]) -> BodyParams<'g> {
+        BodyParams::from_standard(p.map(|x| g.constant(x)))
+    }
+
+    /// The `k`-th unit parameter vector: the regressor column of parameter `k`.
+    pub fn unit(g: &'g Graph, k: usize) -> BodyParams<'g> {
+        let mut p = [0.0; 10];
+        p[k] = 1.0;
+        BodyParams::constant(g, p)
+    }
+
+    fn from_standard(p: [Expr<'g>; 10]) -> BodyParams<'g> {
         BodyParams {
-            m: p(0),
-            h: V3([p(1), p(2), p(3)]),
-            inertia: M3([[p(4), p(5), p(7)], [p(5), p(6), p(8)], [p(7), p(8), p(9)]]),
+            m: p[0],
+            h: V3([p[1], p[2], p[3]]),
+            inertia: M3([[p[4], p[5], p[7]], [p[5], p[6], p[8]], [p[7], p[8], p[9]]]),
         }
     }
+
+    /// The net wrench about the body origin that produces the body's motion:
+    /// `f = m a + ω̇×h + ω×(ω×h)`, `n = I ω̇ + ω×(I ω) + h×a`, with `a` the origin's
+    /// acceleration (gravity included as `−g`).
+    pub fn wrench(&self, m: &BodyMotion<'g>) -> Force<'g> {
+        let (w, wd, a) = (m.w, m.wd, m.acc);
+        Force {
+            f: a.scale(self.m) + wd.cross(self.h) + w.cross(w.cross(self.h)),
+            n: self.inertia.mul_vec(wd) + w.cross(self.inertia.mul_vec(w)) + self.h.cross(a),
+        }
+    }
+}
+
+/// A spatial force: force `f`, moment `n` about the frame origin.
+#[derive(Clone, Copy, Debug)]
+pub struct Force<'g> {
+    pub f: V3<'g>,
+    pub n: V3<'g>,
+}
+
+/// A spatial motion: linear part `v` of the frame origin, angular part `w`.
+#[derive(Clone, Copy, Debug)]
+pub struct Motion<'g> {
+    pub v: V3<'g>,
+    pub w: V3<'g>,
+}
+
+impl<'g> Force<'g> {
+    pub fn zero(g: &'g Graph) -> Force<'g> {
+        Force { f: V3::zero(g), n: V3::zero(g) }
+    }
+
+    pub fn add(self, o: Force<'g>) -> Force<'g> {
+        Force { f: self.f + o.f, n: self.n + o.n }
+    }
+
+    /// Power with a motion: `f·v + n·ω`.
+    pub fn dot(self, m: Motion<'g>) -> Expr<'g> {
+        self.f.dot(m.v) + self.n.dot(m.w)
+    }
+}
+
+impl<'g> Motion<'g> {
+    pub fn zero(g: &'g Graph) -> Motion<'g> {
+        Motion { v: V3::zero(g), w: V3::zero(g) }
+    }
+
+    pub fn add(self, o: Motion<'g>) -> Motion<'g> {
+        Motion { v: self.v + o.v, w: self.w + o.w }
+    }
+
+    pub fn scale(self, s: Expr<'g>) -> Motion<'g> {
+        Motion { v: self.v.scale(s), w: self.w.scale(s) }
+    }
+
+    /// Motion cross product `self ×m m`.
+    pub fn cross_motion(self, m: Motion<'g>) -> Motion<'g> {
+        Motion { v: self.w.cross(m.v) + self.v.cross(m.w), w: self.w.cross(m.w) }
+    }
+
+    /// Force cross product `self ×* f`.
+    pub fn cross_force(self, f: Force<'g>) -> Force<'g> {
+        Force { f: self.w.cross(f.f), n: self.w.cross(f.n) + self.v.cross(f.f) }
+    }
+}
+
+impl<'g> JointTransform<'g> {
+    /// A parent-frame motion seen at the child origin in child axes.
+    pub fn motion_to_child(&self, m: Motion<'g>) -> Motion<'g> {
+        Motion { v: self.to_child(m.v + m.w.cross(self.translation)), w: self.to_child(m.w) }
+    }
+
+    /// A child-frame force re-expressed in the parent frame, moment about its origin.
+    pub fn force_to_parent(&self, f: Force<'g>) -> Force<'g> {
+        let fp = self.to_parent(f.f);
+        Force { f: fp, n: self.to_parent(f.n) + self.translation.cross(fp) }
+    }
+}
+
+/// Joint `j`'s motion subspace in its own frame: `(0, axis)` for rotation,
+/// `(axis, 0)` for translation.
+pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Motion<'g> {
+    let joint = &model.joints[j - 1];
+    let axis = V3::constant(g, joint.axis);
+    if joint.kind.is_revolute() {
+        Motion { v: V3::zero(g), w: axis }
+    } else {
+        Motion { v: axis, w: V3::zero(g) }
+    }
+}
+
+/// Which of `v` and `a` are inputs; the others are zero (and fold away).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inputs {
+    /// `rnea(q, v, a)`.
+    Full,
+    /// `nonlinear_effects(q, v) = rnea(q, v, 0)`.
+    NoAcceleration,
+    /// `generalized_gravity(q) = rnea(q, 0, 0)`.
+    Static,
+}
+
+/// A body's angular velocity `w`, angular acceleration `wd`, and the acceleration
+/// `acc` of its frame origin (gravity included as `−g`), all in body axes.
+#[derive(Clone, Copy, Debug)]
+pub struct BodyMotion<'g> {
+    pub w: V3<'g>,
+    pub wd: V3<'g>,
+    pub acc: V3<'g>,
+}
+
+/// Everything the algorithms share: joint transforms and body motions (index 0 is
+/// the base, at rest, accelerating at `−g`).
+pub struct Kinematics<'g> {
+    pub x: Vec<JointTransform<'g>>,
+    pub motion: Vec<BodyMotion<'g>>,
+}
+
+/// The forward Newton–Euler pass.
+pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics<'g> {
+    let n = model.dof();
+    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let mut motion = vec![BodyMotion { w: V3::zero(g), wd: V3::zero(g), acc: V3::constant(g, model.gravity.map(|c| -c)) }];
+    for j in 1..=n {
+        let joint = &model.joints[j - 1];
+        let p = joint.parent;
+        let xj = &x[j - 1];
+        let axis = V3::constant(g, joint.axis);
+        let qd = if inputs == Inputs::Static { g.zero() } else { g.input(ARG_V, (j - 1) as u32) };
+        let qdd = if inputs == Inputs::Full { g.input(ARG_A, (j - 1) as u32) } else { g.zero() };
+        let t = xj.translation;
+        let mp = motion[p];
+        // Acceleration of the joint-frame origin, still in parent axes.
+        let a_origin = mp.acc + mp.wd.cross(t) + mp.w.cross(mp.w.cross(t));
+        let w_in = xj.to_child(mp.w);
+        let wd_in = xj.to_child(mp.wd);
+        let a_in = xj.to_child(a_origin);
+        let m = if joint.kind.is_revolute() {
+            let wq = axis.scale(qd);
+            BodyMotion { w: w_in + wq, wd: wd_in + axis.scale(qdd) + w_in.cross(wq), acc: a_in }
+        } else {
+            let vq = axis.scale(qd);
+            let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
+            BodyMotion { w: w_in, wd: wd_in, acc: a_in + two_w_vq + axis.scale(qdd) }
+        };
+        motion.push(m);
+    }
+    Kinematics { x, motion }
 }
 
 /// Outputs of the Newton–Euler recursion.
@@ -181,79 +409,340 @@ pub struct Rnea<'g> {
     pub tau: Vec<Expr<'g>>,
     /// For each joint `j`: the force and the moment about the joint-frame origin that
     /// joint `j` applies to body `j`, in body `j`'s frame.
-    pub wrenches: Vec<(V3<'g>, V3<'g>)>,
+    pub wrenches: Vec<Force<'g>>,
 }
 
 /// Recursive Newton–Euler: forward pass for body velocities and accelerations
 /// (gravity as a base acceleration `−g`), per-body Newton–Euler with the symbolic
 /// standard parameters, backward pass accumulating what each joint transmits.
-pub fn rnea<'g>(g: &'g Graph, model: &Model) -> Rnea<'g> {
+pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
     let n = model.dof();
-    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
-    // Index 0 is the base.
-    let mut w = vec![V3::zero(g)];
-    let mut wd = vec![V3::zero(g)];
-    let mut acc = vec![V3::constant(g, model.gravity.map(|c| -c))];
-    for j in 1..=n {
-        let joint = &model.joints[j - 1];
-        let p = joint.parent;
-        let xj = &x[j - 1];
-        let axis = V3::constant(g, joint.axis);
-        let qd = g.input(ARG_V, (j - 1) as u32);
-        let qdd = g.input(ARG_A, (j - 1) as u32);
-        let t = xj.translation;
-        // Acceleration of the joint-frame origin, still in parent axes.
-        let a_origin = acc[p] + wd[p].cross(t) + w[p].cross(w[p].cross(t));
-        let w_in = xj.to_child(w[p]);
-        let wd_in = xj.to_child(wd[p]);
-        let a_in = xj.to_child(a_origin);
-        let (wj, wdj, aj) = if joint.kind.is_revolute() {
-            let wq = axis.scale(qd);
-            (w_in + wq, wd_in + axis.scale(qdd) + w_in.cross(wq), a_in)
-        } else {
-            let vq = axis.scale(qd);
-            let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
-            (w_in, wd_in, a_in + two_w_vq + axis.scale(qdd))
-        };
-        w.push(wj);
-        wd.push(wdj);
-        acc.push(aj);
-    }
-    // Per-body net wrench about the body origin: f = m a + ω̇×h + ω×(ω×h),
-    // n = I ω̇ + ω×(I ω) + h×a.
-    let mut f: Vec<V3<'g>> = Vec::with_capacity(n);
-    let mut nm: Vec<V3<'g>> = Vec::with_capacity(n);
-    for j in 1..=n {
-        let b = BodyParams::input(g, j);
-        let (wj, wdj, aj) = (w[j], wd[j], acc[j]);
-        f.push(aj.scale(b.m) + wdj.cross(b.h) + wj.cross(wj.cross(b.h)));
-        nm.push(b.inertia.mul_vec(wdj) + wj.cross(b.inertia.mul_vec(wj)) + b.h.cross(aj));
-    }
+    let k = kinematics(g, model, inputs);
+    let mut f: Vec<Force<'g>> = (1..=n).map(|j| BodyParams::input(g, j).wrench(&k.motion[j])).collect();
     // Backward pass: children first (regular labelling: higher index first).
     for j in (1..=n).rev() {
         let p = model.parent(j);
-        if p == 0 {
-            continue;
+        if p > 0 {
+            f[p - 1] = f[p - 1].add(k.x[j - 1].force_to_parent(f[j - 1]));
         }
-        let xj = &x[j - 1];
-        let fp = xj.to_parent(f[j - 1]);
-        let np = xj.to_parent(nm[j - 1]) + xj.translation.cross(fp);
-        f[p - 1] = f[p - 1] + fp;
-        nm[p - 1] = nm[p - 1] + np;
     }
-    let tau = (1..=n)
-        .map(|j| {
-            let joint = &model.joints[j - 1];
-            let axis = V3::constant(g, joint.axis);
-            if joint.kind.is_revolute() {
-                axis.dot(nm[j - 1])
-            } else {
-                axis.dot(f[j - 1])
+    let tau = (1..=n).map(|j| f[j - 1].dot(subspace(g, model, j))).collect();
+    Rnea { tau, wrenches: f }
+}
+
+/// `S_j` of every joint `j` expressed in every body `i` it supports:
+/// `out[i][j]` (1-based), `None` where joint `j` is not on body `i`'s path.
+fn subspaces_in_descendants<'g>(g: &'g Graph, model: &Model, k: &Kinematics<'g>) -> Vec<Vec<Option<Motion<'g>>>> {
+    let n = model.dof();
+    let mut out = vec![vec![None; n + 1]; n + 1];
+    for i in 1..=n {
+        out[i][i] = Some(subspace(g, model, i));
+        let p = model.parent(i);
+        for j in 1..i {
+            if let Some(s) = out[p][j] {
+                out[i][j] = Some(k.x[i - 1].motion_to_child(s));
             }
-        })
-        .collect();
-    Rnea {
-        tau,
-        wrenches: f.into_iter().zip(nm).collect(),
+        }
     }
+    out
+}
+
+/// The joint torque regressor `Y` (n × cols·n) for per-body parameter columns
+/// `columns(i)`: entry `(j, cols·(i−1) + c)` is `S_jᵀ` (in body `i`'s frame) times the
+/// wrench that column `c` of body `i`'s parameters needs. Blocks where joint `j` does
+/// not support body `i` are `None`: structurally zero, never computed.
+pub fn torque_regressor<'g>(
+    g: &'g Graph,
+    model: &Model,
+    columns: impl Fn(usize) -> Vec<BodyParams<'g>>,
+) -> Vec<Vec<Option<Expr<'g>>>> {
+    let n = model.dof();
+    let k = kinematics(g, model, Inputs::Full);
+    let s = subspaces_in_descendants(g, model, &k);
+    let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![Vec::new(); n];
+    for i in 1..=n {
+        let wrenches: Vec<Force<'g>> = columns(i).iter().map(|b| b.wrench(&k.motion[i])).collect();
+        for (j, row) in y.iter_mut().enumerate() {
+            for w in &wrenches {
+                row.push(s[i][j + 1].map(|sj| w.dot(sj)));
+            }
+        }
+    }
+    y
+}
+
+/// Standard parameter columns of body `i`: the 10 unit vectors.
+pub fn standard_columns<'g>(g: &'g Graph) -> impl Fn(usize) -> Vec<BodyParams<'g>> + 'g {
+    move |_| (0..10).map(|k| BodyParams::unit(g, k)).collect()
+}
+
+/// Principal parameter columns of body `i`: the 4 columns of `P_i`.
+pub fn principal_columns<'g>(g: &'g Graph, model: &Model) -> impl Fn(usize) -> Vec<BodyParams<'g>> + 'g {
+    let ps: Vec<[[f64; 4]; 10]> = dyngen_model::principal_frames(model).iter().map(|f| f.p_matrix()).collect();
+    move |i| (0..4).map(|c| BodyParams::constant(g, ps[i - 1].map(|row| row[c]))).collect()
+}
+
+/// The joint wrench regressor (6n × 10n): rows `6(j−1)..6j` are joint `j`'s reaction
+/// wrench `[force; moment]` (as [`rnea`]'s `wrenches`) per standard parameter.
+pub fn wrench_regressor<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Option<Expr<'g>>>> {
+    let n = model.dof();
+    let k = kinematics(g, model, Inputs::Full);
+    let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![vec![None; 10 * n]; 6 * n];
+    for i in 1..=n {
+        for c in 0..10 {
+            let mut w = BodyParams::unit(g, c).wrench(&k.motion[i]);
+            let mut j = i;
+            loop {
+                for (r, e) in w.f.0.iter().chain(w.n.0.iter()).enumerate() {
+                    y[6 * (j - 1) + r][10 * (i - 1) + c] = Some(*e);
+                }
+                let p = model.parent(j);
+                if p == 0 {
+                    break;
+                }
+                w = k.x[j - 1].force_to_parent(w);
+                j = p;
+            }
+        }
+    }
+    y
+}
+
+/// Composite rigid-body algorithm: the joint-space inertia matrix `M(q)` (n × n,
+/// symmetric; entries for joints on different branches are exact zeros).
+pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
+    let n = model.dof();
+    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let mut composite: Vec<BodyParams<'g>> = (1..=n).map(|j| BodyParams::input(g, j)).collect();
+    for i in (1..=n).rev() {
+        let p = model.parent(i);
+        if p > 0 {
+            let moved = composite_to_parent(&x[i - 1], &composite[i - 1]);
+            let c = &mut composite[p - 1];
+            *c = BodyParams { m: c.m + moved.m, h: c.h + moved.h, inertia: c.inertia.add(&moved.inertia) };
+        }
+    }
+    let mut m = vec![vec![g.zero(); n]; n];
+    for i in 1..=n {
+        let si = subspace(g, model, i);
+        let c = &composite[i - 1];
+        // F = I_c S_i: the momentum of the composite body moving along S_i.
+        let mut f = Force { f: si.v.scale(c.m) + si.w.cross(c.h), n: c.inertia.mul_vec(si.w) + c.h.cross(si.v) };
+        m[i - 1][i - 1] = f.dot(si);
+        let mut j = i;
+        while model.parent(j) != 0 {
+            f = x[j - 1].force_to_parent(f);
+            j = model.parent(j);
+            let e = f.dot(subspace(g, model, j));
+            m[i - 1][j - 1] = e;
+            m[j - 1][i - 1] = e;
+        }
+    }
+    m
+}
+
+/// A body's parameters seen from its parent frame: `h' = R h + m p`,
+/// `I' = R I Rᵀ − m S(p)S(p) − S(p)S(R h) − S(R h)S(p)`.
+fn composite_to_parent<'g>(x: &JointTransform<'g>, b: &BodyParams<'g>) -> BodyParams<'g> {
+    let p = x.translation;
+    let rh = x.to_parent(b.h);
+    let rot = b.inertia.rotate_sym(&x.motion).rotate_sym(&x.origin);
+    let (sp, srh) = (M3::skew(p), M3::skew(rh));
+    let shift = sp.mul(&sp).scale(b.m).add(&sp.mul(&srh)).add(&srh.mul(&sp));
+    let mut inertia = rot.sub(&shift).0;
+    for a in 0..3 {
+        for c in 0..a {
+            inertia[a][c] = inertia[c][a];
+        }
+    }
+    BodyParams { m: b.m, h: rh + p.scale(b.m), inertia: M3(inertia) }
+}
+
+/// A spatial (articulated) inertia `[[M, H], [Hᵀ, J]]` acting on `(v, ω)`.
+#[derive(Clone, Copy)]
+struct Inertia6<'g> {
+    m: M3<'g>,
+    h: M3<'g>,
+    j: M3<'g>,
+}
+
+impl<'g> Inertia6<'g> {
+    fn rigid(g: &'g Graph, b: &BodyParams<'g>) -> Inertia6<'g> {
+        Inertia6 { m: M3::diagonal(g, b.m), h: M3::skew(b.h).scale(g.constant(-1.0)), j: b.inertia }
+    }
+
+    fn apply(&self, v: Motion<'g>) -> Force<'g> {
+        Force {
+            f: self.m.mul_vec(v.v) + self.h.mul_vec(v.w),
+            n: self.h.tr_mul_vec(v.v) + self.j.mul_vec(v.w),
+        }
+    }
+
+    fn add(&self, o: &Inertia6<'g>) -> Inertia6<'g> {
+        Inertia6 { m: self.m.add(&o.m), h: self.h.add(&o.h), j: self.j.add(&o.j) }
+    }
+
+    /// `self − U Uᵀ / D` with `inv_d = 1 / D`.
+    fn minus_outer(&self, u: &Force<'g>, inv_d: Expr<'g>) -> Inertia6<'g> {
+        let (u1, u2) = (u.f, u.n);
+        let sym = |m: M3<'g>| {
+            let mut a = m.0;
+            for r in 0..3 {
+                for c in 0..r {
+                    a[r][c] = a[c][r];
+                }
+            }
+            M3(a)
+        };
+        Inertia6 {
+            m: sym(self.m.sub(&M3::outer(u1.scale(inv_d), u1))),
+            h: self.h.sub(&M3::outer(u1.scale(inv_d), u2)),
+            j: sym(self.j.sub(&M3::outer(u2.scale(inv_d), u2))),
+        }
+    }
+
+    /// The same inertia seen from the parent frame: rotate every block, then shift
+    /// the reference point: `H' = H − M S(p)`, `J' = J − Hᵀ S(p) + S(p) H − S(p) M S(p)`.
+    fn to_parent(&self, x: &JointTransform<'g>) -> Inertia6<'g> {
+        let r = |m: &M3<'g>, sym: bool| {
+            if sym {
+                m.rotate_sym(&x.motion).rotate_sym(&x.origin)
+            } else {
+                m.rotate(&x.motion).rotate(&x.origin)
+            }
+        };
+        let (m, h, j) = (r(&self.m, true), r(&self.h, false), r(&self.j, true));
+        let sp = M3::skew(x.translation);
+        let h2 = h.sub(&m.mul(&sp));
+        let j2 = j.sub(&h.transpose().mul(&sp)).add(&sp.mul(&h)).sub(&sp.mul(&m).mul(&sp));
+        let mut ja = j2.0;
+        for a in 0..3 {
+            for c in 0..a {
+                ja[a][c] = ja[c][a];
+            }
+        }
+        Inertia6 { m, h: h2, j: M3(ja) }
+    }
+}
+
+/// Featherstone's articulated-body algorithm: `a = M(q)⁻¹ (tau − h(q, v))`, with
+/// `tau` read from the `a` argument slot. One division per joint.
+pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
+    let n = model.dof();
+    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let s: Vec<Motion<'g>> = (1..=n).map(|j| subspace(g, model, j)).collect();
+    // Pass 1: velocities, velocity-product accelerations, bias forces.
+    let mut v = vec![Motion::zero(g)];
+    let mut c = vec![Motion::zero(g)];
+    let mut ia = vec![Inertia6 { m: M3::zero(g), h: M3::zero(g), j: M3::zero(g) }];
+    let mut pa = vec![Force::zero(g)];
+    for i in 1..=n {
+        let p = model.parent(i);
+        let vj = s[i - 1].scale(g.input(ARG_V, (i - 1) as u32));
+        let vi = x[i - 1].motion_to_child(v[p]).add(vj);
+        let inertia = Inertia6::rigid(g, &BodyParams::input(g, i));
+        pa.push(vi.cross_force(inertia.apply(vi)));
+        c.push(vi.cross_motion(vj));
+        v.push(vi);
+        ia.push(inertia);
+    }
+    // Pass 2: articulated inertias and bias forces, leaves first.
+    let mut u_vec = vec![Force::zero(g); n + 1];
+    let mut inv_d = vec![g.zero(); n + 1];
+    let mut u = vec![g.zero(); n + 1];
+    for i in (1..=n).rev() {
+        let ui = ia[i].apply(s[i - 1]);
+        let d = ui.dot(s[i - 1]);
+        let id = g.one() / d;
+        let tau = g.input(ARG_TAU, (i - 1) as u32);
+        let ui_scalar = tau - pa[i].dot(s[i - 1]);
+        let p = model.parent(i);
+        if p > 0 {
+            let a_ia = ia[i].minus_outer(&ui, id);
+            let a_pa = pa[i].add(a_ia.apply(c[i])).add(Force { f: ui.f.scale(ui_scalar * id), n: ui.n.scale(ui_scalar * id) });
+            ia[p] = ia[p].add(&a_ia.to_parent(&x[i - 1]));
+            pa[p] = pa[p].add(x[i - 1].force_to_parent(a_pa));
+        }
+        u_vec[i] = ui;
+        inv_d[i] = id;
+        u[i] = ui_scalar;
+    }
+    // Pass 3: accelerations, root first; the base accelerates at −g.
+    let mut acc = vec![Motion { v: V3::constant(g, model.gravity.map(|x| -x)), w: V3::zero(g) }];
+    let mut qdd = Vec::with_capacity(n);
+    for i in 1..=n {
+        let p = model.parent(i);
+        let a_prime = x[i - 1].motion_to_child(acc[p]).add(c[i]);
+        let qi = (u[i] - u_vec[i].dot(a_prime)) * inv_d[i];
+        acc.push(a_prime.add(s[i - 1].scale(qi)));
+        qdd.push(qi);
+    }
+    qdd
+}
+
+/// The paper's per-body model (DESIGN §5): for each body, `A_i` (6 × 4, row-major)
+/// with `[F; M] = A_i θ_i` in the body's centroidal principal frame:
+/// `A = blkdiag(a_c − g, B(ω, ω̇))`.
+pub fn body_regressors<'g>(g: &'g Graph, model: &Model) -> Vec<[[Expr<'g>; 4]; 6]> {
+    let k = kinematics(g, model, Inputs::Full);
+    let frames = dyngen_model::principal_frames(model);
+    (1..=model.dof())
+        .map(|i| {
+            let f = &frames[i - 1];
+            let r = M3::constant(g, f.rotation);
+            let c = V3::constant(g, f.com);
+            let m = k.motion[i];
+            let a_c = r.tr_mul_vec(m.acc + m.wd.cross(c) + m.w.cross(m.w.cross(c)));
+            let [w1, w2, w3] = r.tr_mul_vec(m.w).0;
+            let [d1, d2, d3] = r.tr_mul_vec(m.wd).0;
+            let z = g.zero();
+            [
+                [a_c.0[0], z, z, z],
+                [a_c.0[1], z, z, z],
+                [a_c.0[2], z, z, z],
+                [z, d1, -(w2 * w3), w2 * w3],
+                [z, w3 * w1, d2, -(w3 * w1)],
+                [z, -(w1 * w2), w1 * w2, d3],
+            ]
+        })
+        .collect()
+}
+
+/// Each body's resultant of the joint reaction wrenches, through the incidence
+/// matrix and the body-joint vectors: `F_i = Σ_a S_ia F_a`,
+/// `M_i = Σ_a S_ia (M_a + c_ia × F_a)`, moment about the centre of mass, in the
+/// body's centroidal principal frame. (For a prismatic joint the point on its
+/// inboard body moves with `q`; `c_ia` follows it.)
+pub fn body_resultants<'g>(g: &'g Graph, model: &Model) -> Vec<Force<'g>> {
+    let n = model.dof();
+    let r = rnea(g, model, Inputs::Full);
+    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let s = dyngen_model::graph::incidence(model);
+    let c = dyngen_model::graph::body_joint_vectors(model);
+    let frames = dyngen_model::principal_frames(model);
+    (1..=n)
+        .map(|i| {
+            let mut total = Force::zero(g);
+            for a in 1..=n {
+                let sign = s[i][a - 1];
+                if sign == 0 {
+                    continue;
+                }
+                // Joint a's wrench in body i's axes: its own frame is body a's.
+                let w = r.wrenches[a - 1];
+                let (fa, ma) = if a == i { (w.f, w.n) } else { (x[a - 1].to_parent(w.f), x[a - 1].to_parent(w.n)) };
+                // c_ia is constant, except that a prismatic joint's point slides along
+                // the inboard body with q: use where its frame origin is now.
+                let cia = if a != i && model.joints[a - 1].kind == dyngen_model::JointKind::Prismatic {
+                    x[a - 1].translation - V3::constant(g, model.bodies[i - 1].inertial.com)
+                } else {
+                    V3::constant(g, c[i][a - 1])
+                };
+                let sg = g.constant(f64::from(sign));
+                total = total.add(Force { f: fa.scale(sg), n: (ma + cia.cross(fa)).scale(sg) });
+            }
+            let rot = M3::constant(g, frames[i - 1].rotation);
+            Force { f: rot.tr_mul_vec(total.f), n: rot.tr_mul_vec(total.n) }
+        })
+        .collect()
 }

@@ -11,8 +11,10 @@ use std::collections::HashMap;
 /// Statements per emitted function before it is split into parts.
 pub const DEFAULT_MAX_STATEMENTS: usize = 1200;
 
-/// A function argument: a fixed-size array of scalars, `&[S; len]`.
+/// A function argument: a fixed-size array of scalars, `&[S; len]`, read by the
+/// graph's `Input { arg: id }` nodes.
 pub struct Arg {
+    pub id: u8,
     pub name: &'static str,
     pub len: usize,
 }
@@ -24,7 +26,7 @@ pub type Assemble<'a> = Box<dyn Fn(&[TokenStream]) -> TokenStream + 'a>;
 pub struct FnSpec<'a> {
     pub name: &'a str,
     pub doc: String,
-    /// Arguments in the order of the graph's `Input { arg }` numbering.
+    /// Arguments in signature order.
     pub args: Vec<Arg>,
     pub ret: TokenStream,
     pub outputs: Vec<NodeId>,
@@ -208,7 +210,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
 
 fn operands(node: &Node) -> Vec<NodeId> {
     match *node {
-        Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => vec![a, b],
+        Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => vec![a, b],
         Node::Neg(a) | Node::Sin(a) | Node::Cos(a) => vec![a],
         Node::Const(_) | Node::Input { .. } => vec![],
     }
@@ -271,7 +273,8 @@ impl Names<'_> {
         match graph.node(id) {
             Node::Const(bits) => constant(f64::from_bits(bits)),
             Node::Input { arg, index } => {
-                let a = format_ident!("{}", self.args[arg as usize].name);
+                let name = self.args.iter().find(|a| a.id == arg).map_or("missing_argument", |a| a.name);
+                let a = format_ident!("{}", name);
                 let i = usize_lit(index as usize);
                 quote!(#a[#i])
             }
@@ -291,6 +294,9 @@ impl Names<'_> {
 
 /// A constant as the scalar type: `S::from_f64(0.425)`.
 pub fn constant(x: f64) -> TokenStream {
+    if x == 0.0 {
+        return quote!(<S as ::dyngen::Scalar>::ZERO);
+    }
     let lit = Literal::f64_unsuffixed(x.abs());
     if x.is_sign_negative() && x != 0.0 {
         quote!(<S as ::dyngen::Scalar>::from_f64(-#lit))
@@ -314,6 +320,10 @@ fn emit_stmt(graph: &Graph, s: &Stmt, names: &Names<'_>) -> TokenStream {
         Node::Mul(a, b) => {
             let (a, b) = (op(a), op(b));
             quote!(let #x = #a * #b;)
+        }
+        Node::Div(a, b) => {
+            let (a, b) = (op(a), op(b));
+            quote!(let #x = #a / #b;)
         }
         Node::Neg(a) => {
             let a = op(a);

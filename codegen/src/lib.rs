@@ -11,6 +11,7 @@
 //! then in the crate `include!(concat!(env!("OUT_DIR"), "/ur5.rs"));` defines `Ur5`.
 
 pub mod algo;
+pub mod base;
 mod build;
 pub mod dsl;
 pub mod emit;
@@ -18,7 +19,7 @@ mod generate;
 pub mod sym;
 
 pub use build::{compile_urdf, write_if_changed, Config, Error};
-pub use generate::{generate, is_type_name, Generated, Options};
+pub use generate::{generate, is_type_name, principal_param_names, standard_param_names, Generated, Options};
 
 use proc_macro2::TokenStream;
 use quote::quote;

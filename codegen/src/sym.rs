@@ -4,7 +4,7 @@
 
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Index of a node in its graph. Operands always have smaller ids than their users,
 /// so id order is a valid evaluation order.
@@ -22,6 +22,7 @@ pub enum Node {
     Add(NodeId, NodeId),
     Sub(NodeId, NodeId),
     Mul(NodeId, NodeId),
+    Div(NodeId, NodeId),
     Neg(NodeId),
     Sin(NodeId),
     Cos(NodeId),
@@ -113,6 +114,7 @@ impl Graph {
                 Node::Add(a, b) => val[a as usize] + val[b as usize],
                 Node::Sub(a, b) => val[a as usize] - val[b as usize],
                 Node::Mul(a, b) => val[a as usize] * val[b as usize],
+                Node::Div(a, b) => val[a as usize] / val[b as usize],
                 Node::Neg(a) => -val[a as usize],
                 Node::Sin(a) => val[a as usize].sin(),
                 Node::Cos(a) => val[a as usize].cos(),
@@ -133,7 +135,7 @@ impl Graph {
                 continue;
             }
             match nodes[id] {
-                Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => {
+                Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
                     live[a as usize] = true;
                     live[b as usize] = true;
                 }
@@ -297,6 +299,29 @@ impl<'g> Mul for Expr<'g> {
     }
 }
 
+impl<'g> Div for Expr<'g> {
+    type Output = Expr<'g>;
+    fn div(self, rhs: Expr<'g>) -> Expr<'g> {
+        let g = self.graph;
+        if let (Some(a), Some(b)) = (self.as_const(), rhs.as_const()) {
+            return g.constant(a / b);
+        }
+        if self.is_zero() {
+            return g.zero();
+        }
+        if rhs.is_const(1.0) {
+            return self;
+        }
+        match (self.negated(), rhs.negated()) {
+            (Some(a), Some(b)) => return a / b,
+            (Some(a), None) => return -(a / rhs),
+            (None, Some(b)) => return -(self / b),
+            (None, None) => {}
+        }
+        g.intern(Node::Div(self.id, rhs.id))
+    }
+}
+
 impl<'g> Neg for Expr<'g> {
     type Output = Expr<'g>;
     fn neg(self) -> Expr<'g> {
@@ -319,6 +344,7 @@ pub struct OpCount {
     /// Additions and subtractions.
     pub adds: usize,
     pub muls: usize,
+    pub divs: usize,
     pub negs: usize,
     /// `sin` and `cos` calls; a `sin`/`cos` pair of one angle counts as two.
     pub trig: usize,
@@ -335,6 +361,7 @@ impl OpCount {
             match graph.node(id as NodeId) {
                 Node::Add(..) | Node::Sub(..) => c.adds += 1,
                 Node::Mul(..) => c.muls += 1,
+                Node::Div(..) => c.divs += 1,
                 Node::Neg(_) => c.negs += 1,
                 Node::Sin(_) | Node::Cos(_) => c.trig += 1,
                 Node::Const(_) | Node::Input { .. } => {}
@@ -343,9 +370,9 @@ impl OpCount {
         c
     }
 
-    /// Floating-point operations: adds + muls (negations are sign flips, trig apart).
+    /// Floating-point operations: adds + muls + divs (negations are sign flips, trig apart).
     pub fn flops(&self) -> usize {
-        self.adds + self.muls
+        self.adds + self.muls + self.divs
     }
 }
 

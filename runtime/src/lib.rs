@@ -15,7 +15,7 @@ pub use dyngen_macros::robot;
 pub use dyngen_model as model;
 pub use nalgebra;
 pub use reference::Reference;
-pub use robot::{OpCount, Pose, Robot, Wrench};
+pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
 pub use scalar::Scalar;
 
 /// Support for generated code; not a public API.
@@ -29,6 +29,18 @@ pub mod __private {
         match x.try_into() {
             Ok(a) => a,
             Err(_) => panic!("dyngen: `{what}` has length {}, expected {N}", x.len()),
+        }
+    }
+
+    /// Copies a matrix given as rows into a row-major slice of the same size.
+    #[inline(always)]
+    #[track_caller]
+    pub fn copy_rows<S: Copy, const R: usize, const C: usize>(rows: &[[S; C]; R], out: &mut [S], what: &str) {
+        if out.len() != R * C {
+            panic!("dyngen: `{what}` has length {}, expected {} ({R} × {C})", out.len(), R * C);
+        }
+        for (dst, src) in out.chunks_exact_mut(C).zip(rows) {
+            dst.copy_from_slice(src);
         }
     }
 

@@ -2,7 +2,7 @@
 //! types of its API.
 
 use crate::Scalar;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// A body's pose in the base frame: `x_base = rotation · x_body + translation`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +36,23 @@ impl<S: Scalar> Default for Wrench<S> {
     }
 }
 
+/// The paper's per-body regressor `A_i` (6 × 4): `[F; M] = A_i θ_i` with
+/// `θ_i = (m, J1, J2, J3)`, force and moment about the centre of mass in the body's
+/// centroidal principal frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyRegressor<S: Scalar> {
+    /// Rows of the force: `m (a_c − g)`.
+    pub force: SMatrix<S, 3, 4>,
+    /// Rows of the moment: `diag(J) ω̇ + ω × diag(J) ω`.
+    pub moment: SMatrix<S, 3, 4>,
+}
+
+impl<S: Scalar> Default for BodyRegressor<S> {
+    fn default() -> Self {
+        BodyRegressor { force: SMatrix::from_element(S::ZERO), moment: SMatrix::from_element(S::ZERO) }
+    }
+}
+
 /// A robot with generated dynamics. Implemented by the types `robot!` and
 /// `dyngen_codegen::compile_urdf` generate; runtime code is generic over it.
 ///
@@ -53,6 +70,12 @@ pub trait Robot {
     const NV: usize;
     const NBODIES: usize;
     const NPARAMS: usize;
+    /// Principal parameters `θ = (m, J1, J2, J3)`, 4 per body.
+    const NTHETA: usize;
+    /// Base parameters of the standard parameterisation.
+    const NBASE: usize;
+    /// Base parameters of the principal parameterisation.
+    const NBASE_PRINCIPAL: usize;
 
     /// Joint names, joint 1 first.
     fn joint_names() -> &'static [&'static str];
@@ -62,6 +85,20 @@ pub trait Robot {
     fn parents() -> &'static [usize];
     /// The nominal standard parameters of the description, length `NPARAMS`.
     fn nominal_params() -> &'static [f64];
+    /// The nominal principal parameters, length `NTHETA`.
+    fn nominal_theta() -> &'static [f64];
+    /// A readable formula for each base parameter, e.g. `Izz1 + Iyy2 + 0.1817·m3`.
+    fn base_groupings() -> &'static [&'static str];
+    /// The standard parameters the base parameters are built on (columns of `Y`).
+    fn base_index() -> &'static [usize];
+    /// `K` (`NBASE × NPARAMS`, row-major): `β = K π`.
+    fn base_k() -> &'static [f64];
+    /// Readable formulas of the principal base parameters.
+    fn principal_base_groupings() -> &'static [&'static str];
+    /// The principal parameters the principal base parameters are built on.
+    fn principal_base_index() -> &'static [usize];
+    /// `K_θ` (`NBASE_PRINCIPAL × NTHETA`, row-major): `β_θ = K_θ θ`.
+    fn principal_base_k() -> &'static [f64];
     /// The robot as URDF text (fixed joints already merged), from which the
     /// reference model is rebuilt: `dyngen_model::parse_urdf(R::urdf())`.
     fn urdf() -> &'static str;
@@ -81,12 +118,42 @@ pub trait Robot {
     /// frame origin), in body `j`'s frame: Pinocchio's `data.f[j]` after `rnea`.
     /// `wrenches`: `NBODIES`.
     fn joint_wrenches<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], wrenches: &mut [Wrench<S>]);
+
+    /// `h(q, v) = rnea(q, v, 0)`. `tau`: `NV`.
+    fn nonlinear_effects<S: Scalar>(q: &[S], v: &[S], params: &[S], tau: &mut [S]);
+    /// `g(q) = rnea(q, 0, 0)`. `tau`: `NV`.
+    fn generalized_gravity<S: Scalar>(q: &[S], params: &[S], tau: &mut [S]);
+    /// Joint-space inertia matrix `M(q)`, row-major into `m` (`NV × NV`).
+    fn crba<S: Scalar>(q: &[S], params: &[S], m: &mut [S]);
+    /// Forward dynamics by the articulated-body algorithm: `a = M⁻¹ (tau − h)`.
+    fn aba<S: Scalar>(q: &[S], v: &[S], tau: &[S], params: &[S], a: &mut [S]);
+    /// `Y` with `tau = Y π`, row-major into `y` (`NV × NPARAMS`).
+    fn joint_torque_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
+    /// Every joint's reaction wrench per parameter, row-major into `y`
+    /// (`6·NBODIES × NPARAMS`, rows `[force; moment]` of joint 1, 2, …).
+    fn joint_wrench_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
+    /// `Y_θ` with `tau = Y_θ θ`, row-major into `y` (`NV × NTHETA`).
+    fn principal_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
+    /// `Y_b` with `tau = Y_b β`, row-major into `y` (`NV × NBASE`).
+    fn base_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
+    /// The principal base regressor, row-major into `y` (`NV × NBASE_PRINCIPAL`).
+    fn principal_base_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
+    /// The paper's per-body regressors `A_i`. `out`: `NBODIES`.
+    fn body_regressors<S: Scalar>(q: &[S], v: &[S], a: &[S], out: &mut [BodyRegressor<S>]);
+    /// Each body's resultant of the joint reaction wrenches (moment about the centre
+    /// of mass, centroidal principal frame). `out`: `NBODIES`.
+    fn body_resultants<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], out: &mut [Wrench<S>]);
+    /// `β = K π`. `params`: `NPARAMS`; `beta`: `NBASE`.
+    fn base_params<S: Scalar>(params: &[S], beta: &mut [S]);
+    /// `β_θ = K_θ θ`. `theta`: `NTHETA`; `beta`: `NBASE_PRINCIPAL`.
+    fn principal_base_params<S: Scalar>(theta: &[S], beta: &mut [S]);
 }
 
 /// Operation counts of one generated function, as the generator measured them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OpCount {
     pub muls: usize,
+    pub divs: usize,
     /// Additions and subtractions.
     pub adds: usize,
     pub negs: usize,
@@ -100,8 +167,8 @@ impl core::fmt::Display for OpCount {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "{} mul, {} add, {} neg, {} trig ({} statements)",
-            self.muls, self.adds, self.negs, self.trig, self.statements
+            "{} mul, {} div, {} add, {} neg, {} trig ({} statements)",
+            self.muls, self.divs, self.adds, self.negs, self.trig, self.statements
         )
     }
 }

@@ -1,0 +1,200 @@
+//! Base parameters, found at generation time: the regressor is evaluated numerically
+//! (straight from the symbolic graph) on random states, stacked, and factored by
+//! Householder QR that takes the columns in parameter order and sets aside every
+//! column already in the span of those kept (a rank-revealing choice that, unlike
+//! norm pivoting, does not depend on the sample). Kept columns are the base; every
+//! other column is a fixed combination of them, so `Y π = Y_b β` with `β = K π`, and
+//! earlier bodies' parameters absorb later ones (`Izz1 + Iyy2 + …`), as in the
+//! classical regrouping rules.
+
+use dyngen_model::Model;
+
+/// A column whose residual, relative to its own norm, falls below this is in the
+/// span of the columns kept before it.
+pub const RANK_TOLERANCE: f64 = 1e-8;
+/// Random states stacked per analysis (rows = `SAMPLES · n`).
+pub const SAMPLES: usize = 40;
+/// The seed of the analysis, and the seed of the check that repeats it.
+pub const SEEDS: [u64; 2] = [0x5eed_0001, 0x5eed_0002];
+
+/// The outcome of one rank analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaseParams {
+    /// Columns of the parameter vector that form the base, ascending.
+    pub independent: Vec<usize>,
+    /// `K` (b × p, row-major per base parameter): `β = K π`.
+    pub k: Vec<Vec<f64>>,
+    /// A readable formula for each base parameter, e.g. `Izz1 + Iyy2 + 0.1817·m3`.
+    pub groupings: Vec<String>,
+    /// Whether the analysis repeated with a second seed chose the same columns.
+    pub confirmed: bool,
+}
+
+impl BaseParams {
+    pub fn count(&self) -> usize {
+        self.independent.len()
+    }
+}
+
+/// Finds the base parameters of a regressor given as a function of `(q, v, a)`
+/// returning `n` rows of `p` numbers. `names[c]` names column `c` in groupings.
+pub fn analyse(
+    model: &Model,
+    names: &[String],
+    seed: u64,
+    regressor: impl Fn(&[f64], &[f64], &[f64]) -> Vec<Vec<f64>>,
+) -> BaseParams {
+    let n = model.dof();
+    let p = names.len();
+    let mut rng = SplitMix64(seed);
+    let mut rows: Vec<Vec<f64>> = Vec::with_capacity(SAMPLES * n);
+    for _ in 0..SAMPLES {
+        let q: Vec<f64> = model
+            .joints
+            .iter()
+            .map(|j| {
+                let reach = if j.kind.is_revolute() { std::f64::consts::PI } else { 0.5 };
+                let (lo, hi) = j.limits.map_or((-reach, reach), |l| (l.lower.max(-reach), l.upper.min(reach)));
+                rng.uniform(lo, hi)
+            })
+            .collect();
+        let v: Vec<f64> = (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let a: Vec<f64> = (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        rows.extend(regressor(&q, &v, &a));
+    }
+    let (perm, r, rank) = ordered_qr(&mut rows, p);
+    // Y_dep = Y_ind R11⁻¹ R12, so β = π_ind + (R11⁻¹ R12) π_dep.
+    let mut coef = vec![vec![0.0; p - rank]; rank];
+    for (d, col) in (rank..p).enumerate() {
+        for row in (0..rank).rev() {
+            let mut x = r[row][col];
+            for k in row + 1..rank {
+                x -= r[row][k] * coef[k][d];
+            }
+            coef[row][d] = x / r[row][row];
+        }
+    }
+    let mut order: Vec<usize> = (0..rank).collect();
+    order.sort_by_key(|&k| perm[k]);
+    let independent: Vec<usize> = order.iter().map(|&k| perm[k]).collect();
+    let k: Vec<Vec<f64>> = order
+        .iter()
+        .map(|&row| {
+            let mut kr = vec![0.0; p];
+            kr[perm[row]] = 1.0;
+            for (d, col) in (rank..p).enumerate() {
+                kr[perm[col]] = clean(coef[row][d]);
+            }
+            kr
+        })
+        .collect();
+    let groupings = k.iter().map(|kr| grouping(kr, names)).collect();
+    BaseParams { independent, k, groupings, confirmed: true }
+}
+
+/// Rounds away the noise of the factorisation: |x| < 1e-10 → 0, and values within
+/// 1e-10 of ±1 → ±1.
+fn clean(x: f64) -> f64 {
+    if x.abs() < 1e-10 {
+        0.0
+    } else if (x.abs() - 1.0).abs() < 1e-10 {
+        x.signum()
+    } else {
+        x
+    }
+}
+
+fn grouping(kr: &[f64], names: &[String]) -> String {
+    let mut s = String::new();
+    for (c, &x) in kr.iter().enumerate() {
+        if x == 0.0 {
+            continue;
+        }
+        let sign = if x < 0.0 { "−" } else { "+" };
+        let mag = x.abs();
+        let term = if mag == 1.0 { names[c].clone() } else { format!("{}·{}", format_coef(mag), names[c]) };
+        if s.is_empty() {
+            s = if x < 0.0 { format!("−{term}") } else { term };
+        } else {
+            s.push_str(&format!(" {sign} {term}"));
+        }
+    }
+    s
+}
+
+fn format_coef(x: f64) -> String {
+    let t = format!("{x:.6}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Householder QR of `a` (m × p, rows) in place, columns in order, each column
+/// kept only if its residual after the reflectors of the kept columns exceeds
+/// `RANK_TOLERANCE` times its own norm. Returns the column order (kept first, then
+/// set aside, each in parameter order), `R` in that order (rows, p wide) and the rank.
+fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
+    let m = a.len();
+    let original: Vec<f64> = (0..p).map(|c| a.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt()).collect();
+    let mut kept = Vec::new();
+    let mut dropped = Vec::new();
+    let mut k = 0;
+    for c in 0..p {
+        let residual = a[k.min(m)..].iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt();
+        if k >= m || original[c] == 0.0 || residual <= RANK_TOLERANCE * original[c] {
+            dropped.push(c);
+            continue;
+        }
+        kept.push(c);
+        // Householder reflector zeroing a[k+1.., c], applied to this and later columns.
+        let sign = if a[k][c] >= 0.0 { 1.0 } else { -1.0 };
+        let mut v: Vec<f64> = a[k..].iter().map(|r| r[c]).collect();
+        v[0] += sign * residual;
+        let vnorm2: f64 = v.iter().map(|x| x * x).sum();
+        for col in c..p {
+            let dot: f64 = v.iter().zip(&a[k..]).map(|(vi, r)| vi * r[col]).sum();
+            let f = 2.0 * dot / vnorm2;
+            for (vi, r) in v.iter().zip(a[k..].iter_mut()) {
+                r[col] -= f * vi;
+            }
+        }
+        k += 1;
+    }
+    let rank = kept.len();
+    let perm: Vec<usize> = kept.iter().chain(dropped.iter()).copied().collect();
+    let r: Vec<Vec<f64>> = (0..rank).map(|row| perm.iter().map(|&c| a[row][c]).collect()).collect();
+    (perm, r, rank)
+}
+
+/// SplitMix64: a fixed, documented generator so the analysis is the same on every
+/// machine and in every version.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn qr_finds_rank_and_combinations() {
+        // Columns: c0, c1 = 2 c0, c2 independent, c3 = c0 − c2.
+        let base = [[1.0, 0.5], [2.0, -1.0], [0.3, 0.7], [-1.0, 2.0], [0.0, 1.0]];
+        let mut rows: Vec<Vec<f64>> = base.iter().map(|r| vec![r[0], 2.0 * r[0], r[1], r[0] - r[1]]).collect();
+        let (perm, r, rank) = ordered_qr(&mut rows, 4);
+        assert_eq!(rank, 2);
+        // c0 and c2 are kept; c1 and c3 are set aside.
+        assert_eq!(perm, vec![0, 2, 1, 3]);
+        assert_eq!(r.len(), 2);
+    }
+}

@@ -40,9 +40,15 @@ FIXTURES = [
     ("robots/gripper_arm/gripper_arm.urdf", "gripper_arm", 50, 0, None),
     ("tests/fixtures/planar2.urdf", "planar2", 50, 0, [0.0, -9.81, 0.0]),
     ("tests/fixtures/paper6.urdf", "paper6", 50, 0, None),
+    ("robots/puma560/puma560.urdf", "puma560", 50, 0, None),
+    ("robots/panda/panda.urdf", "panda", 50, 0, None),
+    ("tests/fixtures/tree12.urdf", "tree12", 50, 0, None),
 ]
 
-SCHEMA_VERSION = 1
+# 2: adds per sample M, nle, g, Y, tau_fd, ddq (and more self-checks); every schema-1
+# field and value is unchanged.
+SCHEMA_VERSION = 2
+TAU_FD_RANGE = 10.0  # tau_fd uniform in [-10, 10]^nv
 
 
 def flat(x):
@@ -106,12 +112,21 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
     pi_all = np.concatenate([model.inertias[i].toDynamicParameters() for i in range(1, nj)])
     ranges = [coord_range(model, model.joints[i]) for i in range(1, nj)]
 
-    worst = {"tau_from_f": 0.0, "regressor": 0.0, "aba": 0.0}
-    out_samples = []
+    # Draws. q, v, a exactly as in schema 1 (per sample: q, then v, then a); the
+    # forward-dynamics torques come from the same generator AFTER all of them, one
+    # vector per sample, so that no schema-1 value changes.
+    draws = []
     for _ in range(samples):
         theta = np.array([rng.uniform(lo, hi) for lo, hi in ranges])
         v = rng.uniform(-2.0, 2.0, model.nv)
         a = rng.uniform(-2.0, 2.0, model.nv)
+        draws.append((theta, v, a))
+    tau_fds = [rng.uniform(-TAU_FD_RANGE, TAU_FD_RANGE, model.nv) for _ in range(samples)]
+
+    worst = {"tau_from_f": 0.0, "regressor": 0.0, "aba": 0.0,
+             "crba_sym": 0.0, "crba_nle_rnea": 0.0, "gravity": 0.0, "aba_fd": 0.0}
+    out_samples = []
+    for (theta, v, a), tau_fd in zip(draws, tau_fds):
         q = to_pin_q(model, theta)
 
         tau = pin.rnea(model, data, q, v, a).copy()
@@ -121,8 +136,22 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
         worst["tau_from_f"] = max(worst["tau_from_f"], float(np.abs(tf - tau).max()))
         Y = pin.computeJointTorqueRegressor(model, data, q, v, a)
         worst["regressor"] = max(worst["regressor"], float(np.abs(Y @ pi_all - tau).max()))
-        ddq = pin.aba(model, data, q, v, tau)
-        worst["aba"] = max(worst["aba"], float(np.abs(ddq - a).max()))
+        Y = Y.copy()
+        ddq_inv = pin.aba(model, data, q, v, tau)
+        worst["aba"] = max(worst["aba"], float(np.abs(ddq_inv - a).max()))
+
+        # Joint-space quantities. crba computes the upper triangle (the Python binding
+        # returns it already symmetrised); symmetrise from the upper triangle anyway.
+        Mraw = np.array(pin.crba(model, data, q))
+        M = np.triu(Mraw) + np.triu(Mraw, 1).T
+        worst["crba_sym"] = max(worst["crba_sym"], float(np.abs(Mraw - M).max()))
+        nle = pin.nonLinearEffects(model, data, q, v).copy()
+        g = pin.computeGeneralizedGravity(model, data, q).copy()
+        worst["crba_nle_rnea"] = max(worst["crba_nle_rnea"], float(np.abs(M @ a + nle - tau).max()))
+        g_rnea = pin.rnea(model, data, q, np.zeros(model.nv), np.zeros(model.nv))
+        worst["gravity"] = max(worst["gravity"], float(np.abs(g_rnea - g).max()))
+        ddq = pin.aba(model, data, q, v, tau_fd).copy()
+        worst["aba_fd"] = max(worst["aba_fd"], float(np.abs(M @ ddq + nle - tau_fd).max()))
 
         pin.forwardKinematics(model, data, q)
         out_samples.append({
@@ -132,6 +161,12 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
             "tau": flat(tau),
             "f": [flat(x) for x in f],
             "oMi": [se3(data.oMi[i]) for i in range(1, nj)],
+            "M": rows(M),
+            "nle": flat(nle),
+            "g": flat(g),
+            "Y": rows(Y),
+            "tau_fd": flat(tau_fd),
+            "ddq": flat(ddq),
         })
     tol = 1e-9
     bad = {k: x for k, x in worst.items() if not x < tol}
@@ -156,6 +191,12 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
             "parents": "Pinocchio parent joint index, 0 = universe; joint i is joint_names[i-1]",
             "placements": "jointPlacements[i]: frame of parent joint -> frame of joint i at q = 0",
             "motion_subspace": "S_i in frame of joint i, [lin; ang]; tau_i = S_i . f_i",
+            "M": "joint-space inertia matrix, pin.crba symmetrised, nv x nv, list of rows",
+            "nle": "pin.nonLinearEffects(q, v) = C(q, v) v + g(q); tau = M a + nle",
+            "g": "pin.computeGeneralizedGravity(q) = rnea(q, 0, 0)",
+            "Y": "pin.computeJointTorqueRegressor(q, v, a), nv x 10 n, list of rows; Y . concat(dyn_params) = tau",
+            "tau_fd": "forward-dynamics torque, uniform in [-10, 10]^nv, drawn after all samples' q, v, a",
+            "ddq": "pin.aba(q, v, tau_fd); M ddq + nle = tau_fd",
         },
         "model": {
             "joint_names": [model.names[i] for i in range(1, nj)],

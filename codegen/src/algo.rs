@@ -283,11 +283,10 @@ pub struct Motion<'g> {
 
 impl<'g> Force<'g> {
     pub fn zero(g: &'g Graph) -> Force<'g> {
-        Force { f: V3::zero(g), n: V3::zero(g) }
-    }
-
-    pub fn add(self, o: Force<'g>) -> Force<'g> {
-        Force { f: self.f + o.f, n: self.n + o.n }
+        Force {
+            f: V3::zero(g),
+            n: V3::zero(g),
+        }
     }
 
     /// Power with a motion: `f·v + n·ω`.
@@ -298,38 +297,72 @@ impl<'g> Force<'g> {
 
 impl<'g> Motion<'g> {
     pub fn zero(g: &'g Graph) -> Motion<'g> {
-        Motion { v: V3::zero(g), w: V3::zero(g) }
-    }
-
-    pub fn add(self, o: Motion<'g>) -> Motion<'g> {
-        Motion { v: self.v + o.v, w: self.w + o.w }
+        Motion {
+            v: V3::zero(g),
+            w: V3::zero(g),
+        }
     }
 
     pub fn scale(self, s: Expr<'g>) -> Motion<'g> {
-        Motion { v: self.v.scale(s), w: self.w.scale(s) }
+        Motion {
+            v: self.v.scale(s),
+            w: self.w.scale(s),
+        }
     }
 
     /// Motion cross product `self ×m m`.
     pub fn cross_motion(self, m: Motion<'g>) -> Motion<'g> {
-        Motion { v: self.w.cross(m.v) + self.v.cross(m.w), w: self.w.cross(m.w) }
+        Motion {
+            v: self.w.cross(m.v) + self.v.cross(m.w),
+            w: self.w.cross(m.w),
+        }
     }
 
     /// Force cross product `self ×* f`.
     pub fn cross_force(self, f: Force<'g>) -> Force<'g> {
-        Force { f: self.w.cross(f.f), n: self.w.cross(f.n) + self.v.cross(f.f) }
+        Force {
+            f: self.w.cross(f.f),
+            n: self.w.cross(f.n) + self.v.cross(f.f),
+        }
+    }
+}
+
+impl<'g> Add for Force<'g> {
+    type Output = Force<'g>;
+    fn add(self, o: Force<'g>) -> Force<'g> {
+        Force {
+            f: self.f + o.f,
+            n: self.n + o.n,
+        }
+    }
+}
+
+impl<'g> Add for Motion<'g> {
+    type Output = Motion<'g>;
+    fn add(self, o: Motion<'g>) -> Motion<'g> {
+        Motion {
+            v: self.v + o.v,
+            w: self.w + o.w,
+        }
     }
 }
 
 impl<'g> JointTransform<'g> {
     /// A parent-frame motion seen at the child origin in child axes.
     pub fn motion_to_child(&self, m: Motion<'g>) -> Motion<'g> {
-        Motion { v: self.to_child(m.v + m.w.cross(self.translation)), w: self.to_child(m.w) }
+        Motion {
+            v: self.to_child(m.v + m.w.cross(self.translation)),
+            w: self.to_child(m.w),
+        }
     }
 
     /// A child-frame force re-expressed in the parent frame, moment about its origin.
     pub fn force_to_parent(&self, f: Force<'g>) -> Force<'g> {
         let fp = self.to_parent(f.f);
-        Force { f: fp, n: self.to_parent(f.n) + self.translation.cross(fp) }
+        Force {
+            f: fp,
+            n: self.to_parent(f.n) + self.translation.cross(fp),
+        }
     }
 }
 
@@ -339,9 +372,15 @@ pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Motion<'g> {
     let joint = &model.joints[j - 1];
     let axis = V3::constant(g, joint.axis);
     if joint.kind.is_revolute() {
-        Motion { v: V3::zero(g), w: axis }
+        Motion {
+            v: V3::zero(g),
+            w: axis,
+        }
     } else {
-        Motion { v: axis, w: V3::zero(g) }
+        Motion {
+            v: axis,
+            w: V3::zero(g),
+        }
     }
 }
 
@@ -376,14 +415,26 @@ pub struct Kinematics<'g> {
 pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics<'g> {
     let n = model.dof();
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
-    let mut motion = vec![BodyMotion { w: V3::zero(g), wd: V3::zero(g), acc: V3::constant(g, model.gravity.map(|c| -c)) }];
+    let mut motion = vec![BodyMotion {
+        w: V3::zero(g),
+        wd: V3::zero(g),
+        acc: V3::constant(g, model.gravity.map(|c| -c)),
+    }];
     for j in 1..=n {
         let joint = &model.joints[j - 1];
         let p = joint.parent;
         let xj = &x[j - 1];
         let axis = V3::constant(g, joint.axis);
-        let qd = if inputs == Inputs::Static { g.zero() } else { g.input(ARG_V, (j - 1) as u32) };
-        let qdd = if inputs == Inputs::Full { g.input(ARG_A, (j - 1) as u32) } else { g.zero() };
+        let qd = if inputs == Inputs::Static {
+            g.zero()
+        } else {
+            g.input(ARG_V, (j - 1) as u32)
+        };
+        let qdd = if inputs == Inputs::Full {
+            g.input(ARG_A, (j - 1) as u32)
+        } else {
+            g.zero()
+        };
         let t = xj.translation;
         let mp = motion[p];
         // Acceleration of the joint-frame origin, still in parent axes.
@@ -393,11 +444,19 @@ pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics
         let a_in = xj.to_child(a_origin);
         let m = if joint.kind.is_revolute() {
             let wq = axis.scale(qd);
-            BodyMotion { w: w_in + wq, wd: wd_in + axis.scale(qdd) + w_in.cross(wq), acc: a_in }
+            BodyMotion {
+                w: w_in + wq,
+                wd: wd_in + axis.scale(qdd) + w_in.cross(wq),
+                acc: a_in,
+            }
         } else {
             let vq = axis.scale(qd);
             let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
-            BodyMotion { w: w_in, wd: wd_in, acc: a_in + two_w_vq + axis.scale(qdd) }
+            BodyMotion {
+                w: w_in,
+                wd: wd_in,
+                acc: a_in + two_w_vq + axis.scale(qdd),
+            }
         };
         motion.push(m);
     }
@@ -423,7 +482,7 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
     for j in (1..=n).rev() {
         let p = model.parent(j);
         if p > 0 {
-            f[p - 1] = f[p - 1].add(k.x[j - 1].force_to_parent(f[j - 1]));
+            f[p - 1] = f[p - 1] + k.x[j - 1].force_to_parent(f[j - 1]);
         }
     }
     let tau = (1..=n).map(|j| f[j - 1].dot(subspace(g, model, j))).collect();
@@ -478,8 +537,15 @@ pub fn standard_columns<'g>(g: &'g Graph) -> impl Fn(usize) -> Vec<BodyParams<'g
 
 /// Principal parameter columns of body `i`: the 4 columns of `P_i`.
 pub fn principal_columns<'g>(g: &'g Graph, model: &Model) -> impl Fn(usize) -> Vec<BodyParams<'g>> + 'g {
-    let ps: Vec<[[f64; 4]; 10]> = dyngen_model::principal_frames(model).iter().map(|f| f.p_matrix()).collect();
-    move |i| (0..4).map(|c| BodyParams::constant(g, ps[i - 1].map(|row| row[c]))).collect()
+    let ps: Vec<[[f64; 4]; 10]> = dyngen_model::principal_frames(model)
+        .iter()
+        .map(|f| f.p_matrix())
+        .collect();
+    move |i| {
+        (0..4)
+            .map(|c| BodyParams::constant(g, ps[i - 1].map(|row| row[c])))
+            .collect()
+    }
 }
 
 /// The joint wrench regressor (6n × 10n): rows `6(j−1)..6j` are joint `j`'s reaction
@@ -519,7 +585,11 @@ pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
         if p > 0 {
             let moved = composite_to_parent(&x[i - 1], &composite[i - 1]);
             let c = &mut composite[p - 1];
-            *c = BodyParams { m: c.m + moved.m, h: c.h + moved.h, inertia: c.inertia.add(&moved.inertia) };
+            *c = BodyParams {
+                m: c.m + moved.m,
+                h: c.h + moved.h,
+                inertia: c.inertia.add(&moved.inertia),
+            };
         }
     }
     let mut m = vec![vec![g.zero(); n]; n];
@@ -527,7 +597,10 @@ pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
         let si = subspace(g, model, i);
         let c = &composite[i - 1];
         // F = I_c S_i: the momentum of the composite body moving along S_i.
-        let mut f = Force { f: si.v.scale(c.m) + si.w.cross(c.h), n: c.inertia.mul_vec(si.w) + c.h.cross(si.v) };
+        let mut f = Force {
+            f: si.v.scale(c.m) + si.w.cross(c.h),
+            n: c.inertia.mul_vec(si.w) + c.h.cross(si.v),
+        };
         m[i - 1][i - 1] = f.dot(si);
         let mut j = i;
         while model.parent(j) != 0 {
@@ -555,7 +628,11 @@ fn composite_to_parent<'g>(x: &JointTransform<'g>, b: &BodyParams<'g>) -> BodyPa
             inertia[a][c] = inertia[c][a];
         }
     }
-    BodyParams { m: b.m, h: rh + p.scale(b.m), inertia: M3(inertia) }
+    BodyParams {
+        m: b.m,
+        h: rh + p.scale(b.m),
+        inertia: M3(inertia),
+    }
 }
 
 /// A spatial (articulated) inertia `[[M, H], [Hᵀ, J]]` acting on `(v, ω)`.
@@ -568,7 +645,11 @@ struct Inertia6<'g> {
 
 impl<'g> Inertia6<'g> {
     fn rigid(g: &'g Graph, b: &BodyParams<'g>) -> Inertia6<'g> {
-        Inertia6 { m: M3::diagonal(g, b.m), h: M3::skew(b.h).scale(g.constant(-1.0)), j: b.inertia }
+        Inertia6 {
+            m: M3::diagonal(g, b.m),
+            h: M3::skew(b.h).scale(g.constant(-1.0)),
+            j: b.inertia,
+        }
     }
 
     fn apply(&self, v: Motion<'g>) -> Force<'g> {
@@ -579,7 +660,11 @@ impl<'g> Inertia6<'g> {
     }
 
     fn add(&self, o: &Inertia6<'g>) -> Inertia6<'g> {
-        Inertia6 { m: self.m.add(&o.m), h: self.h.add(&o.h), j: self.j.add(&o.j) }
+        Inertia6 {
+            m: self.m.add(&o.m),
+            h: self.h.add(&o.h),
+            j: self.j.add(&o.j),
+        }
     }
 
     /// `self − U Uᵀ / D` with `inv_d = 1 / D`.
@@ -603,7 +688,7 @@ impl<'g> Inertia6<'g> {
 
     /// The same inertia seen from the parent frame: rotate every block, then shift
     /// the reference point: `H' = H − M S(p)`, `J' = J − Hᵀ S(p) + S(p) H − S(p) M S(p)`.
-    fn to_parent(&self, x: &JointTransform<'g>) -> Inertia6<'g> {
+    fn in_parent(&self, x: &JointTransform<'g>) -> Inertia6<'g> {
         let r = |m: &M3<'g>, sym: bool| {
             if sym {
                 m.rotate_sym(&x.motion).rotate_sym(&x.origin)
@@ -614,7 +699,10 @@ impl<'g> Inertia6<'g> {
         let (m, h, j) = (r(&self.m, true), r(&self.h, false), r(&self.j, true));
         let sp = M3::skew(x.translation);
         let h2 = h.sub(&m.mul(&sp));
-        let j2 = j.sub(&h.transpose().mul(&sp)).add(&sp.mul(&h)).sub(&sp.mul(&m).mul(&sp));
+        let j2 = j
+            .sub(&h.transpose().mul(&sp))
+            .add(&sp.mul(&h))
+            .sub(&sp.mul(&m).mul(&sp));
         let mut ja = j2.0;
         for a in 0..3 {
             for c in 0..a {
@@ -634,12 +722,16 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     // Pass 1: velocities, velocity-product accelerations, bias forces.
     let mut v = vec![Motion::zero(g)];
     let mut c = vec![Motion::zero(g)];
-    let mut ia = vec![Inertia6 { m: M3::zero(g), h: M3::zero(g), j: M3::zero(g) }];
+    let mut ia = vec![Inertia6 {
+        m: M3::zero(g),
+        h: M3::zero(g),
+        j: M3::zero(g),
+    }];
     let mut pa = vec![Force::zero(g)];
     for i in 1..=n {
         let p = model.parent(i);
         let vj = s[i - 1].scale(g.input(ARG_V, (i - 1) as u32));
-        let vi = x[i - 1].motion_to_child(v[p]).add(vj);
+        let vi = x[i - 1].motion_to_child(v[p]) + vj;
         let inertia = Inertia6::rigid(g, &BodyParams::input(g, i));
         pa.push(vi.cross_force(inertia.apply(vi)));
         c.push(vi.cross_motion(vj));
@@ -659,22 +751,30 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
         let p = model.parent(i);
         if p > 0 {
             let a_ia = ia[i].minus_outer(&ui, id);
-            let a_pa = pa[i].add(a_ia.apply(c[i])).add(Force { f: ui.f.scale(ui_scalar * id), n: ui.n.scale(ui_scalar * id) });
-            ia[p] = ia[p].add(&a_ia.to_parent(&x[i - 1]));
-            pa[p] = pa[p].add(x[i - 1].force_to_parent(a_pa));
+            let a_pa = pa[i]
+                + a_ia.apply(c[i])
+                + Force {
+                    f: ui.f.scale(ui_scalar * id),
+                    n: ui.n.scale(ui_scalar * id),
+                };
+            ia[p] = ia[p].add(&a_ia.in_parent(&x[i - 1]));
+            pa[p] = pa[p] + x[i - 1].force_to_parent(a_pa);
         }
         u_vec[i] = ui;
         inv_d[i] = id;
         u[i] = ui_scalar;
     }
     // Pass 3: accelerations, root first; the base accelerates at −g.
-    let mut acc = vec![Motion { v: V3::constant(g, model.gravity.map(|x| -x)), w: V3::zero(g) }];
+    let mut acc = vec![Motion {
+        v: V3::constant(g, model.gravity.map(|x| -x)),
+        w: V3::zero(g),
+    }];
     let mut qdd = Vec::with_capacity(n);
     for i in 1..=n {
         let p = model.parent(i);
-        let a_prime = x[i - 1].motion_to_child(acc[p]).add(c[i]);
+        let a_prime = x[i - 1].motion_to_child(acc[p]) + c[i];
         let qi = (u[i] - u_vec[i].dot(a_prime)) * inv_d[i];
-        acc.push(a_prime.add(s[i - 1].scale(qi)));
+        acc.push(a_prime + s[i - 1].scale(qi));
         qdd.push(qi);
     }
     qdd
@@ -730,7 +830,11 @@ pub fn body_resultants<'g>(g: &'g Graph, model: &Model) -> Vec<Force<'g>> {
                 }
                 // Joint a's wrench in body i's axes: its own frame is body a's.
                 let w = r.wrenches[a - 1];
-                let (fa, ma) = if a == i { (w.f, w.n) } else { (x[a - 1].to_parent(w.f), x[a - 1].to_parent(w.n)) };
+                let (fa, ma) = if a == i {
+                    (w.f, w.n)
+                } else {
+                    (x[a - 1].to_parent(w.f), x[a - 1].to_parent(w.n))
+                };
                 // c_ia is constant, except that a prismatic joint's point slides along
                 // the inboard body with q: use where its frame origin is now.
                 let cia = if a != i && model.joints[a - 1].kind == dyngen_model::JointKind::Prismatic {
@@ -739,10 +843,17 @@ pub fn body_resultants<'g>(g: &'g Graph, model: &Model) -> Vec<Force<'g>> {
                     V3::constant(g, c[i][a - 1])
                 };
                 let sg = g.constant(f64::from(sign));
-                total = total.add(Force { f: fa.scale(sg), n: (ma + cia.cross(fa)).scale(sg) });
+                total = total
+                    + Force {
+                        f: fa.scale(sg),
+                        n: (ma + cia.cross(fa)).scale(sg),
+                    };
             }
             let rot = M3::constant(g, frames[i - 1].rotation);
-            Force { f: rot.tr_mul_vec(total.f), n: rot.tr_mul_vec(total.n) }
+            Force {
+                f: rot.tr_mul_vec(total.f),
+                n: rot.tr_mul_vec(total.n),
+            }
         })
         .collect()
 }

@@ -53,8 +53,14 @@ pub fn analyse(
             .joints
             .iter()
             .map(|j| {
-                let reach = if j.kind.is_revolute() { std::f64::consts::PI } else { 0.5 };
-                let (lo, hi) = j.limits.map_or((-reach, reach), |l| (l.lower.max(-reach), l.upper.min(reach)));
+                let reach = if j.kind.is_revolute() {
+                    std::f64::consts::PI
+                } else {
+                    0.5
+                };
+                let (lo, hi) = j
+                    .limits
+                    .map_or((-reach, reach), |l| (l.lower.max(-reach), l.upper.min(reach)));
                 rng.uniform(lo, hi)
             })
             .collect();
@@ -89,7 +95,12 @@ pub fn analyse(
         })
         .collect();
     let groupings = k.iter().map(|kr| grouping(kr, names)).collect();
-    BaseParams { independent, k, groupings, confirmed: true }
+    BaseParams {
+        independent,
+        k,
+        groupings,
+        confirmed: true,
+    }
 }
 
 /// Rounds away the noise of the factorisation: |x| < 1e-10 → 0, and values within
@@ -112,7 +123,11 @@ fn grouping(kr: &[f64], names: &[String]) -> String {
         }
         let sign = if x < 0.0 { "−" } else { "+" };
         let mag = x.abs();
-        let term = if mag == 1.0 { names[c].clone() } else { format!("{}·{}", format_coef(mag), names[c]) };
+        let term = if mag == 1.0 {
+            names[c].clone()
+        } else {
+            format!("{}·{}", format_coef(mag), names[c])
+        };
         if s.is_empty() {
             s = if x < 0.0 { format!("−{term}") } else { term };
         } else {
@@ -133,7 +148,9 @@ fn format_coef(x: f64) -> String {
 /// set aside, each in parameter order), `R` in that order (rows, p wide) and the rank.
 fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
     let m = a.len();
-    let original: Vec<f64> = (0..p).map(|c| a.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt()).collect();
+    let original: Vec<f64> = (0..p)
+        .map(|c| a.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt())
+        .collect();
     let mut kept = Vec::new();
     let mut dropped = Vec::new();
     let mut k = 0;

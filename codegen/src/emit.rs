@@ -28,10 +28,21 @@ pub struct FnSpec<'a> {
     pub doc: String,
     /// Arguments in signature order.
     pub args: Vec<Arg>,
+    /// The return type; or, for `Output::InPlace`, the type `out` points to.
     pub ret: TokenStream,
+    /// Whether the value is returned or written through a final `out: &mut` argument
+    /// (large matrices: no copy of the result).
+    pub output: Output,
     pub outputs: Vec<NodeId>,
     /// Builds the returned value from one expression per output.
     pub assemble: Assemble<'a>,
+}
+
+/// How an emitted function hands back its result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    Return,
+    InPlace,
 }
 
 /// What was emitted for one function, for reports and docs.
@@ -56,6 +67,10 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let fname = format_ident!("{}", spec.name);
     let doc = spec.doc.lines();
     let ret = &spec.ret;
+    let (out_param, ret_ty) = match spec.output {
+        Output::Return => (None, quote!(-> #ret)),
+        Output::InPlace => (Some(quote!(out: &mut #ret)), quote!()),
+    };
     let params: Vec<TokenStream> = spec
         .args
         .iter()
@@ -99,7 +114,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             #[doc = ""]
             #[doc = #op_doc]
             #[inline]
-            pub fn #fname<S: ::dyngen::Scalar>(#(#params),*) -> #ret {
+            pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
                 #(#body)*
                 #value
             }
@@ -198,7 +213,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         #(#[doc = #doc])*
         #[doc = ""]
         #[doc = #op_doc]
-        pub fn #fname<S: ::dyngen::Scalar>(#(#params),*) -> #ret {
+        pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
             let mut w = [<S as ::dyngen::Scalar>::ZERO; #width];
             #(#calls)*
             #value
@@ -273,7 +288,11 @@ impl Names<'_> {
         match graph.node(id) {
             Node::Const(bits) => constant(f64::from_bits(bits)),
             Node::Input { arg, index } => {
-                let name = self.args.iter().find(|a| a.id == arg).map_or("missing_argument", |a| a.name);
+                let name = self
+                    .args
+                    .iter()
+                    .find(|a| a.id == arg)
+                    .map_or("missing_argument", |a| a.name);
                 let a = format_ident!("{}", name);
                 let i = usize_lit(index as usize);
                 quote!(#a[#i])

@@ -3,7 +3,7 @@
 
 use crate::algo::{self, Force, Inputs, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
 use crate::base::{self, BaseParams};
-use crate::emit::{self, Arg, Assemble, FnReport, FnSpec};
+use crate::emit::{self, Arg, Assemble, FnReport, FnSpec, Output};
 use crate::sym::{Expr, Graph, NodeId};
 use dyngen_model::Model;
 use proc_macro2::TokenStream;
@@ -18,7 +18,9 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { max_statements: emit::DEFAULT_MAX_STATEMENTS }
+        Options {
+            max_statements: emit::DEFAULT_MAX_STATEMENTS,
+        }
     }
 }
 
@@ -63,7 +65,11 @@ impl Generated {
                 f.ops.negs,
                 f.ops.trig,
                 f.statements,
-                if f.parts > 1 { format!(" in {} parts", f.parts) } else { String::new() }
+                if f.parts > 1 {
+                    format!(" in {} parts", f.parts)
+                } else {
+                    String::new()
+                }
             ));
         }
         s
@@ -78,17 +84,23 @@ pub fn is_type_name(name: &str) -> bool {
 /// Names of the standard parameters, `m1, mx1, …, Izz1, m2, …`.
 pub fn standard_param_names(n: usize) -> Vec<String> {
     const NAMES: [&str; 10] = ["m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"];
-    (1..=n).flat_map(|i| NAMES.iter().map(move |s| format!("{s}{i}"))).collect()
+    (1..=n)
+        .flat_map(|i| NAMES.iter().map(move |s| format!("{s}{i}")))
+        .collect()
 }
 
 /// Names of the principal parameters, `m1, J1_1, J2_1, J3_1, m2, …`.
 pub fn principal_param_names(n: usize) -> Vec<String> {
-    (1..=n).flat_map(|i| [format!("m{i}"), format!("J1_{i}"), format!("J2_{i}"), format!("J3_{i}")]).collect()
+    (1..=n)
+        .flat_map(|i| [format!("m{i}"), format!("J1_{i}"), format!("J2_{i}"), format!("J3_{i}")])
+        .collect()
 }
 
 /// A regressor as output nodes, structural zeros as the constant 0.
 fn matrix_ids<'g>(g: &'g Graph, y: &[Vec<Option<Expr<'g>>>]) -> Vec<NodeId> {
-    y.iter().flat_map(|row| row.iter().map(|e| e.unwrap_or_else(|| g.zero()).id())).collect()
+    y.iter()
+        .flat_map(|row| row.iter().map(|e| e.unwrap_or_else(|| g.zero()).id()))
+        .collect()
 }
 
 /// Evaluates a symbolic regressor numerically at `(q, v, a)`.
@@ -115,10 +127,14 @@ fn base_params(model: &Model, names: &[String], g: &Graph, ids: &[NodeId]) -> Ba
     first
 }
 
+/// Writes a matrix entry by entry into `out`.
 fn rows_of(cols: usize) -> Assemble<'static> {
     Box::new(move |outs| {
-        let rows = outs.chunks(cols).map(|r| quote!([#(#r),*]));
-        quote!([#(#rows),*])
+        let stores = outs.iter().enumerate().map(|(k, x)| {
+            let (r, c) = (emit::usize_lit(k / cols), emit::usize_lit(k % cols));
+            quote!(out[#r][#c] = #x;)
+        });
+        quote!(#(#stores)*)
     })
 }
 
@@ -140,7 +156,10 @@ fn wrenches_of() -> Assemble<'static> {
 }
 
 fn force_ids(forces: &[Force<'_>]) -> Vec<NodeId> {
-    forces.iter().flat_map(|w| w.f.0.iter().chain(w.n.0.iter()).map(|e| e.id())).collect()
+    forces
+        .iter()
+        .flat_map(|w| w.f.0.iter().chain(w.n.0.iter()).map(|e| e.id()))
+        .collect()
 }
 
 /// Collects emitted functions.
@@ -166,11 +185,27 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
     let nt = 4 * n;
     let (n_lit, np_lit, nt_lit) = (emit::usize_lit(n), emit::usize_lit(np), emit::usize_lit(nt));
     let ty = format_ident!("{}", name);
-    let arg = |id: u8, name: &'static str| Arg { id, name, len: if id == ARG_PARAMS { np } else { n } };
+    let arg = |id: u8, name: &'static str| Arg {
+        id,
+        name,
+        len: if id == ARG_PARAMS { np } else { n },
+    };
     let qva = || vec![arg(ARG_Q, "q"), arg(ARG_V, "v"), arg(ARG_A, "a")];
-    let qvap = || vec![arg(ARG_Q, "q"), arg(ARG_V, "v"), arg(ARG_A, "a"), arg(ARG_PARAMS, "params")];
-    let mut e = Emitter { max_statements: options.max_statements, functions: Vec::new(), items: Vec::new() };
-    let params_doc = format!("`params`: {np} standard parameters, 10 per body (`Self::NOMINAL_PARAMS` for the description's)");
+    let qvap = || {
+        vec![
+            arg(ARG_Q, "q"),
+            arg(ARG_V, "v"),
+            arg(ARG_A, "a"),
+            arg(ARG_PARAMS, "params"),
+        ]
+    };
+    let mut e = Emitter {
+        max_statements: options.max_statements,
+        functions: Vec::new(),
+        items: Vec::new(),
+    };
+    let params_doc =
+        format!("`params`: {np} standard parameters, 10 per body (`Self::NOMINAL_PARAMS` for the description's)");
     let state_doc = format!("`q, v, a`: {n} joint positions (rad or m), velocities, accelerations");
 
     // Inverse dynamics and its special cases.
@@ -197,13 +232,16 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
         let g = Graph::new();
         let r = algo::rnea(&g, model, inputs);
         let outputs = r.tau.iter().map(|x| x.id()).collect();
-        e.emit(&g, FnSpec { name: fname, doc, args, ret: quote!([S; #n_lit]), outputs, assemble: vector() });
+        e.emit(&g, FnSpec { name: fname, doc, args, ret: quote!([S; #n_lit]), output: Output::Return, outputs, assemble: vector() });
     }
 
     {
         let g = Graph::new();
         let poses = algo::forward_kinematics(&g, model);
-        let outputs = poses.iter().flat_map(|(r, t)| r.0.iter().flatten().chain(t.0.iter()).map(|x| x.id())).collect();
+        let outputs = poses
+            .iter()
+            .flat_map(|(r, t)| r.0.iter().flatten().chain(t.0.iter()).map(|x| x.id()))
+            .collect();
         e.emit(
             &g,
             FnSpec {
@@ -211,6 +249,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Every body's pose in the base frame, body 1 first: `x_base = rotation · x_body +\n translation`. `q`: {n} joint positions."),
                 args: vec![arg(ARG_Q, "q")],
                 ret: quote!([::dyngen::Pose<S>; #n_lit]),
+                output: Output::Return,
                 outputs,
                 assemble: Box::new(|outs| {
                     let poses = outs.chunks(12).map(|c| {
@@ -236,6 +275,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The reaction wrench each joint applies to its outboard body: for joint `j`, the\n force (N) and the moment (N·m) about the joint-frame origin, in body `j`'s frame\n (Pinocchio's `data.f[j]` after `rnea`). Arguments as for [`Self::rnea`]; returns {n}\n wrenches, joint 1 first."),
                 args: qvap(),
                 ret: quote!([::dyngen::Wrench<S>; #n_lit]),
+                output: Output::Return,
                 outputs: force_ids(&r.wrenches),
                 assemble: wrenches_of(),
             },
@@ -252,6 +292,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The joint-space inertia matrix `M(q)` ({n} × {n}, symmetric positive definite) by the\n composite-rigid-body algorithm; entries of joints on different branches are not\n computed. {params_doc}."),
                 args: vec![arg(ARG_Q, "q"), arg(ARG_PARAMS, "params")],
                 ret: quote!([[S; #n_lit]; #n_lit]),
+                output: Output::InPlace,
                 outputs: m.iter().flatten().map(|x| x.id()).collect(),
                 assemble: rows_of(n),
             },
@@ -268,6 +309,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Forward dynamics, `a = M(q)⁻¹ (tau − h(q, v))`, by the articulated-body algorithm.\n `q, v, tau`: {n} positions, velocities, joint torques or forces; {params_doc}.\n Returns the {n} joint accelerations; `aba(q, v, rnea(q, v, a)) = a`."),
                 args: vec![arg(ARG_Q, "q"), arg(ARG_V, "v"), arg(ARG_A, "tau"), arg(ARG_PARAMS, "params")],
                 ret: quote!([S; #n_lit]),
+                output: Output::Return,
                 outputs: qdd.iter().map(|x| x.id()).collect(),
                 assemble: vector(),
             },
@@ -291,13 +333,17 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The joint torque regressor `Y(q, v, a)` ({n} × {np}): `tau = Y · params` for any\n standard parameters. Blocks of joints that do not support a body are structural\n zeros, never computed. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #np_lit]; #n_lit]),
+                output: Output::InPlace,
                 outputs: ids,
                 assemble: rows_of(np),
             },
         );
         let b = base.count();
         let b_lit = emit::usize_lit(b);
-        let cols: Vec<Vec<Option<Expr<'_>>>> = y.iter().map(|row| base.independent.iter().map(|&c| row[c]).collect()).collect();
+        let cols: Vec<Vec<Option<Expr<'_>>>> = y
+            .iter()
+            .map(|row| base.independent.iter().map(|&c| row[c]).collect())
+            .collect();
         e.emit(
             &g,
             FnSpec {
@@ -305,6 +351,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The base regressor `Y_b(q, v, a)` ({n} × {b}): `tau = Y_b · β` with `β = K · params`\n (`Self::base_params`), the {b} identifiable combinations listed in\n `Self::BASE_GROUPINGS`. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #b_lit]; #n_lit]),
+                output: Output::InPlace,
                 outputs: matrix_ids(&g, &cols),
                 assemble: rows_of(b),
             },
@@ -322,14 +369,17 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The regressor in the paper's parameters ({n} × {nt}): `tau = Y_θ · theta` with\n `theta = (m, J1, J2, J3)` per body, each body's centre of mass and principal axes\n fixed by the description (`Self::NOMINAL_THETA` for its values). {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #nt_lit]; #n_lit]),
+                output: Output::InPlace,
                 outputs: ids,
                 assemble: rows_of(nt),
             },
         );
         let b = principal_base.count();
         let b_lit = emit::usize_lit(b);
-        let cols: Vec<Vec<Option<Expr<'_>>>> =
-            y.iter().map(|row| principal_base.independent.iter().map(|&c| row[c]).collect()).collect();
+        let cols: Vec<Vec<Option<Expr<'_>>>> = y
+            .iter()
+            .map(|row| principal_base.independent.iter().map(|&c| row[c]).collect())
+            .collect();
         e.emit(
             &g,
             FnSpec {
@@ -337,6 +387,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The base regressor of the principal parameterisation ({n} × {b}): `tau = Y · β_θ`\n with `β_θ = K_θ · theta` (`Self::principal_base_params`), groupings in\n `Self::PRINCIPAL_BASE_GROUPINGS`. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #b_lit]; #n_lit]),
+                output: Output::InPlace,
                 outputs: matrix_ids(&g, &cols),
                 assemble: rows_of(b),
             },
@@ -353,6 +404,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Every joint's full reaction wrench as a linear function of the parameters\n ({} × {np}): rows `6(j−1)..6j` are `[force; moment]` of joint `j`, as\n [`Self::joint_wrenches`] gives them, equal to this matrix times `params`. {state_doc}.", 6 * n),
                 args: qva(),
                 ret: quote!([[S; #np_lit]; #n6]),
+                output: Output::InPlace,
                 outputs: matrix_ids(&g, &y),
                 assemble: rows_of(np),
             },
@@ -368,6 +420,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The paper's decoupled model, per body: `A_i` with `[F_i; M_i] = A_i θ_i` in the\n body's centroidal principal frame, `A_i = blkdiag(a_c − g, B(ω, ω̇))` (DESIGN §5).\n {state_doc}."),
                 args: qva(),
                 ret: quote!([::dyngen::BodyRegressor<S>; #n_lit]),
+                output: Output::Return,
                 outputs: a.iter().flat_map(|m| m.iter().flatten().map(|x| x.id())).collect(),
                 assemble: Box::new(|outs| {
                     let bodies = outs.chunks(24).map(|c| {
@@ -392,35 +445,46 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Each body's resultant of the joint reaction wrenches, through the incidence\n matrix and body-joint vectors: `F_i = Σ_a S_ia F_a`, `M_i = Σ_a S_ia (M_a + c_ia × F_a)`;\n force and moment about the centre of mass, in the centroidal principal frame.\n With the description's parameters, `body_regressors(q, v, a)[i] · θ_i` equals it.\n {state_doc}; {params_doc}."),
                 args: qvap(),
                 ret: quote!([::dyngen::Wrench<S>; #n_lit]),
+                output: Output::Return,
                 outputs: force_ids(&r),
                 assemble: wrenches_of(),
             },
         );
     }
     // β = K π and β_θ = K_θ θ as straight-line code.
-    for (fname, bp, cols, argname) in
-        [("base_params", &base, np, "params"), ("principal_base_params", &principal_base, nt, "theta")]
-    {
+    for (fname, bp, cols, argname) in [
+        ("base_params", &base, np, "params"),
+        ("principal_base_params", &principal_base, nt, "theta"),
+    ] {
         let g = Graph::new();
-        let outs: Vec<NodeId> = bp
-            .k
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .enumerate()
-                    .filter(|(_, &x)| x != 0.0)
-                    .fold(g.zero(), |acc, (c, &x)| acc + g.constant(x) * g.input(ARG_PARAMS, c as u32))
-                    .id()
-            })
-            .collect();
+        let outs: Vec<NodeId> =
+            bp.k.iter()
+                .map(|row| {
+                    row.iter()
+                        .enumerate()
+                        .filter(|(_, &x)| x != 0.0)
+                        .fold(g.zero(), |acc, (c, &x)| {
+                            acc + g.constant(x) * g.input(ARG_PARAMS, c as u32)
+                        })
+                        .id()
+                })
+                .collect();
         let b_lit = emit::usize_lit(bp.count());
         e.emit(
             &g,
             FnSpec {
                 name: fname,
-                doc: format!(" The {} base parameters of `{argname}` ({cols} values): `β = K · {argname}`.", bp.count()),
-                args: vec![Arg { id: ARG_PARAMS, name: argname, len: cols }],
+                doc: format!(
+                    " The {} base parameters of `{argname}` ({cols} values): `β = K · {argname}`.",
+                    bp.count()
+                ),
+                args: vec![Arg {
+                    id: ARG_PARAMS,
+                    name: argname,
+                    len: cols,
+                }],
                 ret: quote!([S; #b_lit]),
+                output: Output::Return,
                 outputs: outs,
                 assemble: vector(),
             },
@@ -428,7 +492,13 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
     }
 
     let tokens = robot_type(model, &ty, &e, &base, &principal_base);
-    Generated { tokens, functions: e.functions, items: e.items, base, principal_base }
+    Generated {
+        tokens,
+        functions: e.functions,
+        items: e.items,
+        base,
+        principal_base,
+    }
 }
 
 /// The type, its constants, its functions and its `Robot` impl.
@@ -452,6 +522,7 @@ fn robot_type(model: &Model, ty: &syn::Ident, e: &Emitter, base: &BaseParams, pb
     let nf = emit::usize_lit(e.functions.len());
     let items = e.items.iter().map(|(_, t)| t);
     let (nb, nbt) = (base.count(), pbase.count());
+    let n6_lit = emit::usize_lit(6 * n);
     let (nb_lit, nbt_lit) = (emit::usize_lit(nb), emit::usize_lit(nbt));
     let groupings = &base.groupings;
     let pgroupings = &pbase.groupings;
@@ -460,8 +531,18 @@ fn robot_type(model: &Model, ty: &syn::Ident, e: &Emitter, base: &BaseParams, pb
     let base_k = base.k.iter().flatten().map(|&x| emit::f64_lit(x));
     let pbase_k = pbase.k.iter().flatten().map(|&x| emit::f64_lit(x));
     let (nbk, nbtk) = (emit::usize_lit(nb * 10 * n), emit::usize_lit(nbt * 4 * n));
-    let group_doc: String = base.groupings.iter().enumerate().map(|(k, s)| format!("\n {}. `{s}`", k + 1)).collect();
-    let pgroup_doc: String = pbase.groupings.iter().enumerate().map(|(k, s)| format!("\n {}. `{s}`", k + 1)).collect();
+    let group_doc: String = base
+        .groupings
+        .iter()
+        .enumerate()
+        .map(|(k, s)| format!("\n {}. `{s}`", k + 1))
+        .collect();
+    let pgroup_doc: String = pbase
+        .groupings
+        .iter()
+        .enumerate()
+        .map(|(k, s)| format!("\n {}. `{s}`", k + 1))
+        .collect();
     let base_doc = format!(" The {nb} base parameters of the standard parameterisation (rank of the stacked\n regressor, pivoted QR, relative tolerance {:e}):\n{group_doc}", base::RANK_TOLERANCE);
     let pbase_doc = format!(" The {nbt} base parameters of the principal parameterisation:\n{pgroup_doc}");
     let doc = format!(
@@ -574,8 +655,8 @@ fn robot_type(model: &Model, ty: &syn::Ident, e: &Emitter, base: &BaseParams, pb
                 );
             }
             fn crba<S: ::dyngen::Scalar>(q: &[S], params: &[S], m: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::crba(as_array(q, "q"), as_array(params, "params")), m, "m");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::crba(as_array(q, "q"), as_array(params, "params"), as_rows_mut::<S, #n_lit, #n_lit>(m, "m"));
             }
             fn forward_kinematics<S: ::dyngen::Scalar>(q: &[S], poses: &mut [::dyngen::Pose<S>]) {
                 use ::dyngen::__private::{as_array, as_array_mut};
@@ -588,24 +669,24 @@ fn robot_type(model: &Model, ty: &syn::Ident, e: &Emitter, base: &BaseParams, pb
                 );
             }
             fn joint_torque_regressor<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::joint_torque_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a")), y, "y");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::joint_torque_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_rows_mut::<S, #np_lit, #n_lit>(y, "y"));
             }
             fn joint_wrench_regressor<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::joint_wrench_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a")), y, "y");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::joint_wrench_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_rows_mut::<S, #np_lit, #n6_lit>(y, "y"));
             }
             fn principal_regressor<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::principal_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a")), y, "y");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::principal_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_rows_mut::<S, #nt_lit, #n_lit>(y, "y"));
             }
             fn base_regressor<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::base_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a")), y, "y");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::base_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_rows_mut::<S, #nb_lit, #n_lit>(y, "y"));
             }
             fn principal_base_regressor<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]) {
-                use ::dyngen::__private::{as_array, copy_rows};
-                copy_rows(&<#ty>::principal_base_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a")), y, "y");
+                use ::dyngen::__private::{as_array, as_rows_mut};
+                <#ty>::principal_base_regressor(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_rows_mut::<S, #nbt_lit, #n_lit>(y, "y"));
             }
             fn body_regressors<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], out: &mut [::dyngen::BodyRegressor<S>]) {
                 use ::dyngen::__private::{as_array, as_array_mut};

@@ -250,6 +250,14 @@ impl<'g> Sub for Expr<'g> {
             // −a − b = −(a + b)
             return -(a + rhs);
         }
+        // b − a is built as −(a − b), so both share one node.
+        if self.id > rhs.id {
+            let mirrored = g.index.borrow().get(&Node::Sub(rhs.id, self.id)).copied();
+            if let Some(id) = mirrored {
+                // Interned directly: `Neg` itself would flip the subtraction back.
+                return g.intern(Node::Neg(id));
+            }
+        }
         g.intern(Node::Sub(self.id, rhs.id))
     }
 }

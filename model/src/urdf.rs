@@ -103,7 +103,7 @@ fn read(text: &str) -> Result<(Description, Option<usize>), Vec<ModelError>> {
             let source = outline.joint(k, &joint.name);
             let kind = convert_type(&joint.joint_type);
             // urdf-rs fills a missing <limit> with zeros, which would lock the joint.
-            let has_limit = source.map_or(true, |s| s.has_child("limit"));
+            let has_limit = source.is_none_or(|s| s.has_child("limit"));
             let limits = match kind {
                 DeclaredJointType::Moving(JointKind::Revolute | JointKind::Prismatic) if has_limit => Some(Limits {
                     lower: joint.limit.lower,

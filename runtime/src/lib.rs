@@ -32,15 +32,16 @@ pub mod __private {
         }
     }
 
-    /// Copies a matrix given as rows into a row-major slice of the same size.
+    /// A row-major slice as a fixed-size matrix `[[S; C]; R]`, with a message naming
+    /// the argument when the length is wrong.
     #[inline(always)]
     #[track_caller]
-    pub fn copy_rows<S: Copy, const R: usize, const C: usize>(rows: &[[S; C]; R], out: &mut [S], what: &str) {
-        if out.len() != R * C {
-            panic!("dyngen: `{what}` has length {}, expected {} ({R} × {C})", out.len(), R * C);
-        }
-        for (dst, src) in out.chunks_exact_mut(C).zip(rows) {
-            dst.copy_from_slice(src);
+    pub fn as_rows_mut<'a, S, const C: usize, const R: usize>(x: &'a mut [S], what: &str) -> &'a mut [[S; C]; R] {
+        let len = x.len();
+        let (rows, rest) = x.as_chunks_mut::<C>();
+        match (rest.is_empty(), <&mut [[S; C]; R]>::try_from(rows)) {
+            (true, Ok(m)) => m,
+            _ => panic!("dyngen: `{what}` has length {len}, expected {} ({R} × {C})", R * C),
         }
     }
 

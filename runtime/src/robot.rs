@@ -49,7 +49,10 @@ pub struct BodyRegressor<S: Scalar> {
 
 impl<S: Scalar> Default for BodyRegressor<S> {
     fn default() -> Self {
-        BodyRegressor { force: SMatrix::from_element(S::ZERO), moment: SMatrix::from_element(S::ZERO) }
+        BodyRegressor {
+            force: SMatrix::from_element(S::ZERO),
+            moment: SMatrix::from_element(S::ZERO),
+        }
     }
 }
 

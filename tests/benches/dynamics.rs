@@ -67,6 +67,53 @@ fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
             black_box(&wrenches);
         })
     });
+    let mut y = vec![0.0; R::NV * R::NPARAMS];
+    group.bench_function("joint_torque_regressor/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::joint_torque_regressor(black_box(&s.q), black_box(&s.v), black_box(&s.a), &mut y);
+            black_box(&y);
+        })
+    });
+    let mut yb = vec![0.0; R::NV * R::NBASE];
+    group.bench_function("base_regressor/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::base_regressor(black_box(&s.q), black_box(&s.v), black_box(&s.a), &mut yb);
+            black_box(&yb);
+        })
+    });
+    let mut m = vec![0.0; R::NV * R::NV];
+    group.bench_function("crba/generated", |b| {
+        b.iter(|| {
+            let s = &states[k % states.len()];
+            k += 1;
+            R::crba(black_box(&s.q), black_box(&params), &mut m);
+            black_box(&m);
+        })
+    });
+    let taus: Vec<Vec<f64>> = states
+        .iter()
+        .map(|s| reference.rnea(&s.q, &s.v, &s.a, &params))
+        .collect();
+    let mut acc = vec![0.0; R::NV];
+    group.bench_function("aba/generated", |b| {
+        b.iter(|| {
+            let i = k % states.len();
+            k += 1;
+            let s = &states[i];
+            R::aba(
+                black_box(&s.q),
+                black_box(&s.v),
+                black_box(&taus[i]),
+                black_box(&params),
+                &mut acc,
+            );
+            black_box(&acc);
+        })
+    });
     group.finish();
 }
 

@@ -17,7 +17,9 @@ const STATES: usize = 200;
 const TOL: f64 = 1e-9;
 
 fn mat_vec(m: &[f64], cols: usize, x: &[f64]) -> Vec<f64> {
-    m.chunks(cols).map(|row| row.iter().zip(x).map(|(a, b)| a * b).sum()).collect()
+    m.chunks(cols)
+        .map(|row| row.iter().zip(x).map(|(a, b)| a * b).sum())
+        .collect()
 }
 
 /// Cholesky without pivoting: `None` unless symmetric positive definite.
@@ -49,7 +51,11 @@ fn check<R: Robot>(seed: u64) {
     let (n, np, nt) = (R::NV, R::NPARAMS, R::NTHETA);
     let zeros = vec![0.0; n];
     for (k, s) in sample_states(&model, STATES, seed).iter().enumerate() {
-        let params = if k % 2 == 0 { R::nominal_params().to_vec() } else { perturbed_params(&model, seed + k as u64, 0.3) };
+        let params = if k % 2 == 0 {
+            R::nominal_params().to_vec()
+        } else {
+            perturbed_params(&model, seed + k as u64, 0.3)
+        };
         let mut tau = vec![0.0; n];
         R::rnea(&s.q, &s.v, &s.a, &params, &mut tau);
 
@@ -71,11 +77,19 @@ fn check<R: Robot>(seed: u64) {
         R::joint_wrenches(&s.q, &s.v, &s.a, &params, &mut w);
         let want: Vec<f64> = w.iter().flat_map(wrench_vec).collect();
         let e = rel_err(&mat_vec(&yw, np, &params), &want, 1e-9);
-        assert!(e < TOL, "{}: wrench regressor · π ≠ joint wrenches at state {k}: {e:e}", R::NAME);
+        assert!(
+            e < TOL,
+            "{}: wrench regressor · π ≠ joint wrenches at state {k}: {e:e}",
+            R::NAME
+        );
 
         let mut m = vec![0.0; n * n];
         R::crba(&s.q, &params, &mut m);
-        assert!(is_spd(&m, n), "{}: M not symmetric positive definite at state {k}", R::NAME);
+        assert!(
+            is_spd(&m, n),
+            "{}: M not symmetric positive definite at state {k}",
+            R::NAME
+        );
         let mut h = vec![0.0; n];
         R::nonlinear_effects(&s.q, &s.v, &params, &mut h);
         let mut h_ref = vec![0.0; n];
@@ -117,12 +131,26 @@ fn check<R: Robot>(seed: u64) {
         R::body_resultants(&s.q, &s.v, &s.a, R::nominal_params(), &mut res);
         for b in 0..n {
             let th = nalgebra::Vector4::from_column_slice(&theta[4 * b..4 * b + 4]);
-            let got: Vec<f64> = (a_i[b].force * th).iter().chain((a_i[b].moment * th).iter()).copied().collect();
+            let got: Vec<f64> = (a_i[b].force * th)
+                .iter()
+                .chain((a_i[b].moment * th).iter())
+                .copied()
+                .collect();
             let e = rel_err(&got, &wrench_vec(&res[b]), 1e-9);
-            assert!(e < TOL, "{}: A_{} θ ≠ body resultant at state {k}: {e:e}", R::NAME, b + 1);
+            assert!(
+                e < TOL,
+                "{}: A_{} θ ≠ body resultant at state {k}: {e:e}",
+                R::NAME,
+                b + 1
+            );
         }
     }
-    eprintln!("{}: {} base parameters (standard), {} (principal)", R::NAME, R::NBASE, R::NBASE_PRINCIPAL);
+    eprintln!(
+        "{}: {} base parameters (standard), {} (principal)",
+        R::NAME,
+        R::NBASE,
+        R::NBASE_PRINCIPAL
+    );
 }
 
 #[test]

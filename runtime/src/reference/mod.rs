@@ -8,15 +8,35 @@
 //! frame), gravity entering as a base acceleration `a_0 = −a_g = [−g; 0]`.
 //! Bodies are numbered `0..=n` here with `0` the fixed base, so `λ(i)` indexes
 //! directly; public results list the moving bodies `1..=n` only.
+//!
+//! The algorithms, each a method of [`Reference`]:
+//!
+//! - kinematics: [`Reference::forward_kinematics`], [`Reference::body_motions`];
+//! - inverse dynamics: [`Reference::rnea`] (recursive Newton–Euler),
+//!   [`Reference::joint_wrenches`], [`Reference::nonlinear_effects`],
+//!   [`Reference::generalized_gravity`];
+//! - the mass matrix: [`Reference::crba`] (composite rigid body algorithm);
+//! - forward dynamics: [`Reference::aba`] (articulated body algorithm) and
+//!   [`Reference::forward_dynamics`] (`M⁻¹` by Cholesky, a second opinion);
+//! - regressors, linear in the standard parameters: [`Reference::joint_torque_regressor`],
+//!   [`Reference::joint_wrench_regressor`], and in the principal parameters
+//!   [`Reference::principal_regressor`];
+//! - the paper's decoupled body model (MIM, DESIGN §4–§5): [`Reference::body_regressor`]
+//!   and [`Reference::body_resultants`], per body in its centroidal principal frame.
 
+mod aba;
+mod mim;
+mod regressor;
 mod sample;
 pub mod spatial;
 
+pub use mim::euler_matrix;
+pub use regressor::{principal_matrix, principal_params_to_standard};
 pub use sample::{perturbed_params, sample_states, SplitMix64, State};
 pub use spatial::Motion;
 
 use crate::{Pose, Wrench};
-use dyngen_model::{JointKind, Model};
+use dyngen_model::{JointKind, Model, PrincipalFrame};
 use nalgebra::{DMatrix, DVector, Vector3};
 use spatial::{cross_force, cross_motion, spatial_inertia, stack, vec3, SpatialMatrix, SpatialVector, Transform};
 
@@ -33,6 +53,9 @@ pub struct Reference {
     joints: Vec<JointData>,
     /// `a_g = [g; 0]`: gravity as a spatial acceleration of the base frame.
     gravity: SpatialVector,
+    /// Each moving body's centroidal principal frame (nominal centre of mass and
+    /// principal axes), body 1 first.
+    frames: Vec<PrincipalFrame>,
 }
 
 /// What the algorithms need of joint `i`, converted once.
@@ -105,6 +128,7 @@ impl Reference {
             model: model.clone(),
             joints,
             gravity: stack(&vec3(&model.gravity), &Vector3::zeros()),
+            frames: dyngen_model::principal_frames(model),
         }
     }
 
@@ -284,7 +308,7 @@ impl Reference {
     ///
     /// Independent of `rnea`: `M(q) e_j = rnea(q, 0, e_j) − rnea(q, 0, 0)`.
     /// Panics if a length differs.
-    pub fn mass_matrix(&self, q: &[f64], params: &[f64]) -> DMatrix<f64> {
+    pub fn crba(&self, q: &[f64], params: &[f64]) -> DMatrix<f64> {
         let n = self.nq();
         self.check_len("q", q, n);
         self.check_len("params", params, 10 * n);
@@ -317,15 +341,21 @@ impl Reference {
         m
     }
 
+    /// The joint-space mass matrix: another name for [`Reference::crba`].
+    pub fn mass_matrix(&self, q: &[f64], params: &[f64]) -> DMatrix<f64> {
+        self.crba(q, params)
+    }
+
     /// Forward dynamics `a = M(q)⁻¹ (tau − C(q, v) v − g(q))`, by a Cholesky
-    /// factorisation of [`Reference::mass_matrix`]. Returns `n` accelerations, or
+    /// factorisation of [`Reference::crba`]; [`Reference::aba`] computes the same
+    /// without forming `M`. Returns `n` accelerations, or
     /// `None` when `M(q)` is not positive definite (never for physically consistent
     /// parameters). Panics if a length differs.
     pub fn forward_dynamics(&self, q: &[f64], v: &[f64], tau: &[f64], params: &[f64]) -> Option<Vec<f64>> {
         self.check_len("tau", tau, self.nv());
         let bias = DVector::from_vec(self.nonlinear_effects(q, v, params));
         let rhs = DVector::from_column_slice(tau) - bias;
-        let cholesky = self.mass_matrix(q, params).cholesky()?;
+        let cholesky = self.crba(q, params).cholesky()?;
         Some(cholesky.solve(&rhs).iter().copied().collect())
     }
 }

@@ -5,12 +5,15 @@
 
 use dyngen_model::math::{Mat3, Vec3};
 use dyngen_model::Placement;
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 
 /// A spatial motion `[v; ω]` or force `[f; n]` vector, in some body's coordinates.
 pub type SpatialVector = Vector6<f64>;
 /// A spatial transform, inertia or cross-product operator.
 pub type SpatialMatrix = Matrix6<f64>;
+/// A body's spatial force as a linear function of its 10 standard parameters
+/// (see [`force_regressor`]).
+pub type ForceRegressor = SMatrix<f64, 6, 10>;
 
 /// A spatial motion vector with named parts: the linear velocity (or acceleration)
 /// of the point at the frame origin, and the angular velocity (or acceleration).
@@ -176,6 +179,53 @@ pub fn spatial_inertia(params: &[f64]) -> SpatialMatrix {
     x
 }
 
+/// `L(w)` (3 × 6) with `I w = L(w) ι` for the six entries of a symmetric inertia in
+/// Pinocchio's order `ι = [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`:
+///
+/// ```text
+/// L(w) = [ w1  w2  0   w3  0   0  ]
+///        [ 0   w1  w2  0   w3  0  ]
+///        [ 0   0   0   w1  w2  w3 ]
+/// ```
+pub fn inertia_product_matrix(w: &Vector3<f64>) -> SMatrix<f64, 3, 6> {
+    #[rustfmt::skip]
+    let l = SMatrix::<f64, 3, 6>::new(
+        w.x, w.y, 0.0, w.z, 0.0, 0.0,
+        0.0, w.x, w.y, 0.0, w.z, 0.0,
+        0.0, 0.0, 0.0, w.x, w.y, w.z,
+    );
+    l
+}
+
+/// The body regressor (Atkeson, An and Hollerbach 1986; Pinocchio's
+/// `bodyRegressor`): the net spatial force a body needs, `f = I a + v ×* I v`, is
+/// linear in its standard parameters `π = [m, h, ι]` (`h = m c`, `ι` the inertia
+/// about the origin, see [`spatial_inertia`]), `f = A(v, a) π` with, for
+/// `v = [v; ω]` and `a = [a; ω̇]`,
+///
+/// ```text
+/// force  = m (a + ω × v) + ([ω̇]× + [ω]×²) h
+/// torque = −[a + ω × v]× h + (L(ω̇) + [ω]× L(ω)) ι
+/// ```
+///
+/// (`L` from [`inertia_product_matrix`]). Gravity enters through `a` when the
+/// base is given the acceleration `−a_g`.
+pub fn force_regressor(v: &SpatialVector, a: &SpatialVector) -> ForceRegressor {
+    let (lin, w): (Vector3<f64>, Vector3<f64>) = (v.fixed_rows::<3>(0).into(), v.fixed_rows::<3>(3).into());
+    let (acc, dw): (Vector3<f64>, Vector3<f64>) = (a.fixed_rows::<3>(0).into(), a.fixed_rows::<3>(3).into());
+    let classical = acc + w.cross(&lin);
+    let mut y = ForceRegressor::zeros();
+    // force
+    y.fixed_view_mut::<3, 1>(0, 0).copy_from(&classical);
+    y.fixed_view_mut::<3, 3>(0, 1)
+        .copy_from(&(skew(&dw) + skew(&w) * skew(&w)));
+    // torque
+    y.fixed_view_mut::<3, 3>(3, 1).copy_from(&(-skew(&classical)));
+    y.fixed_view_mut::<3, 6>(3, 4)
+        .copy_from(&(inertia_product_matrix(&dw) + skew(&w) * inertia_product_matrix(&w)));
+    y
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -283,5 +333,25 @@ mod tests {
         let angular = ic * w + c.cross(&momentum);
         assert!((h.fixed_rows::<3>(0) - momentum).amax() < 1e-15);
         assert!((h.fixed_rows::<3>(3) - angular).amax() < 1e-15);
+    }
+    #[test]
+    fn force_regressor_columns_are_forces_of_unit_parameters() {
+        // Column k of A(v, a) is the force of a "body" whose only parameter is π_k = 1.
+        let v = SpatialVector::new(0.3, -0.1, 0.8, 1.2, -0.4, 0.5);
+        let a = SpatialVector::new(-0.6, 0.2, 0.1, 0.7, 0.9, -1.1);
+        let y = force_regressor(&v, &a);
+        for k in 0..10 {
+            let mut unit = [0.0; 10];
+            unit[k] = 1.0;
+            let inertia = spatial_inertia(&unit);
+            let f = inertia * a + cross_force(&v) * (inertia * v);
+            assert!((y.column(k) - f).amax() < 1e-15, "column {k}");
+        }
+        let w = Vector3::new(0.4, -0.3, 0.2);
+        let iota = [1.0, 0.1, 2.0, -0.2, 0.3, 3.0];
+        #[rustfmt::skip]
+        let i = Matrix3::new(1.0, 0.1, -0.2, 0.1, 2.0, 0.3, -0.2, 0.3, 3.0);
+        let l = inertia_product_matrix(&w) * nalgebra::Vector6::from_column_slice(&iota);
+        assert!((l - i * w).amax() < 1e-15);
     }
 }

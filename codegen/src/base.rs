@@ -10,7 +10,8 @@
 use dyngen_model::Model;
 
 /// A column whose residual, relative to its own norm, falls below this is in the
-/// span of the columns kept before it.
+/// span of the columns kept before it; a column whose norm, relative to the largest
+/// column's, falls below it is zero.
 pub const RANK_TOLERANCE: f64 = 1e-8;
 /// Random states stacked per analysis (rows = `SAMPLES · n`).
 pub const SAMPLES: usize = 40;
@@ -143,20 +144,23 @@ fn format_coef(x: f64) -> String {
 }
 
 /// Householder QR of `a` (m × p, rows) in place, columns in order, each column
-/// kept only if its residual after the reflectors of the kept columns exceeds
-/// `RANK_TOLERANCE` times its own norm. Returns the column order (kept first, then
+/// kept only if it is not numerically zero and its residual after the reflectors of
+/// the kept columns exceeds `RANK_TOLERANCE` times its own norm. Returns the column order (kept first, then
 /// set aside, each in parameter order), `R` in that order (rows, p wide) and the rank.
 fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
     let m = a.len();
     let original: Vec<f64> = (0..p)
         .map(|c| a.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt())
         .collect();
+    let largest = original.iter().copied().fold(0.0, f64::max);
     let mut kept = Vec::new();
     let mut dropped = Vec::new();
     let mut k = 0;
     for c in 0..p {
         let residual = a[k.min(m)..].iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt();
-        if k >= m || original[c] == 0.0 || residual <= RANK_TOLERANCE * original[c] {
+        // Numerically zero columns (algebraic cancellations leave rounding noise) and
+        // columns in the span of those kept are set aside.
+        if k >= m || original[c] <= RANK_TOLERANCE * largest || residual <= RANK_TOLERANCE * original[c] {
             dropped.push(c);
             continue;
         }

@@ -7,6 +7,13 @@ pub mod split {
     include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
 }
 
+/// A 12-DOF branched tree (torso, head, two arms; revolute, continuous and
+/// prismatic joints, unaligned axes, a merged fixed link): the largest tree the
+/// tests generate and compile.
+pub mod tree12 {
+    dyngen::robot!(name: Tree12, urdf: "fixtures/tree12.urdf");
+}
+
 use dyngen::reference::Reference;
 use dyngen::Robot;
 use serde::Deserialize;
@@ -76,6 +83,17 @@ pub struct FixtureSample {
     pub f: Vec<[f64; 6]>,
     #[serde(rename = "oMi")]
     pub o_m_i: Vec<FixturePose>,
+    /// `crba`, rows.
+    #[serde(rename = "M")]
+    pub m: Vec<Vec<f64>>,
+    pub nle: Vec<f64>,
+    pub g: Vec<f64>,
+    /// Joint torque regressor, rows.
+    #[serde(rename = "Y")]
+    pub y: Vec<Vec<f64>>,
+    pub tau_fd: Vec<f64>,
+    /// `aba(q, v, tau_fd)`.
+    pub ddq: Vec<f64>,
 }
 
 impl FixturePose {

@@ -2,22 +2,33 @@
 //! robot (fixed seeds), with nominal and with perturbed parameters.
 
 use dyngen::reference::{perturbed_params, sample_states};
-use dyngen::{Pose, Robot, Wrench};
+use dyngen::{BodyRegressor, Pose, Robot, Wrench};
+use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{pose_vec, reference_of, rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;
+use robot_panda::Panda;
 use robot_paper6::Paper6;
 use robot_planar2::Planar2;
+use robot_puma560::Puma560;
 use robot_ur5::Ur5;
 
 const STATES: usize = 1000;
 const TOL: f64 = 1e-10;
 
-/// Returns the worst relative errors (rnea, forward kinematics, joint wrenches).
-fn check<R: Robot>(seed: u64) -> [f64; 3] {
+fn mat(rows: usize, cols: usize, data: &[f64]) -> nalgebra::DMatrix<f64> {
+    nalgebra::DMatrix::from_row_slice(rows, cols, data)
+}
+
+/// Returns the worst relative errors (rnea, forward kinematics, joint wrenches,
+/// crba, aba, torque regressor, wrench regressor, principal regressor, body
+/// regressors, body resultants).
+fn check<R: Robot>(seed: u64) -> [f64; 10] {
     let reference = reference_of::<R>();
     let model = reference.model().clone();
     let n = R::NV;
-    let mut worst = [0.0f64; 3];
+    let mut worst = [0.0f64; 10];
+    let n6 = 6 * n;
+    let n6 = 6 * n;
     for (k, s) in sample_states(&model, STATES, seed).iter().enumerate() {
         // Every other state uses parameters that are not the nominal ones, so that
         // the parameters really are a runtime input.
@@ -51,13 +62,82 @@ fn check<R: Robot>(seed: u64) -> [f64; 3] {
         let e = rel_err(&got, &want, 1e-9);
         assert!(e < TOL, "{}: joint wrenches state {k}: relative error {e:e}", R::NAME);
         worst[2] = worst[2].max(e);
+
+        if k % 10 != 0 {
+            continue;
+        }
+        let (q, v, a) = (&s.q, &s.v, &s.a);
+        let mut m = vec![0.0; n * n];
+        R::crba(q, &params, &mut m);
+        worst[3] = worst[3].max(rel_err(&m, reference.crba(q, &params).transpose().as_slice(), 1e-9));
+        let mut acc = vec![0.0; n];
+        R::aba(q, v, &tau, &params, &mut acc);
+        worst[4] = worst[4].max(rel_err(&acc, &reference.aba(q, v, &tau, &params), 1.0));
+        // Row-major generated matrices against column-major nalgebra ones.
+        let mut y = vec![0.0; n * R::NPARAMS];
+        R::joint_torque_regressor(q, v, a, &mut y);
+        let want = reference.joint_torque_regressor(q, v, a);
+        worst[5] = worst[5].max(rel_err(mat(n, R::NPARAMS, &y).as_slice(), want.as_slice(), 1e-9));
+        let mut yw = vec![0.0; n6 * R::NPARAMS];
+        R::joint_wrench_regressor(q, v, a, &mut yw);
+        let want = reference.joint_wrench_regressor(q, v, a);
+        worst[6] = worst[6].max(rel_err(mat(n6, R::NPARAMS, &yw).as_slice(), want.as_slice(), 1e-9));
+        let mut yt = vec![0.0; n * R::NTHETA];
+        R::principal_regressor(q, v, a, &mut yt);
+        let want = reference.principal_regressor(q, v, a);
+        worst[7] = worst[7].max(rel_err(mat(n, R::NTHETA, &yt).as_slice(), want.as_slice(), 1e-9));
+        let mut ai = vec![BodyRegressor::default(); n];
+        R::body_regressors(q, v, a, &mut ai);
+        for (b, want) in reference.body_regressor(q, v, a).iter().enumerate() {
+            let got: Vec<f64> = (0..6)
+                .flat_map(|r| (0..4).map(move |c| (r, c)))
+                .map(|(r, c)| {
+                    if r < 3 {
+                        ai[b].force[(r, c)]
+                    } else {
+                        ai[b].moment[(r - 3, c)]
+                    }
+                })
+                .collect();
+            let want: Vec<f64> = (0..6).flat_map(|r| (0..4).map(move |c| want[(r, c)])).collect();
+            worst[8] = worst[8].max(rel_err(&got, &want, 1e-9));
+        }
+        let mut res = vec![Wrench::default(); n];
+        R::body_resultants(q, v, a, &params, &mut res);
+        let got: Vec<f64> = res.iter().flat_map(wrench_vec).collect();
+        let want: Vec<f64> = reference
+            .body_resultants(q, v, a, &params)
+            .iter()
+            .flat_map(wrench_vec)
+            .collect();
+        worst[9] = worst[9].max(rel_err(&got, &want, 1e-9));
+        let names = [
+            "crba",
+            "aba",
+            "torque regressor",
+            "wrench regressor",
+            "principal regressor",
+            "body regressors",
+            "body resultants",
+        ];
+        for (name, e) in names.iter().zip(&worst[3..]) {
+            assert!(*e < TOL, "{}: {name} state {k}: relative error {e:e}", R::NAME);
+        }
     }
     eprintln!(
-        "{}: max relative error rnea {:.2e}, kinematics {:.2e}, wrenches {:.2e}",
+        "{}: max relative error rnea {:.1e}, kinematics {:.1e}, wrenches {:.1e}, crba {:.1e}, aba {:.1e}, \
+         regressors (torque, wrench, principal) {:.1e} {:.1e} {:.1e}, body regressors {:.1e}, body resultants {:.1e}",
         R::NAME,
         worst[0],
         worst[1],
-        worst[2]
+        worst[2],
+        worst[3],
+        worst[4],
+        worst[5],
+        worst[6],
+        worst[7],
+        worst[8],
+        worst[9]
     );
     worst
 }
@@ -101,4 +181,19 @@ fn f32_instantiation_agrees() {
 fn slice_api_names_wrong_length() {
     let mut tau = [0.0; 6];
     <Ur5 as Robot>::rnea(&[0.0; 5], &[0.0; 6], &[0.0; 6], &Ur5::NOMINAL_PARAMS, &mut tau);
+}
+
+#[test]
+fn puma560_matches_reference() {
+    check::<Puma560>(5);
+}
+
+#[test]
+fn panda_matches_reference() {
+    check::<Panda>(6);
+}
+
+#[test]
+fn tree12_matches_reference() {
+    check::<Tree12>(7);
 }

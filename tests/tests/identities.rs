@@ -7,10 +7,13 @@
 
 use dyngen::reference::{perturbed_params, sample_states};
 use dyngen::{BodyRegressor, Robot, Wrench};
+use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{reference_of, rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;
+use robot_panda::Panda;
 use robot_paper6::Paper6;
 use robot_planar2::Planar2;
+use robot_puma560::Puma560;
 use robot_ur5::Ur5;
 
 const STATES: usize = 200;
@@ -171,4 +174,19 @@ fn ur5_identities() {
 #[test]
 fn gripper_arm_identities() {
     check::<GripperArm>(24);
+}
+
+#[test]
+fn puma560_identities() {
+    check::<Puma560>(25);
+}
+
+#[test]
+fn panda_identities() {
+    check::<Panda>(26);
+}
+
+#[test]
+fn tree12_identities() {
+    check::<Tree12>(27);
 }

@@ -2,15 +2,20 @@
 //! `scripts/make_fixtures.py`), so these tests need no Python.
 
 use dyngen::{Pose, Robot, Wrench};
+use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{load_fixture, pose_vec, rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;
+use robot_panda::Panda;
 use robot_paper6::Paper6;
 use robot_planar2::Planar2;
+use robot_puma560::Puma560;
 use robot_ur5::Ur5;
 
 const TOL: f64 = 1e-10;
 
-fn check<R: Robot>(fixture: &str) -> [f64; 4] {
+/// Worst relative errors: params, rnea, kinematics, wrenches, crba, nle, gravity,
+/// regressor, aba.
+fn check<R: Robot>(fixture: &str) -> [f64; 9] {
     let fx = load_fixture(fixture);
     let names: Vec<&str> = fx.model.joint_names.iter().map(String::as_str).collect();
     assert_eq!(
@@ -32,7 +37,8 @@ fn check<R: Robot>(fixture: &str) -> [f64; 4] {
     );
 
     let n = R::NV;
-    let mut worst = [e_params, 0.0, 0.0, 0.0];
+    let mut worst = [e_params, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let params = R::nominal_params();
     for (k, s) in fx.samples.iter().enumerate() {
         let mut tau = vec![0.0; n];
         R::rnea(&s.q, &s.v, &s.a, R::nominal_params(), &mut tau);
@@ -60,16 +66,53 @@ fn check<R: Robot>(fixture: &str) -> [f64; 4] {
         let e = rel_err(&got, &want, 1e-9);
         assert!(e < TOL, "{}: joint wrenches sample {k}: rel {e:e}", fx.name);
         worst[3] = worst[3].max(e);
+
+        let mut m = vec![0.0; n * n];
+        R::crba(&s.q, params, &mut m);
+        let want: Vec<f64> = s.m.iter().flatten().copied().collect();
+        worst[4] = worst[4].max(rel_err(&m, &want, 1e-9));
+        let mut h = vec![0.0; n];
+        R::nonlinear_effects(&s.q, &s.v, params, &mut h);
+        worst[5] = worst[5].max(rel_err(&h, &s.nle, 1e-9));
+        R::generalized_gravity(&s.q, params, &mut h);
+        worst[6] = worst[6].max(rel_err(&h, &s.g, 1e-9));
+        let mut y = vec![0.0; n * R::NPARAMS];
+        R::joint_torque_regressor(&s.q, &s.v, &s.a, &mut y);
+        let want: Vec<f64> = s.y.iter().flatten().copied().collect();
+        worst[7] = worst[7].max(rel_err(&y, &want, 1e-9));
+        let mut ddq = vec![0.0; n];
+        R::aba(&s.q, &s.v, &s.tau_fd, params, &mut ddq);
+        worst[8] = worst[8].max(rel_err(&ddq, &s.ddq, 1e-9));
+        for (name, e) in ["crba", "nle", "gravity", "regressor", "aba"].iter().zip(&worst[4..]) {
+            assert!(
+                *e < TOL,
+                "{}: {name} differs from Pinocchio at sample {k}: {e:e}",
+                fx.name
+            );
+        }
     }
+    // The number of base parameters is the rank of Pinocchio's stacked regressor.
+    let rows: Vec<f64> = fx.samples.iter().flat_map(|s| s.y.iter().flatten().copied()).collect();
+    let stacked = nalgebra::DMatrix::from_row_slice(n * fx.samples.len(), R::NPARAMS, &rows);
+    let sv = stacked.singular_values();
+    let rank = sv.iter().filter(|&&x| x > 1e-8 * sv.max()).count();
+    assert_eq!(rank, R::NBASE, "{}: rank of Pinocchio's stacked regressor", fx.name);
     eprintln!(
-        "{} vs Pinocchio {}: {} samples; max relative error params {:.2e}, rnea {:.2e}, kinematics {:.2e}, wrenches {:.2e}",
+        "{} vs Pinocchio {}: {} samples; max relative error params {:.1e}, rnea {:.1e}, kinematics {:.1e}, \
+         wrenches {:.1e}, crba {:.1e}, nle {:.1e}, gravity {:.1e}, regressor {:.1e}, aba {:.1e}; {} base parameters",
         fx.name,
         fx.pinocchio_version,
         fx.samples.len(),
         worst[0],
         worst[1],
         worst[2],
-        worst[3]
+        worst[3],
+        worst[4],
+        worst[5],
+        worst[6],
+        worst[7],
+        worst[8],
+        R::NBASE
     );
     worst
 }
@@ -92,6 +135,21 @@ fn planar2_matches_pinocchio() {
 #[test]
 fn paper6_matches_pinocchio() {
     check::<Paper6>("paper6");
+}
+
+#[test]
+fn puma560_matches_pinocchio() {
+    check::<Puma560>("puma560");
+}
+
+#[test]
+fn panda_matches_pinocchio() {
+    check::<Panda>("panda");
+}
+
+#[test]
+fn tree12_matches_pinocchio() {
+    check::<Tree12>("tree12");
 }
 
 /// The DSL robots' fixtures were made from the URDF dyngen writes for them; if the

@@ -28,7 +28,6 @@ fn check<R: Robot>(seed: u64) -> [f64; 10] {
     let n = R::NV;
     let mut worst = [0.0f64; 10];
     let n6 = 6 * n;
-    let n6 = 6 * n;
     for (k, s) in sample_states(&model, STATES, seed).iter().enumerate() {
         // Every other state uses parameters that are not the nominal ones, so that
         // the parameters really are a runtime input.

@@ -250,15 +250,21 @@ impl<'g> Sub for Expr<'g> {
             // −a − b = −(a + b)
             return -(a + rhs);
         }
-        // b − a is built as −(a − b), so both share one node.
-        if self.id > rhs.id {
-            let mirrored = g.index.borrow().get(&Node::Sub(rhs.id, self.id)).copied();
-            if let Some(id) = mirrored {
-                // Interned directly: `Neg` itself would flip the subtraction back.
-                return g.intern(Node::Neg(id));
-            }
+        // b − a is built as −(a − b) when a − b exists, so both share one node.
+        let direct = Node::Sub(self.id, rhs.id);
+        let (existing, mirrored) = {
+            let index = g.index.borrow();
+            (
+                index.get(&direct).copied(),
+                index.get(&Node::Sub(rhs.id, self.id)).copied(),
+            )
+        };
+        match (existing, mirrored) {
+            (Some(id), _) => g.expr(id),
+            // Interned directly: `Neg` itself would flip the subtraction back.
+            (None, Some(id)) => g.intern(Node::Neg(id)),
+            (None, None) => g.intern(direct),
         }
-        g.intern(Node::Sub(self.id, rhs.id))
     }
 }
 

@@ -7,8 +7,10 @@ use dyngen::reference::{sample_states, State};
 use dyngen::{Pose, Robot, Wrench};
 use dyngen_tests::reference_of;
 use robot_gripper_arm::GripperArm;
+use robot_panda::Panda;
 use robot_paper6::Paper6;
 use robot_planar2::Planar2;
+use robot_puma560::Puma560;
 use robot_ur5::Ur5;
 
 fn states<R: Robot>() -> Vec<State> {
@@ -119,6 +121,8 @@ fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
 
 fn dynamics(c: &mut Criterion) {
     bench_robot::<Ur5>(c, "ur5");
+    bench_robot::<Panda>(c, "panda");
+    bench_robot::<Puma560>(c, "puma560");
     bench_robot::<GripperArm>(c, "gripper_arm");
     bench_robot::<Paper6>(c, "paper6");
     bench_robot::<Planar2>(c, "planar2");

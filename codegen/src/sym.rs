@@ -394,8 +394,8 @@ impl std::fmt::Display for OpCount {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} mul, {} add, {} neg, {} trig",
-            self.muls, self.adds, self.negs, self.trig
+            "{} mul, {} div, {} add, {} neg, {} trig",
+            self.muls, self.divs, self.adds, self.negs, self.trig
         )
     }
 }

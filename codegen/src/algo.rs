@@ -489,27 +489,13 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
     Rnea { tau, wrenches: f }
 }
 
-/// `S_j` of every joint `j` expressed in every body `i` it supports:
-/// `out[i][j]` (1-based), `None` where joint `j` is not on body `i`'s path.
-fn subspaces_in_descendants<'g>(g: &'g Graph, model: &Model, k: &Kinematics<'g>) -> Vec<Vec<Option<Motion<'g>>>> {
-    let n = model.dof();
-    let mut out = vec![vec![None; n + 1]; n + 1];
-    for i in 1..=n {
-        out[i][i] = Some(subspace(g, model, i));
-        let p = model.parent(i);
-        for j in 1..i {
-            if let Some(s) = out[p][j] {
-                out[i][j] = Some(k.x[i - 1].motion_to_child(s));
-            }
-        }
-    }
-    out
-}
-
 /// The joint torque regressor `Y` (n × cols·n) for per-body parameter columns
 /// `columns(i)`: entry `(j, cols·(i−1) + c)` is `S_jᵀ` (in body `i`'s frame) times the
 /// wrench that column `c` of body `i`'s parameters needs. Blocks where joint `j` does
 /// not support body `i` are `None`: structurally zero, never computed.
+///
+/// Each `S_j` is carried down the tree one body at a time, right before that body's
+/// columns use it, so the emitted code keeps few values alive at once.
 pub fn torque_regressor<'g>(
     g: &'g Graph,
     model: &Model,
@@ -517,9 +503,15 @@ pub fn torque_regressor<'g>(
 ) -> Vec<Vec<Option<Expr<'g>>>> {
     let n = model.dof();
     let k = kinematics(g, model, Inputs::Full);
-    let s = subspaces_in_descendants(g, model, &k);
+    // s[i][j]: S_j in body i's frame (1-based), where joint j supports body i.
+    let mut s: Vec<Vec<Option<Motion<'g>>>> = vec![vec![None; n + 1]; n + 1];
     let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![Vec::new(); n];
     for i in 1..=n {
+        let p = model.parent(i);
+        for j in 1..i {
+            s[i][j] = s[p][j].map(|sj| k.x[i - 1].motion_to_child(sj));
+        }
+        s[i][i] = Some(subspace(g, model, i));
         let wrenches: Vec<Force<'g>> = columns(i).iter().map(|b| b.wrench(&k.motion[i])).collect();
         for (j, row) in y.iter_mut().enumerate() {
             for w in &wrenches {

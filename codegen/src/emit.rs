@@ -22,27 +22,29 @@ pub struct Arg {
 /// Builds a function's returned value from one expression per output.
 pub type Assemble<'a> = Box<dyn Fn(&[TokenStream]) -> TokenStream + 'a>;
 
+/// The place output `k` is stored to, e.g. `out[2][5]`.
+pub type Place<'a> = Box<dyn Fn(usize) -> TokenStream + 'a>;
+
+/// How an emitted function hands back its result.
+pub enum Output<'a> {
+    /// Returned by value, built from all outputs at the end.
+    Return(Assemble<'a>),
+    /// Written through a final `out: &mut` argument, each output stored right after
+    /// the statement that computes it, so large matrices neither tie up registers
+    /// until the end nor are copied.
+    InPlace(Place<'a>),
+}
+
 /// A function to emit: its signature pieces and symbolic outputs.
 pub struct FnSpec<'a> {
     pub name: &'a str,
     pub doc: String,
     /// Arguments in signature order.
     pub args: Vec<Arg>,
-    /// The return type; or, for `Output::InPlace`, the type `out` points to.
+    /// The return type; or, for [`Output::InPlace`], the type `out` points to.
     pub ret: TokenStream,
-    /// Whether the value is returned or written through a final `out: &mut` argument
-    /// (large matrices: no copy of the result).
-    pub output: Output,
+    pub output: Output<'a>,
     pub outputs: Vec<NodeId>,
-    /// Builds the returned value from one expression per output.
-    pub assemble: Assemble<'a>,
-}
-
-/// How an emitted function hands back its result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Output {
-    Return,
-    InPlace,
 }
 
 /// What was emitted for one function, for reports and docs.
@@ -67,9 +69,11 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let fname = format_ident!("{}", spec.name);
     let doc = spec.doc.lines();
     let ret = &spec.ret;
-    let (out_param, ret_ty) = match spec.output {
-        Output::Return => (None, quote!(-> #ret)),
-        Output::InPlace => (Some(quote!(out: &mut #ret)), quote!()),
+    let in_place = matches!(spec.output, Output::InPlace(_));
+    let (out_param, out_arg, ret_ty) = if in_place {
+        (Some(quote!(out: &mut #ret)), Some(quote!(out)), quote!())
+    } else {
+        (None, None, quote!(-> #ret))
     };
     let params: Vec<TokenStream> = spec
         .args
@@ -82,8 +86,9 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         .collect();
     let arg_names: Vec<Ident> = spec.args.iter().map(|a| format_ident!("{}", a.name)).collect();
     let op_doc = format!(
-        " Generated: {} multiplications, {} additions, {} negations, {} sin/cos; {} statements.",
+        " Generated: {} multiplications, {} divisions, {} additions, {} negations, {} sin/cos; {} statements.",
         ops.muls,
+        ops.divs,
         ops.adds,
         ops.negs,
         ops.trig,
@@ -101,20 +106,64 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         parts: chunks.len(),
     };
 
+    // In place: the output slots of each computed node, and the stores of outputs
+    // that are constants or inputs (made up front).
+    let mut slots: HashMap<NodeId, Vec<usize>> = HashMap::new();
+    let mut early_stores = Vec::new();
+    if let Output::InPlace(place) = &spec.output {
+        let computed: std::collections::HashSet<NodeId> =
+            stmts.iter().flat_map(|s| s.defines.iter().copied()).collect();
+        let names = Names {
+            spill: &HashMap::new(),
+            args: &spec.args,
+        };
+        for (k, &o) in spec.outputs.iter().enumerate() {
+            if computed.contains(&o) {
+                slots.entry(o).or_default().push(k);
+            } else {
+                let (p, x) = (place(k), names.operand(graph, o));
+                early_stores.push(quote!(#p = #x;));
+            }
+        }
+    }
+    let stores_after = |s: &Stmt| -> TokenStream {
+        let Output::InPlace(place) = &spec.output else {
+            return TokenStream::new();
+        };
+        let stores = s.defines.iter().flat_map(|d| {
+            let x = var(*d);
+            slots.get(d).into_iter().flatten().map(move |&k| {
+                let p = place(k);
+                quote!(#p = #x;)
+            })
+        });
+        quote!(#(#stores)*)
+    };
+
     if chunks.len() == 1 {
         let names = Names {
             spill: &HashMap::new(),
             args: &spec.args,
         };
-        let body = chunks[0].iter().map(|s| emit_stmt(graph, s, &names));
-        let outs: Vec<TokenStream> = spec.outputs.iter().map(|&o| names.operand(graph, o)).collect();
-        let value = (spec.assemble)(&outs);
+        let body = chunks[0].iter().map(|s| {
+            let st = emit_stmt(graph, s, &names);
+            let stores = stores_after(s);
+            quote!(#st #stores)
+        });
+        let value = match &spec.output {
+            Output::Return(assemble) => {
+                let outs: Vec<TokenStream> = spec.outputs.iter().map(|&o| names.operand(graph, o)).collect();
+                assemble(&outs)
+            }
+            Output::InPlace(_) => TokenStream::new(),
+        };
         let tokens = quote! {
             #(#[doc = #doc])*
             #[doc = ""]
             #[doc = #op_doc]
             #[inline]
             pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+                #(#early_stores)*
                 #(#body)*
                 #value
             }
@@ -122,7 +171,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         return (tokens, report);
     }
 
-    // Split: values crossing a part boundary, or returned, live in `w`.
+    // Split: values crossing a part boundary (or returned by value) live in `w`.
     let mut defined_in: HashMap<NodeId, usize> = HashMap::new();
     for (c, chunk) in chunks.iter().enumerate() {
         for s in chunk.iter() {
@@ -145,9 +194,11 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             }
         }
     }
-    for &o in &spec.outputs {
-        if defined_in.contains_key(&o) {
-            mark(o, &mut spill);
+    if !in_place {
+        for &o in &spec.outputs {
+            if defined_in.contains_key(&o) {
+                mark(o, &mut spill);
+            }
         }
     }
     let width = usize_lit(spill.len().max(1));
@@ -173,8 +224,12 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             let k = usize_lit(spill[&id]);
             quote!(let #x = w[#k];)
         });
-        let body = chunk.iter().map(|s| emit_stmt(graph, s, &names));
-        let stores = chunk.iter().flat_map(|s| s.defines.iter()).filter_map(|id| {
+        let body = chunk.iter().map(|s| {
+            let st = emit_stmt(graph, s, &names);
+            let stores = stores_after(s);
+            quote!(#st #stores)
+        });
+        let spills = chunk.iter().flat_map(|s| s.defines.iter()).filter_map(|id| {
             spill.get(id).map(|&k| {
                 let k = usize_lit(k);
                 let x = var(*id);
@@ -185,36 +240,42 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             #[doc(hidden)]
             #[inline(never)]
             #[allow(unused_variables)]
-            fn #part<S: ::dyngen::Scalar>(#(#params,)* w: &mut [S; #width]) {
+            fn #part<S: ::dyngen::Scalar>(#(#params,)* w: &mut [S; #width], #out_param) {
                 #(#load_stmts)*
                 #(#body)*
-                #(#stores)*
+                #(#spills)*
             }
         });
-        calls.push(quote!(Self::#part(#(#arg_names,)* &mut w);));
+        calls.push(quote!(Self::#part(#(#arg_names,)* &mut w, #out_arg);));
     }
-    let names = Names {
-        spill: &spill,
-        args: &spec.args,
+    let value = match &spec.output {
+        Output::Return(assemble) => {
+            let names = Names {
+                spill: &spill,
+                args: &spec.args,
+            };
+            let outs: Vec<TokenStream> = spec
+                .outputs
+                .iter()
+                .map(|&o| match spill.get(&o) {
+                    Some(&k) => {
+                        let k = usize_lit(k);
+                        quote!(w[#k])
+                    }
+                    None => names.operand(graph, o),
+                })
+                .collect();
+            assemble(&outs)
+        }
+        Output::InPlace(_) => TokenStream::new(),
     };
-    let outs: Vec<TokenStream> = spec
-        .outputs
-        .iter()
-        .map(|&o| match spill.get(&o) {
-            Some(&k) => {
-                let k = usize_lit(k);
-                quote!(w[#k])
-            }
-            None => names.operand(graph, o),
-        })
-        .collect();
-    let value = (spec.assemble)(&outs);
     let tokens = quote! {
         #(#[doc = #doc])*
         #[doc = ""]
         #[doc = #op_doc]
         pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
             let mut w = [<S as ::dyngen::Scalar>::ZERO; #width];
+            #(#early_stores)*
             #(#calls)*
             #value
         }

@@ -127,15 +127,12 @@ fn base_params(model: &Model, names: &[String], g: &Graph, ids: &[NodeId]) -> Ba
     first
 }
 
-/// Writes a matrix entry by entry into `out`.
-fn rows_of(cols: usize) -> Assemble<'static> {
-    Box::new(move |outs| {
-        let stores = outs.iter().enumerate().map(|(k, x)| {
-            let (r, c) = (emit::usize_lit(k / cols), emit::usize_lit(k % cols));
-            quote!(out[#r][#c] = #x;)
-        });
-        quote!(#(#stores)*)
-    })
+/// A matrix written entry by entry into `out`, row-major.
+fn rows_of(cols: usize) -> Output<'static> {
+    Output::InPlace(Box::new(move |k| {
+        let (r, c) = (emit::usize_lit(k / cols), emit::usize_lit(k % cols));
+        quote!(out[#r][#c])
+    }))
 }
 
 fn vector() -> Assemble<'static> {
@@ -232,7 +229,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
         let g = Graph::new();
         let r = algo::rnea(&g, model, inputs);
         let outputs = r.tau.iter().map(|x| x.id()).collect();
-        e.emit(&g, FnSpec { name: fname, doc, args, ret: quote!([S; #n_lit]), output: Output::Return, outputs, assemble: vector() });
+        e.emit(&g, FnSpec { name: fname, doc, args, ret: quote!([S; #n_lit]), outputs, output: Output::Return(vector()) });
     }
 
     {
@@ -249,9 +246,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Every body's pose in the base frame, body 1 first: `x_base = rotation · x_body +\n translation`. `q`: {n} joint positions."),
                 args: vec![arg(ARG_Q, "q")],
                 ret: quote!([::dyngen::Pose<S>; #n_lit]),
-                output: Output::Return,
                 outputs,
-                assemble: Box::new(|outs| {
+                output: Output::Return(Box::new(|outs| {
                     let poses = outs.chunks(12).map(|c| {
                         let (r, t) = (&c[..9], &c[9..]);
                         quote!(::dyngen::Pose {
@@ -260,7 +256,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                         })
                     });
                     quote!([#(#poses),*])
-                }),
+                })),
             },
         );
     }
@@ -275,9 +271,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The reaction wrench each joint applies to its outboard body: for joint `j`, the\n force (N) and the moment (N·m) about the joint-frame origin, in body `j`'s frame\n (Pinocchio's `data.f[j]` after `rnea`). Arguments as for [`Self::rnea`]; returns {n}\n wrenches, joint 1 first."),
                 args: qvap(),
                 ret: quote!([::dyngen::Wrench<S>; #n_lit]),
-                output: Output::Return,
                 outputs: force_ids(&r.wrenches),
-                assemble: wrenches_of(),
+                output: Output::Return(wrenches_of()),
             },
         );
     }
@@ -292,9 +287,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The joint-space inertia matrix `M(q)` ({n} × {n}, symmetric positive definite) by the\n composite-rigid-body algorithm; entries of joints on different branches are not\n computed. {params_doc}."),
                 args: vec![arg(ARG_Q, "q"), arg(ARG_PARAMS, "params")],
                 ret: quote!([[S; #n_lit]; #n_lit]),
-                output: Output::InPlace,
-                outputs: m.iter().flatten().map(|x| x.id()).collect(),
-                assemble: rows_of(n),
+                                outputs: m.iter().flatten().map(|x| x.id()).collect(),
+                output: rows_of(n),
             },
         );
     }
@@ -309,9 +303,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Forward dynamics, `a = M(q)⁻¹ (tau − h(q, v))`, by the articulated-body algorithm.\n `q, v, tau`: {n} positions, velocities, joint torques or forces; {params_doc}.\n Returns the {n} joint accelerations; `aba(q, v, rnea(q, v, a)) = a`."),
                 args: vec![arg(ARG_Q, "q"), arg(ARG_V, "v"), arg(ARG_A, "tau"), arg(ARG_PARAMS, "params")],
                 ret: quote!([S; #n_lit]),
-                output: Output::Return,
                 outputs: qdd.iter().map(|x| x.id()).collect(),
-                assemble: vector(),
+                output: Output::Return(vector()),
             },
         );
     }
@@ -333,9 +326,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The joint torque regressor `Y(q, v, a)` ({n} × {np}): `tau = Y · params` for any\n standard parameters. Blocks of joints that do not support a body are structural\n zeros, never computed. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #np_lit]; #n_lit]),
-                output: Output::InPlace,
-                outputs: ids,
-                assemble: rows_of(np),
+                                outputs: ids,
+                output: rows_of(np),
             },
         );
         let b = base.count();
@@ -351,9 +343,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The base regressor `Y_b(q, v, a)` ({n} × {b}): `tau = Y_b · β` with `β = K · params`\n (`Self::base_params`), the {b} identifiable combinations listed in\n `Self::BASE_GROUPINGS`. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #b_lit]; #n_lit]),
-                output: Output::InPlace,
-                outputs: matrix_ids(&g, &cols),
-                assemble: rows_of(b),
+                                outputs: matrix_ids(&g, &cols),
+                output: rows_of(b),
             },
         );
     }
@@ -369,9 +360,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The regressor in the paper's parameters ({n} × {nt}): `tau = Y_θ · theta` with\n `theta = (m, J1, J2, J3)` per body, each body's centre of mass and principal axes\n fixed by the description (`Self::NOMINAL_THETA` for its values). {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #nt_lit]; #n_lit]),
-                output: Output::InPlace,
-                outputs: ids,
-                assemble: rows_of(nt),
+                                outputs: ids,
+                output: rows_of(nt),
             },
         );
         let b = principal_base.count();
@@ -387,9 +377,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The base regressor of the principal parameterisation ({n} × {b}): `tau = Y · β_θ`\n with `β_θ = K_θ · theta` (`Self::principal_base_params`), groupings in\n `Self::PRINCIPAL_BASE_GROUPINGS`. {state_doc}."),
                 args: qva(),
                 ret: quote!([[S; #b_lit]; #n_lit]),
-                output: Output::InPlace,
-                outputs: matrix_ids(&g, &cols),
-                assemble: rows_of(b),
+                                outputs: matrix_ids(&g, &cols),
+                output: rows_of(b),
             },
         );
     }
@@ -404,9 +393,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Every joint's full reaction wrench as a linear function of the parameters\n ({} × {np}): rows `6(j−1)..6j` are `[force; moment]` of joint `j`, as\n [`Self::joint_wrenches`] gives them, equal to this matrix times `params`. {state_doc}.", 6 * n),
                 args: qva(),
                 ret: quote!([[S; #np_lit]; #n6]),
-                output: Output::InPlace,
-                outputs: matrix_ids(&g, &y),
-                assemble: rows_of(np),
+                                outputs: matrix_ids(&g, &y),
+                output: rows_of(np),
             },
         );
     }
@@ -420,9 +408,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" The paper's decoupled model, per body: `A_i` with `[F_i; M_i] = A_i θ_i` in the\n body's centroidal principal frame, `A_i = blkdiag(a_c − g, B(ω, ω̇))` (DESIGN §5).\n {state_doc}."),
                 args: qva(),
                 ret: quote!([::dyngen::BodyRegressor<S>; #n_lit]),
-                output: Output::Return,
                 outputs: a.iter().flat_map(|m| m.iter().flatten().map(|x| x.id())).collect(),
-                assemble: Box::new(|outs| {
+                output: Output::Return(Box::new(|outs| {
                     let bodies = outs.chunks(24).map(|c| {
                         let (f, m) = (&c[..12], &c[12..]);
                         quote!(::dyngen::BodyRegressor {
@@ -431,7 +418,7 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                         })
                     });
                     quote!([#(#bodies),*])
-                }),
+                })),
             },
         );
     }
@@ -445,9 +432,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                 doc: format!(" Each body's resultant of the joint reaction wrenches, through the incidence\n matrix and body-joint vectors: `F_i = Σ_a S_ia F_a`, `M_i = Σ_a S_ia (M_a + c_ia × F_a)`;\n force and moment about the centre of mass, in the centroidal principal frame.\n With the description's parameters, `body_regressors(q, v, a)[i] · θ_i` equals it.\n {state_doc}; {params_doc}."),
                 args: qvap(),
                 ret: quote!([::dyngen::Wrench<S>; #n_lit]),
-                output: Output::Return,
                 outputs: force_ids(&r),
-                assemble: wrenches_of(),
+                output: Output::Return(wrenches_of()),
             },
         );
     }
@@ -484,9 +470,8 @@ pub fn generate(model: &Model, name: &str, options: &Options) -> Generated {
                     len: cols,
                 }],
                 ret: quote!([S; #b_lit]),
-                output: Output::Return,
                 outputs: outs,
-                assemble: vector(),
+                output: Output::Return(vector()),
             },
         );
     }

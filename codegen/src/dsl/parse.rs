@@ -548,24 +548,34 @@ fn named_args(
     out
 }
 
-fn body_joint_vectors(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<VectorTable> {
-    let g = report(
-        cx,
-        single_group(
-            tokens,
-            Delimiter::Brace,
-            "the body-joint vectors as `{ (body, joint): [x, y, z], ... }`",
-            end,
-        ),
-    )?;
-    let entries = nonempty_pieces(cx, g.stream(), "an entry `(body, joint): [x, y, z]`")
+/// `{ entry, ... }`, each entry parsed on its own so one bad entry does not hide
+/// the others.
+fn braced_entries<T>(
+    cx: &Ctxt,
+    tokens: TokenStream,
+    end: Loc,
+    expected: &str,
+    entry: &str,
+    parse: impl Fn(&Ctxt, TokenStream) -> Option<T>,
+) -> Option<(Vec<T>, Loc)> {
+    let g = report(cx, single_group(tokens, Delimiter::Brace, expected, end))?;
+    let entries = nonempty_pieces(cx, g.stream(), entry)
         .into_iter()
-        .filter_map(|piece| vector_entry(cx, piece.tokens))
+        .filter_map(|piece| parse(cx, piece.tokens))
         .collect();
-    Some(VectorTable {
-        entries,
-        loc: Loc::at(g.span()),
-    })
+    Some((entries, Loc::at(g.span())))
+}
+
+fn body_joint_vectors(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<VectorTable> {
+    let (entries, loc) = braced_entries(
+        cx,
+        tokens,
+        end,
+        "the body-joint vectors as `{ (body, joint): [x, y, z], ... }`",
+        "an entry `(body, joint): [x, y, z]`",
+        vector_entry,
+    )?;
+    Some(VectorTable { entries, loc })
 }
 
 /// `(i, a): [x, y, z]`.
@@ -611,23 +621,15 @@ fn vector_entry(cx: &Ctxt, tokens: TokenStream) -> Option<VectorEntry> {
 }
 
 fn bodies(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<BodyTable> {
-    let g = report(
+    let (entries, loc) = braced_entries(
         cx,
-        single_group(
-            tokens,
-            Delimiter::Brace,
-            "the bodies as `{ 1: principal(mass: .., moments: [..]), ... }`",
-            end,
-        ),
+        tokens,
+        end,
+        "the bodies as `{ 1: principal(mass: .., moments: [..]), ... }`",
+        "a body `number: kind(...)`",
+        body_entry,
     )?;
-    let entries = nonempty_pieces(cx, g.stream(), "a body `number: kind(...)`")
-        .into_iter()
-        .filter_map(|piece| body_entry(cx, piece.tokens))
-        .collect();
-    Some(BodyTable {
-        entries,
-        loc: Loc::at(g.span()),
-    })
+    Some(BodyTable { entries, loc })
 }
 
 /// `i: cylinder(...)` or `i: principal(...)`.

@@ -7,9 +7,13 @@
 //! a type implementing [`Robot`], with generated functions that agree with the
 //! readable [`reference`] implementation (and with Pinocchio) to 1e-10.
 
+pub mod data;
+pub mod dynamics;
+pub mod identify;
 pub mod reference;
 mod robot;
 mod scalar;
+pub mod simulate;
 
 pub use dyngen_macros::robot;
 pub use dyngen_model as model;

@@ -1,0 +1,318 @@
+//! Velocities and accelerations from measured positions: a zero-phase low-pass filter
+//! (forward–backward 2nd-order Butterworth) followed by central differences.
+
+use super::error::{DataError, Location};
+use super::trajectory::{column, set_column, Trajectory};
+use nalgebra::{Matrix4, Vector4};
+
+/// Largest allowed deviation of one time step from the mean step, relative.
+pub const SAMPLING_TOLERANCE: f64 = 0.01;
+
+/// A 2nd-order Butterworth low-pass filter, `H(z) = (b0 + b1 z⁻¹ + b2 z⁻²) / (1 + a1 z⁻¹ + a2 z⁻²)`,
+/// from the analog prototype `1 / (s² + √2 s + 1)` by the bilinear transform with
+/// the cutoff prewarped: `K = tan(π f_c Δt)`, `b0 = K² / (1 + √2 K + K²)`,
+/// `b1 = 2 b0`, `b2 = b0`, `a1 = 2 (K² − 1) / (…)`, `a2 = (1 − √2 K + K²) / (…)`.
+/// Unit gain at DC, −3 dB at exactly `f_c`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Butterworth2 {
+    b: [f64; 3],
+    a: [f64; 2],
+}
+
+impl Butterworth2 {
+    fn low_pass(dt: f64, cutoff_hz: f64) -> Self {
+        let k = (std::f64::consts::PI * cutoff_hz * dt).tan();
+        let sqrt2 = std::f64::consts::SQRT_2;
+        let norm = 1.0 / (1.0 + sqrt2 * k + k * k);
+        let b0 = k * k * norm;
+        Butterworth2 {
+            b: [b0, 2.0 * b0, b0],
+            a: [2.0 * (k * k - 1.0) * norm, (1.0 - sqrt2 * k + k * k) * norm],
+        }
+    }
+
+    /// Direct form II transposed, state `z` in place.
+    fn run(&self, x: &[f64], mut z: [f64; 2]) -> Vec<f64> {
+        let [b0, b1, b2] = self.b;
+        let [a1, a2] = self.a;
+        x.iter()
+            .map(|&x| {
+                let y = b0 * x + z[0];
+                z[0] = b1 * x - a1 * y + z[1];
+                z[1] = b2 * x - a2 * y;
+                y
+            })
+            .collect()
+    }
+
+    /// The state in which a constant input of 1 gives a constant output of 1 (unit
+    /// DC gain): starting there, a filter fed a signal starting at `x0` starts
+    /// without a step transient (scipy's `lfilter_zi`).
+    fn steady_state(&self) -> [f64; 2] {
+        let z1 = self.b[2] - self.a[1];
+        [1.0 - self.b[0], z1]
+    }
+}
+
+fn check_dt(dt: f64) -> Result<(), DataError> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(())
+    } else {
+        Err(DataError::InvalidArgument {
+            name: "dt",
+            value: dt,
+            expected: "a finite time step > 0 s".into(),
+        })
+    }
+}
+
+fn check_cutoff(dt: f64, cutoff_hz: f64) -> Result<(), DataError> {
+    let nyquist = 0.5 / dt;
+    if cutoff_hz.is_finite() && cutoff_hz > 0.0 && cutoff_hz < nyquist {
+        Ok(())
+    } else {
+        Err(DataError::InvalidArgument {
+            name: "cutoff_hz",
+            value: cutoff_hz,
+            expected: format!("0 < cutoff_hz < {nyquist} Hz (the Nyquist frequency of Δt = {dt} s)"),
+        })
+    }
+}
+
+fn check_finite(x: &[f64]) -> Result<(), DataError> {
+    match x.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(DataError::NonFinite {
+            at: Location::Sample(k),
+            column: "x".into(),
+            value: x[k],
+        }),
+    }
+}
+
+/// The `pad` samples before `x[0]`, oldest first: odd reflection about `x[0]`
+/// corrected for curvature, `x[−k] = 2 x[0] − x[k] + c k²`.
+///
+/// Plain odd reflection (`c = 0`) continues value and slope (and every odd power
+/// of a polynomial around `x[0]`) but flips the curvature; the filter then smears
+/// that kink, which biases the filtered slope at the end by about curvature ×
+/// filter width and the curvature itself by 100 %. `c = 2 c₂` restores the
+/// quadratic term, with `c₂` from a least-squares cubic fit to the first `fit`
+/// samples (a cubic, so that a cubic trend does not bias `c₂`; its odd terms are
+/// already continued exactly by the reflection).
+fn extension(x: &[f64], pad: usize, fit: usize) -> Vec<f64> {
+    let c = if fit >= 4 && x.len() >= fit {
+        quadratic_coefficient(&x[..fit])
+    } else {
+        0.0
+    };
+    (1..=pad)
+        .rev()
+        .map(|k| {
+            let k2 = (k * k) as f64;
+            2.0 * x[0] - x[k] + 2.0 * c * k2
+        })
+        .collect()
+}
+
+/// `c₂` of the least-squares cubic `c₀ + c₁ k + c₂ k² + c₃ k³` through `(k, x[k])`;
+/// 0 if the fit fails (it cannot for 4 or more samples).
+fn quadratic_coefficient(x: &[f64]) -> f64 {
+    // In the scaled abscissa s = k / len, for a well-conditioned normal matrix.
+    let scale = x.len() as f64;
+    let mut ata = Matrix4::zeros();
+    let mut atb = Vector4::zeros();
+    for (k, &xk) in x.iter().enumerate() {
+        let s = k as f64 / scale;
+        let p = Vector4::new(1.0, s, s * s, s * s * s);
+        ata += p * p.transpose();
+        atb += p * xk;
+    }
+    match ata.cholesky() {
+        Some(llt) => llt.solve(&atb)[2] / (scale * scale),
+        None => 0.0,
+    }
+}
+
+/// Zero-phase low-pass filtering of `x` (uniformly sampled every `dt` seconds):
+/// a 2nd-order Butterworth filter with cutoff `cutoff_hz`, run forward then
+/// backward (`filtfilt`), so the result has no lag and the magnitude response
+/// `1 / (1 + (f/f_c)⁴)` (prewarped: exact at `f_c`, where it is −6 dB).
+///
+/// Edges: the signal is extended at both ends over
+/// `min(len − 1, max(9, ⌈3 / (f_c Δt)⌉))` samples (three cutoff periods, about 13
+/// time constants of the filter) by odd reflection about the end value corrected
+/// for curvature: `x[−k] = 2 x[0] − x[k] + x″ (kΔt)²`, with `x″` from a
+/// least-squares cubic over the last `max(4, ⌈1 / (f_c Δt)⌉)` samples (one cutoff
+/// period: longer fits average noise better but miss faster curvature changes). The
+/// extension continues value, slope and curvature (plain odd reflection flips the
+/// curvature, which spoils derivatives at the ends). Each pass starts in the steady
+/// state of its first value; the padding is removed afterwards.
+///
+/// Errors: `dt` not positive and finite, `cutoff_hz` not in `(0, 1 / (2 dt))`, a
+/// non-finite value in `x`. Signals of 0 or 1 samples are returned unchanged.
+pub fn butterworth_filtfilt(x: &[f64], dt: f64, cutoff_hz: f64) -> Result<Vec<f64>, DataError> {
+    check_dt(dt)?;
+    check_cutoff(dt, cutoff_hz)?;
+    check_finite(x)?;
+    let n = x.len();
+    if n < 2 {
+        return Ok(x.to_vec());
+    }
+    let filter = Butterworth2::low_pass(dt, cutoff_hz);
+    // Samples per cutoff period, finite and positive here (casts saturate).
+    let period = 1.0 / (cutoff_hz * dt);
+    let pad = ((3.0 * period).ceil() as usize).max(9).min(n - 1);
+    let fit = (period.ceil() as usize).max(4).min(n);
+
+    let reversed: Vec<f64> = x.iter().rev().copied().collect();
+    let mut ext = Vec::with_capacity(n + 2 * pad);
+    ext.extend(extension(x, pad, fit));
+    ext.extend_from_slice(x);
+    ext.extend(extension(&reversed, pad, fit).into_iter().rev());
+
+    let zi = filter.steady_state();
+    let forward = filter.run(&ext, zi.map(|z| z * ext[0]));
+    let mut reversed: Vec<f64> = forward.into_iter().rev().collect();
+    let start = reversed[0];
+    reversed = filter.run(&reversed, zi.map(|z| z * start));
+    reversed.reverse();
+    reversed.truncate(pad + n);
+    reversed.drain(..pad);
+    Ok(reversed)
+}
+
+/// The derivative of `x` (uniformly sampled every `dt` seconds) by finite
+/// differences, second-order accurate everywhere: central `(x[k+1] − x[k−1]) / 2Δt`
+/// inside, one-sided `(−3 x[0] + 4 x[1] − x[2]) / 2Δt` and
+/// `(3 x[n−1] − 4 x[n−2] + x[n−3]) / 2Δt` at the ends. With exactly 2 samples both
+/// values are the forward difference.
+///
+/// Errors: `dt` not positive and finite, fewer than 2 samples, a non-finite value.
+pub fn central_difference(x: &[f64], dt: f64) -> Result<Vec<f64>, DataError> {
+    check_dt(dt)?;
+    check_finite(x)?;
+    let n = x.len();
+    if n < 2 {
+        return Err(DataError::TooFewSamples { found: n, needed: 2 });
+    }
+    if n == 2 {
+        let d = (x[1] - x[0]) / dt;
+        return Ok(vec![d, d]);
+    }
+    let h2 = 2.0 * dt;
+    let mut d = Vec::with_capacity(n);
+    d.push((-3.0 * x[0] + 4.0 * x[1] - x[2]) / h2);
+    d.extend(x.windows(3).map(|w| (w[2] - w[0]) / h2));
+    d.push((3.0 * x[n - 1] - 4.0 * x[n - 2] + x[n - 3]) / h2);
+    Ok(d)
+}
+
+/// The second derivative of `x` (uniformly sampled every `dt` seconds) by finite
+/// differences, second-order accurate everywhere: central
+/// `(x[k+1] − 2 x[k] + x[k−1]) / Δt²` inside, one-sided
+/// `(2 x[0] − 5 x[1] + 4 x[2] − x[3]) / Δt²` (and its mirror) at the ends. With
+/// exactly 3 samples all values are the central one.
+///
+/// Errors: `dt` not positive and finite, fewer than 3 samples, a non-finite value.
+pub fn second_difference(x: &[f64], dt: f64) -> Result<Vec<f64>, DataError> {
+    check_dt(dt)?;
+    check_finite(x)?;
+    let n = x.len();
+    if n < 3 {
+        return Err(DataError::TooFewSamples { found: n, needed: 3 });
+    }
+    let h2 = dt * dt;
+    let inner = x.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]) / h2);
+    if n == 3 {
+        let d = (x[2] - 2.0 * x[1] + x[0]) / h2;
+        return Ok(vec![d; 3]);
+    }
+    let mut d = Vec::with_capacity(n);
+    d.push((2.0 * x[0] - 5.0 * x[1] + 4.0 * x[2] - x[3]) / h2);
+    d.extend(inner);
+    d.push((2.0 * x[n - 1] - 5.0 * x[n - 2] + 4.0 * x[n - 3] - x[n - 4]) / h2);
+    Ok(d)
+}
+
+/// Per joint column of a row-major `len × dof` array: `f(F(column))`, `F` the filter.
+fn filtered(
+    values: &[f64],
+    dof: usize,
+    dt: f64,
+    cutoff_hz: f64,
+    f: impl Fn(&[f64], f64) -> Result<Vec<f64>, DataError>,
+) -> Result<Vec<f64>, DataError> {
+    let mut out = vec![0.0; values.len()];
+    for j in 0..dof {
+        let smooth = butterworth_filtfilt(&column(values, dof, j), dt, cutoff_hz)?;
+        set_column(&mut out, dof, j, &f(&smooth, dt)?);
+    }
+    Ok(out)
+}
+
+impl Trajectory {
+    /// The mean time step `(t[n−1] − t[0]) / (n − 1)`, after checking that every
+    /// step is within 1 % of it ([`SAMPLING_TOLERANCE`]); the error names the line
+    /// (or sample) that ends the first step out of tolerance.
+    pub fn uniform_time_step(&self) -> Result<f64, DataError> {
+        let t = self.t();
+        let n = t.len();
+        let nominal = (t[n - 1] - t[0]) / (n - 1) as f64;
+        for k in 1..n {
+            let step = t[k] - t[k - 1];
+            if (step - nominal).abs() > SAMPLING_TOLERANCE * nominal {
+                return Err(DataError::NonUniformSampling {
+                    at: self.location(k),
+                    step,
+                    nominal,
+                });
+            }
+        }
+        Ok(nominal)
+    }
+
+    /// The same trajectory with the missing velocities and accelerations computed
+    /// from the positions; values already present are kept, and so are `q` and
+    /// `tau` (they are not filtered).
+    ///
+    /// Per joint, with `F` = [`butterworth_filtfilt`] at `cutoff_hz`, `D` =
+    /// [`central_difference`] and `D²` = [`second_difference`] at the mean time step:
+    ///
+    /// - neither given: `v = D(F(q))`, `a = D²(F(q))` (one filter pass, both
+    ///   derivatives of the same smooth signal);
+    /// - only `v` given (measured): `a = D(F(v))`;
+    /// - only `a` given: `v = D(F(q))`.
+    ///
+    /// `D²` rather than `D(D(·))`: its stencil is half as wide, its truncation error
+    /// a quarter, and at the ends it avoids differentiating the one-sided
+    /// differences of `D` a second time.
+    ///
+    /// Errors: sampling not uniform within 1 % ([`Trajectory::uniform_time_step`]),
+    /// `cutoff_hz` not in `(0, f_s / 2)`, fewer than 3 samples when `a` is computed
+    /// from `q`.
+    pub fn with_derivatives(&self, cutoff_hz: f64) -> Result<Trajectory, DataError> {
+        let dt = self.uniform_time_step()?;
+        check_cutoff(dt, cutoff_hz)?;
+        let dof = self.dof();
+        let q = self.positions();
+        let (v, a) = match (self.velocities(), self.accelerations()) {
+            (Some(v), Some(a)) => (v.to_vec(), a.to_vec()),
+            (Some(v), None) => (v.to_vec(), filtered(v, dof, dt, cutoff_hz, central_difference)?),
+            (None, Some(a)) => (filtered(q, dof, dt, cutoff_hz, central_difference)?, a.to_vec()),
+            (None, None) => {
+                let mut v = vec![0.0; q.len()];
+                let mut a = vec![0.0; q.len()];
+                for j in 0..dof {
+                    let smooth = butterworth_filtfilt(&column(q, dof, j), dt, cutoff_hz)?;
+                    set_column(&mut v, dof, j, &central_difference(&smooth, dt)?);
+                    set_column(&mut a, dof, j, &second_difference(&smooth, dt)?);
+                }
+                (v, a)
+            }
+        };
+        let mut out = self.clone();
+        out.set_derivatives(Some(v), Some(a))?;
+        Ok(out)
+    }
+}

@@ -1,0 +1,233 @@
+//! One error type for everything the data module reads, checks, filters and writes.
+//! Each variant says where (file line, or sample index for data built in memory) and
+//! what would have been valid.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// Where a value sits: a line of a CSV file (1-based, as an editor shows it), or a
+/// sample index (0-based) of a trajectory built in memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Location {
+    Line(u64),
+    Sample(usize),
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(line) => write!(f, "line {line}"),
+            Location::Sample(k) => write!(f, "sample {k} (0-based)"),
+        }
+    }
+}
+
+/// Bad data or a failed read/write. Messages name the line (1-based file line) and
+/// the column, and say what would be valid.
+///
+/// The CSV reader collects up to [`MAX_ERRORS`](super::MAX_ERRORS) errors in one pass
+/// and returns a single one as itself, several as [`DataError::Multiple`]; use
+/// [`DataError::errors`] to go through them either way.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum DataError {
+    /// The file could not be opened, read or written.
+    Io {
+        path: Option<PathBuf>,
+        source: std::io::Error,
+    },
+    /// [`write_csv`](super::write_csv) refuses to replace an existing file.
+    FileExists { path: PathBuf },
+    /// The input has no lines at all (or only blank ones).
+    Empty,
+    /// The first line holds numbers (or nothing), not column names.
+    MissingHeader { line: u64, found: String },
+    /// A header name that is not in the schema for this number of joints.
+    UnknownColumn {
+        line: u64,
+        column: String,
+        position: usize,
+        valid: String,
+    },
+    /// The same column name twice in the header (`first`, `second`: 1-based positions).
+    DuplicateColumn {
+        line: u64,
+        column: String,
+        first: usize,
+        second: usize,
+    },
+    /// A column the schema requires (`t`, every `q`, every `tau`) is absent.
+    MissingColumn { line: u64, column: String, valid: String },
+    /// Part of an optional group (`v`, `a`, joint wrenches) is present, part is not.
+    IncompleteGroup {
+        line: u64,
+        group: &'static str,
+        present: usize,
+        missing: Vec<String>,
+    },
+    /// The number of joints asked for differs from the file's `q` columns.
+    DofMismatch { line: u64, expected: usize, found: usize },
+    /// A row with too few or too many fields.
+    FieldCount { line: u64, expected: usize, found: usize },
+    /// A field that does not parse as a number.
+    NotANumber { line: u64, column: String, text: String },
+    /// NaN or ±infinity.
+    NonFinite { at: Location, column: String, value: f64 },
+    /// `t` not strictly increasing.
+    NonMonotonicTime { at: Location, t: f64, previous: f64 },
+    /// Too few samples: a trajectory needs 2, a second difference 3.
+    TooFewSamples { found: usize, needed: usize },
+    /// A time step that differs from the mean step by more than 1 %.
+    NonUniformSampling { at: Location, step: f64, nominal: f64 },
+    /// An in-memory array whose length does not fit the trajectory.
+    LengthMismatch {
+        what: &'static str,
+        expected: usize,
+        found: usize,
+    },
+    /// An argument out of its valid range (`dof`, `dt`, `cutoff_hz`).
+    InvalidArgument {
+        name: &'static str,
+        value: f64,
+        expected: String,
+    },
+    /// The CSV layer itself failed (for example invalid UTF-8).
+    Malformed { line: Option<u64>, message: String },
+    /// Several errors found in one pass (at most [`MAX_ERRORS`](super::MAX_ERRORS));
+    /// `truncated` when reading stopped there.
+    Multiple { errors: Vec<DataError>, truncated: bool },
+}
+
+impl DataError {
+    /// The individual errors: the errors of a [`DataError::Multiple`], or `self`.
+    pub fn errors(&self) -> &[DataError] {
+        match self {
+            DataError::Multiple { errors, .. } => errors,
+            other => std::slice::from_ref(other),
+        }
+    }
+
+    /// The 1-based file line this error is about, when it is about one line.
+    pub fn line(&self) -> Option<u64> {
+        match self {
+            DataError::MissingHeader { line, .. }
+            | DataError::UnknownColumn { line, .. }
+            | DataError::DuplicateColumn { line, .. }
+            | DataError::MissingColumn { line, .. }
+            | DataError::IncompleteGroup { line, .. }
+            | DataError::DofMismatch { line, .. }
+            | DataError::FieldCount { line, .. }
+            | DataError::NotANumber { line, .. } => Some(*line),
+            DataError::NonFinite { at, .. }
+            | DataError::NonMonotonicTime { at, .. }
+            | DataError::NonUniformSampling { at, .. } => match at {
+                Location::Line(line) => Some(*line),
+                Location::Sample(_) => None,
+            },
+            DataError::Malformed { line, .. } => *line,
+            DataError::Multiple { errors, .. } => errors.first().and_then(DataError::line),
+            _ => None,
+        }
+    }
+
+    /// The error of a failed `io` operation on `path`.
+    pub(crate) fn io(path: Option<PathBuf>, source: std::io::Error) -> Self {
+        DataError::Io { path, source }
+    }
+}
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DataError::Io { path: Some(path), source } => write!(f, "cannot access `{}`: {source}", path.display()),
+            DataError::Io { path: None, source } => write!(f, "input/output error: {source}"),
+            DataError::FileExists { path } => write!(
+                f,
+                "`{}` already exists; refusing to overwrite it (use `overwrite_csv` to replace it)",
+                path.display()
+            ),
+            DataError::Empty => write!(
+                f,
+                "the input is empty; expected a header line `t, q1, …, tau1, …` followed by at least 2 rows"
+            ),
+            DataError::MissingHeader { line, found } => write!(
+                f,
+                "line {line}: expected a header of column names (`t, q1, …, tau1, …`), found `{found}`"
+            ),
+            DataError::UnknownColumn { line, column, position, valid } => {
+                write!(f, "line {line}, column {position}: unknown column `{column}`; valid columns: {valid}")
+            }
+            DataError::DuplicateColumn { line, column, first, second } => {
+                write!(f, "line {line}: column `{column}` appears twice (columns {first} and {second})")
+            }
+            DataError::MissingColumn { line, column, valid } => {
+                write!(f, "line {line}: missing required column `{column}`; a file needs {valid}")
+            }
+            DataError::IncompleteGroup { line, group, present, missing } => write!(
+                f,
+                "line {line}: incomplete {group} columns: {present} present but {} missing ({}); give all of them or none",
+                missing.len(),
+                missing.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ")
+            ),
+            DataError::DofMismatch { line, expected, found } => write!(
+                f,
+                "line {line}: the header has `q1`..`q{found}` ({found} joints) but {expected} joints were expected \
+                 (`q1`..`q{expected}`)"
+            ),
+            DataError::FieldCount { line, expected, found } => {
+                let what = if found < expected { "too few" } else { "too many" };
+                write!(f, "line {line}: {what} fields: {found}, expected {expected} (one per header column)")
+            }
+            DataError::NotANumber { line, column, text } if text.is_empty() => {
+                write!(f, "line {line}, column `{column}`: empty field; expected a number")
+            }
+            DataError::NotANumber { line, column, text } => {
+                write!(f, "line {line}, column `{column}`: `{text}` is not a number")
+            }
+            DataError::NonFinite { at, column, value } => {
+                write!(f, "{at}, column `{column}`: {value} is not a finite number")
+            }
+            DataError::NonMonotonicTime { at, t, previous } => write!(
+                f,
+                "{at}: time t = {t} s does not increase (previous t = {previous} s); t must be strictly increasing"
+            ),
+            DataError::TooFewSamples { found, needed } => {
+                write!(f, "{found} sample(s); at least {needed} are needed")
+            }
+            DataError::NonUniformSampling { at, step, nominal } => write!(
+                f,
+                "{at}: time step {step} s differs from the mean step {nominal} s by {:.3} %; \
+                 filtering and differentiation need uniform sampling (within 1 %)",
+                100.0 * (step - nominal).abs() / nominal
+            ),
+            DataError::LengthMismatch { what, expected, found } => {
+                write!(f, "`{what}` has {found} values, expected {expected}")
+            }
+            DataError::InvalidArgument { name, value, expected } => {
+                write!(f, "invalid `{name}` = {value}: expected {expected}")
+            }
+            DataError::Malformed { line: Some(line), message } => write!(f, "line {line}: malformed CSV: {message}"),
+            DataError::Malformed { line: None, message } => write!(f, "malformed CSV: {message}"),
+            DataError::Multiple { errors, truncated } => {
+                write!(f, "{} errors", errors.len())?;
+                if *truncated {
+                    write!(f, " (stopped reading there)")?;
+                }
+                write!(f, ":")?;
+                for e in errors {
+                    write!(f, "\n  {e}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl std::error::Error for DataError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            DataError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}

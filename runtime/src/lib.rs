@@ -10,7 +10,9 @@
 pub mod data;
 pub mod dynamics;
 pub mod identify;
+pub mod mim;
 pub mod reference;
+pub mod report;
 mod robot;
 mod scalar;
 pub mod simulate;

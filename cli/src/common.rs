@@ -1,0 +1,113 @@
+//! What every subcommand shares: loading a URDF, the gravity option, progress bars.
+
+use dyngen_model::Model;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::Path;
+use std::time::Duration;
+
+/// A subcommand's result: the error text is printed after `error: `.
+pub type Result<T> = std::result::Result<T, String>;
+
+/// `--gravity gx gy gz`.
+#[derive(Clone, Debug, clap::Args)]
+pub struct GravityArg {
+    /// Gravity in the base frame, m/s² (default: the URDF's model default, 0 0 -9.81).
+    #[arg(long, num_args = 3, value_names = ["GX", "GY", "GZ"], allow_negative_numbers = true)]
+    pub gravity: Option<Vec<f64>>,
+}
+
+impl GravityArg {
+    pub fn get(&self) -> Result<Option<[f64; 3]>> {
+        match &self.gravity {
+            None => Ok(None),
+            Some(g) if g.len() == 3 && g.iter().all(|x| x.is_finite()) => Ok(Some([g[0], g[1], g[2]])),
+            Some(g) => Err(format!("--gravity needs three finite numbers, got {g:?}")),
+        }
+    }
+}
+
+/// Reads, parses and checks the URDF at `path` (all errors as `file:line: message`),
+/// then sets the gravity when given.
+pub fn load_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
+    let mut model = dyngen_model::load_urdf(path).map_err(|e| e.to_string())?;
+    if let Some(g) = gravity {
+        model.gravity = g;
+    }
+    Ok(model)
+}
+
+/// Like [`load_model`], and refuses a model without moving joints.
+pub fn load_moving_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
+    let model = load_model(path, gravity)?;
+    if model.dof() == 0 {
+        return Err(format!("{}: the robot has no moving joints", path.display()));
+    }
+    Ok(model)
+}
+
+/// Progress bars on stderr, hidden with `--quiet` or when stdout is not a terminal.
+pub struct Progress {
+    visible: bool,
+}
+
+impl Progress {
+    pub fn new(quiet: bool) -> Progress {
+        Progress {
+            visible: !quiet && std::io::stdout().is_terminal(),
+        }
+    }
+
+    fn target(&self) -> ProgressDrawTarget {
+        if self.visible {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        }
+    }
+
+    /// A spinner for work without a known length; finish it with `finish_and_clear`.
+    pub fn spinner(&self, message: impl Into<String>) -> ProgressBar {
+        let bar = ProgressBar::with_draw_target(None, self.target());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.set_message(message.into());
+        if self.visible {
+            bar.enable_steady_tick(Duration::from_millis(100));
+        }
+        bar
+    }
+
+    /// A bar over `len` steps.
+    pub fn bar(&self, len: u64, message: impl Into<String>) -> ProgressBar {
+        let bar = ProgressBar::with_draw_target(Some(len), self.target());
+        bar.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        bar.set_message(message.into());
+        bar
+    }
+}
+
+/// Runs `work` under a spinner showing `message`.
+pub fn with_spinner<T>(progress: &Progress, message: &str, work: impl FnOnce() -> T) -> T {
+    let spinner = progress.spinner(message);
+    let out = work();
+    spinner.finish_and_clear();
+    out
+}
+
+/// Refuses to replace an existing file unless `force`.
+pub fn check_overwrite(path: &Path, force: bool) -> Result<()> {
+    if !force && path.exists() {
+        return Err(format!(
+            "{} already exists; pass --force to overwrite it",
+            path.display()
+        ));
+    }
+    Ok(())
+}

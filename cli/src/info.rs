@@ -1,0 +1,180 @@
+//! `dyngen info`: what dyngen sees in a URDF.
+
+use crate::common::{load_model, with_spinner, GravityArg, Progress, Result};
+use dyngen_codegen::{generate, Options};
+use dyngen_model::graph::{incidence, path_matrix};
+use dyngen_model::Model;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+pub const EXAMPLES: &str = "\
+Examples:
+  dyngen info robots/ur5/ur5.urdf
+  dyngen info robots/ur5/ur5.urdf --no-ops          # skip code generation (faster)
+  dyngen info arm.urdf --gravity 0 -9.81 0";
+
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// The robot description (URDF).
+    pub urdf: PathBuf,
+
+    #[command(flatten)]
+    pub gravity: GravityArg,
+
+    /// Skip the base parameters and operation counts (they need a full code
+    /// generation, which takes a few seconds for a 6–7 DOF arm).
+    #[arg(long)]
+    pub no_ops: bool,
+}
+
+pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
+    let model = load_model(&args.urdf, args.gravity.get()?)?;
+    let mut out = topology(&model, &args.urdf);
+    let n = model.dof();
+    writeln!(out).ok();
+    writeln!(out, "Parameters").ok();
+    writeln!(
+        out,
+        "  standard (m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz per body): 10n = {}",
+        10 * n
+    )
+    .ok();
+    writeln!(
+        out,
+        "  principal (m, J1, J2, J3 per body):                        4n = {}",
+        4 * n
+    )
+    .ok();
+    if args.no_ops || n == 0 {
+        print!("{out}");
+        return Ok(());
+    }
+    let generated = with_spinner(
+        progress,
+        "generating code for the base parameters and op counts",
+        || generate(&model, "Robot", &Options::default()),
+    );
+    let base = &generated.base;
+    let pbase = &generated.principal_base;
+    writeln!(
+        out,
+        "  base (identifiable from joint torques):                    {}",
+        base.count()
+    )
+    .ok();
+    writeln!(
+        out,
+        "  principal base:                                            {}",
+        pbase.count()
+    )
+    .ok();
+    for (title, b) in [
+        ("Base parameters (standard)", base),
+        ("Base parameters (principal)", pbase),
+    ] {
+        writeln!(out).ok();
+        let note = if b.confirmed {
+            ""
+        } else {
+            " (not confirmed by a second random seed)"
+        };
+        writeln!(out, "{title}{note}").ok();
+        for (k, g) in b.groupings.iter().enumerate() {
+            writeln!(out, "  {:>3}  {g}", k + 1).ok();
+        }
+    }
+    writeln!(out).ok();
+    writeln!(out, "Generated functions (operation counts)").ok();
+    for line in generated.op_report().lines() {
+        writeln!(out, "  {line}").ok();
+    }
+    print!("{out}");
+    Ok(())
+}
+
+fn topology(model: &Model, path: &std::path::Path) -> String {
+    let n = model.dof();
+    let mut out = String::new();
+    let g = model.gravity;
+    writeln!(out, "Robot `{}` from {}", model.name, path.display()).ok();
+    writeln!(
+        out,
+        "  {n} moving bodies, {n} joints, base link `{}`, gravity [{}, {}, {}] m/s²",
+        model.base, g[0], g[1], g[2]
+    )
+    .ok();
+    writeln!(out).ok();
+    writeln!(out, "Joints (joint j carries body j; parent 0 is the base)").ok();
+    let width = model.joints.iter().map(|j| j.name.len()).max().unwrap_or(4).max(4);
+    writeln!(
+        out,
+        "  {:>3}  {:<width$}  {:<10}  {:>6}  {:<24}  limits",
+        "j", "name", "type", "parent", "axis"
+    )
+    .ok();
+    for (k, j) in model.joints.iter().enumerate() {
+        let axis = format!("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2]);
+        let limits = match j.limits {
+            Some(l) => format!("[{}, {}], v ≤ {}, effort ≤ {}", l.lower, l.upper, l.velocity, l.effort),
+            None => "—".to_string(),
+        };
+        writeln!(
+            out,
+            "  {:>3}  {:<width$}  {:<10}  {:>6}  {:<24}  {limits}",
+            k + 1,
+            j.name,
+            j.kind.urdf_name(),
+            j.parent,
+            axis
+        )
+        .ok();
+    }
+    writeln!(out).ok();
+    writeln!(out, "Bodies").ok();
+    let width = model.bodies.iter().map(|b| b.name.len()).max().unwrap_or(4).max(4);
+    writeln!(
+        out,
+        "  {:>3}  {:<width$}  {:>10}  merged fixed links",
+        "i", "name", "mass/kg"
+    )
+    .ok();
+    writeln!(out, "  {:>3}  {:<width$}  {:>10}  (base)", 0, model.base, "—").ok();
+    for (k, b) in model.bodies.iter().enumerate() {
+        let merged = if b.merged.is_empty() {
+            "—".to_string()
+        } else {
+            b.merged.join(", ")
+        };
+        writeln!(
+            out,
+            "  {:>3}  {:<width$}  {:>10.4}  {merged}",
+            k + 1,
+            b.name,
+            b.inertial.mass
+        )
+        .ok();
+    }
+    if n > 0 {
+        writeln!(out).ok();
+        writeln!(
+            out,
+            "Incidence matrix S (rows bodies 0 = base, 1..{n}; columns joints 1..{n})"
+        )
+        .ok();
+        out.push_str(&matrix(&incidence(model), 0));
+        writeln!(out).ok();
+        writeln!(out, "Path matrix T = S⁻¹ (rows joints 1..{n}; columns bodies 1..{n})").ok();
+        out.push_str(&matrix(&path_matrix(model), 1));
+    }
+    out
+}
+
+/// An integer matrix with row labels starting at `first_row`.
+fn matrix(m: &[Vec<i8>], first_row: usize) -> String {
+    let mut out = String::new();
+    for (r, row) in m.iter().enumerate() {
+        let cells: Vec<String> = row.iter().map(|x| format!("{x:>2}")).collect();
+        writeln!(out, "  {:>3} [{} ]", r + first_row, cells.join(" ")).ok();
+    }
+    out
+}

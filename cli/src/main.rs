@@ -1,0 +1,99 @@
+//! `dyngen`: the command line of dyngen. Every subcommand works on any URDF given at
+//! run time, through the reference implementation (`dyngen::Reference`, behind the
+//! `dyngen::dynamics::Dynamics` trait).
+//!
+//! Errors are printed as `error: …` on stderr with exit code 1; bad input never
+//! panics.
+
+mod common;
+mod generate;
+mod identify;
+mod info;
+mod simulate;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+const EXAMPLES: &str = "\
+Examples:
+  dyngen info robots/ur5/ur5.urdf
+  dyngen generate robots/ur5/ur5.urdf --name Ur5 -o ur5.rs
+  dyngen simulate robots/ur5/ur5.urdf -o ur5.csv --experiment fourier --noise 0.01
+  dyngen identify robots/ur5/ur5.urdf ur5.csv --method wls
+
+Run `dyngen <command> --help` for the options of one command.";
+
+/// Robot dynamics from a URDF: inspect it, generate specialised Rust for it, simulate
+/// identification experiments, identify its inertial parameters.
+#[derive(Debug, Parser)]
+#[command(name = "dyngen", version, after_help = EXAMPLES)]
+pub struct Cli {
+    /// No progress bars (they are also hidden when stdout is not a terminal).
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Topology, incidence and path matrices, parameter counts, base parameters and
+    /// operation counts of a URDF.
+    #[command(after_help = info::EXAMPLES)]
+    Info(info::InfoArgs),
+    /// Generate the specialised Rust code for a URDF (what `build.rs` does), to a file
+    /// or stdout.
+    #[command(after_help = generate::EXAMPLES)]
+    Generate(generate::GenerateArgs),
+    /// Simulate an identification experiment with the URDF's nominal parameters and
+    /// write the measurements as CSV.
+    #[command(after_help = simulate::EXAMPLES)]
+    Simulate(simulate::SimulateArgs),
+    /// Identify the standard inertial parameters from joint torques in a CSV file.
+    #[command(after_help = identify::EXAMPLES)]
+    Identify(identify::IdentifyArgs),
+}
+
+fn main() -> ExitCode {
+    install_panic_hook();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // `--help` and `--version` are not errors.
+            let code = if e.use_stderr() { 1 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let progress = common::Progress::new(cli.quiet);
+    let result = match &cli.command {
+        Command::Info(args) => info::run(args, &progress),
+        Command::Generate(args) => generate::run(args, &progress),
+        Command::Simulate(args) => simulate::run(args, &progress),
+        Command::Identify(args) => identify::run(args, &progress),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A last resort: a panic is a bug of dyngen, never of the input, but it should
+/// still read like the other errors and exit with 1.
+fn install_panic_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".to_string());
+        let location = info.location().map(|l| format!(" at {l}")).unwrap_or_default();
+        eprintln!("error: internal error{location}: {message} (this is a bug of dyngen; please report it)");
+        std::process::exit(1);
+    }));
+}

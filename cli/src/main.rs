@@ -6,6 +6,7 @@
 //! panics.
 
 mod common;
+mod demo;
 mod generate;
 mod identify;
 mod info;
@@ -20,6 +21,7 @@ Examples:
   dyngen generate robots/ur5/ur5.urdf --name Ur5 -o ur5.rs
   dyngen simulate robots/ur5/ur5.urdf -o ur5.csv --experiment fourier --noise 0.01
   dyngen identify robots/ur5/ur5.urdf ur5.csv --method wls
+  dyngen demo
 
 Run `dyngen <command> --help` for the options of one command.";
 
@@ -53,6 +55,10 @@ pub enum Command {
     /// Identify the standard inertial parameters from joint torques in a CSV file.
     #[command(after_help = identify::EXAMPLES)]
     Identify(identify::IdentifyArgs),
+    /// The paper's experiment on its 6-DOF manipulator, identified by MIM: Tables 2–3
+    /// from one instant and from all samples, noise-free and with sensor noise.
+    #[command(after_help = demo::EXAMPLES)]
+    Demo(demo::DemoArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +78,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(args, &progress),
         Command::Simulate(args) => simulate::run(args, &progress),
         Command::Identify(args) => identify::run(args, &progress),
+        Command::Demo(args) => demo::run(args, &progress),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,61 +1,8 @@
 //! The `dyngen` binary end to end, on robots/ur5/ur5.urdf and broken inputs.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn ur5() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf")
-}
-
-/// A fresh directory for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("dyngen-cli").join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn dyngen(args: &[&std::ffi::OsStr]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dyngen"))
-        .args(args)
-        .output()
-        .expect("run dyngen")
-}
-
-macro_rules! run {
-    ($($arg:expr),* $(,)?) => {
-        dyngen(&[$(std::ffi::OsStr::new(&$arg)),*])
-    };
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-#[track_caller]
-fn assert_ok(o: &Output) {
-    assert!(
-        o.status.success(),
-        "dyngen failed ({:?}):\n{}\n{}",
-        o.status,
-        stdout(o),
-        stderr(o)
-    );
-}
-
-/// Exit code 1, one `error: ` message containing `needle`, no panic.
-#[track_caller]
-fn assert_error(o: &Output, needle: &str) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(1), "stdout:\n{}\nstderr:\n{err}", stdout(o));
-    assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(needle), "expected `{needle}` in:\n{err}");
-    assert!(!err.contains("panicked") && !err.contains("internal error"), "{err}");
-}
+use common::{assert_error, assert_ok, run, stderr, stdout, temp_dir, ur5};
 
 #[test]
 fn help_has_examples() {
@@ -94,7 +41,7 @@ fn info_prints_topology_matrices_and_base_count() {
 
 #[test]
 fn generate_writes_header_and_refuses_to_overwrite() {
-    let dir = temp_dir("generate");
+    let dir = temp_dir("dyngen-cli", "generate");
     let file = dir.join("ur5.rs");
     let o = run!("generate", ur5(), "--name", "Ur5", "-o", file);
     assert_ok(&o);
@@ -121,7 +68,7 @@ fn generate_writes_header_and_refuses_to_overwrite() {
 
 #[test]
 fn simulate_then_identify_recovers_the_torques() {
-    let dir = temp_dir("identify");
+    let dir = temp_dir("dyngen-cli", "identify");
     let csv = dir.join("ur5.csv");
     // `--evaluations 0`: the optimiser's random feasible start, enough excitation
     // for noise-free data and fast in a debug build.
@@ -166,7 +113,7 @@ fn simulate_then_identify_recovers_the_torques() {
 
 #[test]
 fn paper_experiment_has_default_length() {
-    let dir = temp_dir("paper");
+    let dir = temp_dir("dyngen-cli", "paper");
     let csv = dir.join("paper.csv");
     let o = run!("simulate", ur5(), "-o", csv, "--noise", "0.01", "--seed", "4");
     assert_ok(&o);
@@ -177,7 +124,7 @@ fn paper_experiment_has_default_length() {
 
 #[test]
 fn bad_inputs_name_the_file_and_line() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("dyngen-cli", "bad");
     // Missing file.
     let missing = dir.join("missing.urdf");
     assert_error(&run!("info", missing), "missing.urdf");

@@ -1,64 +1,10 @@
 //! `dyngen identify` with --params-json, --svg and --urdf-out on robots/ur5/ur5.urdf.
 
 use dyngen::report::{ParamStatus, ParameterReport};
+mod common;
+
+use common::{assert_error, assert_ok, run, stderr, stdout, temp_dir, ur5};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn ur5() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf")
-}
-
-/// A fresh directory for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("dyngen-cli-identify-outputs")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn dyngen(args: &[&std::ffi::OsStr]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dyngen"))
-        .args(args)
-        .output()
-        .expect("run dyngen")
-}
-
-macro_rules! run {
-    ($($arg:expr),* $(,)?) => {
-        dyngen(&[$(std::ffi::OsStr::new(&$arg)),*])
-    };
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-#[track_caller]
-fn assert_ok(o: &Output) {
-    assert!(
-        o.status.success(),
-        "dyngen failed ({:?}):\n{}\n{}",
-        o.status,
-        stdout(o),
-        stderr(o)
-    );
-}
-
-/// Exit code 1, one `error: ` message containing `needle`, no panic.
-#[track_caller]
-fn assert_error(o: &Output, needle: &str) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(1), "stdout:\n{}\nstderr:\n{err}", stdout(o));
-    assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(needle), "expected `{needle}` in:\n{err}");
-    assert!(!err.contains("panicked") && !err.contains("internal error"), "{err}");
-}
 
 const JOINTS: [&str; 6] = [
     "shoulder_pan_joint",
@@ -90,7 +36,7 @@ fn simulate(dir: &Path) -> PathBuf {
 
 #[test]
 fn identify_writes_json_svg_and_urdf() {
-    let dir = temp_dir("all");
+    let dir = temp_dir("dyngen-cli-identify-outputs", "all");
     let csv = simulate(&dir);
     let json = dir.join("ur5.json");
     let svg = dir.join("ur5.svg");
@@ -191,7 +137,7 @@ fn identify_writes_json_svg_and_urdf() {
 
 #[test]
 fn identify_output_flags_are_checked() {
-    let dir = temp_dir("flags");
+    let dir = temp_dir("dyngen-cli-identify-outputs", "flags");
     let csv = simulate(&dir);
     let same = dir.join("out");
     let o = run!("identify", ur5(), csv, "--params-json", same, "--svg", same);

@@ -19,12 +19,6 @@ use std::time::Instant;
 
 const STATES: usize = 2000;
 
-fn reference_of<R: Robot>() -> Reference {
-    let mut model = dyngen::model::parse_urdf(R::urdf()).expect("generated URDF parses");
-    model.gravity = R::gravity();
-    Reference::new(&model)
-}
-
 /// Median over 5 rounds of the mean time per call, in nanoseconds.
 fn time_ns(mut f: impl FnMut(usize)) -> f64 {
     let mut rounds: Vec<f64> = (0..5)
@@ -41,7 +35,7 @@ fn time_ns(mut f: impl FnMut(usize)) -> f64 {
 }
 
 fn tour<R: Robot>() {
-    let reference = reference_of::<R>();
+    let reference = Reference::of::<R>();
     let states = sample_states(reference.model(), STATES, 42);
     let params = R::nominal_params();
     let mut worst = 0.0f64;
@@ -94,7 +88,7 @@ fn main() {
     tour::<Puma560>();
     tour::<Panda>();
 
-    let model = reference_of::<Paper6>().model().clone();
+    let model = Reference::of::<Paper6>().model().clone();
     println!("\nThe paper's 6-DOF manipulator as a graph (DESIGN §4):");
     println!("incidence matrix S (rows bodies 0..6, columns joints 1..6):");
     for row in graph::incidence(&model) {

@@ -47,27 +47,9 @@ pub fn analyse(
 ) -> BaseParams {
     let n = model.dof();
     let p = names.len();
-    let mut rng = SplitMix64(seed);
     let mut rows: Vec<Vec<f64>> = Vec::with_capacity(SAMPLES * n);
-    for _ in 0..SAMPLES {
-        let q: Vec<f64> = model
-            .joints
-            .iter()
-            .map(|j| {
-                let reach = if j.kind.is_revolute() {
-                    std::f64::consts::PI
-                } else {
-                    0.5
-                };
-                let (lo, hi) = j
-                    .limits
-                    .map_or((-reach, reach), |l| (l.lower.max(-reach), l.upper.min(reach)));
-                rng.uniform(lo, hi)
-            })
-            .collect();
-        let v: Vec<f64> = (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect();
-        let a: Vec<f64> = (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect();
-        rows.extend(regressor(&q, &v, &a));
+    for state in dyngen_model::sample::sample_states(model, SAMPLES, seed) {
+        rows.extend(regressor(&state.q, &state.v, &state.a));
     }
     let (perm, r, rank) = ordered_qr(&mut rows, p);
     // Y_dep = Y_ind R11⁻¹ R12, so β = π_ind + (R11⁻¹ R12) π_dep.
@@ -183,24 +165,6 @@ fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize
     let perm: Vec<usize> = kept.iter().chain(dropped.iter()).copied().collect();
     let r: Vec<Vec<f64>> = (0..rank).map(|row| perm.iter().map(|&c| a[row][c]).collect()).collect();
     (perm, r, rank)
-}
-
-/// SplitMix64: a fixed, documented generator so the analysis is the same on every
-/// machine and in every version.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next() >> 11) as f64 / (1u64 << 53) as f64)
-    }
 }
 
 #[cfg(test)]

@@ -24,8 +24,10 @@ pub mod graph;
 mod ir;
 pub mod math;
 pub mod principal;
+pub mod sample;
 pub mod urdf;
 mod write;
+pub mod xml;
 
 pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};

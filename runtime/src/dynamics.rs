@@ -178,11 +178,8 @@ impl<R: Robot> Generated<R> {
     /// Parses `R::urdf()` and sets the gravity `R` was generated for. Panics if the
     /// URDF does not parse, which would be a bug of the generator.
     pub fn new() -> Generated<R> {
-        let mut model = dyngen_model::parse_urdf(R::urdf())
-            .unwrap_or_else(|e| panic!("dyngen: the URDF generated for `{}` does not parse: {e}", R::NAME));
-        model.gravity = R::gravity();
         Generated {
-            reference: Reference::new(&model),
+            reference: Reference::of::<R>(),
             robot: PhantomData,
         }
     }

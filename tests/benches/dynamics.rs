@@ -3,9 +3,9 @@
 //! Ratios against Pinocchio are measured in the same sitting; see docs/benchmarks.md.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use dyngen::reference::Reference;
 use dyngen::reference::{sample_states, State};
 use dyngen::{Pose, Robot, Wrench};
-use dyngen_tests::reference_of;
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;
@@ -14,13 +14,13 @@ use robot_puma560::Puma560;
 use robot_ur5::Ur5;
 
 fn states<R: Robot>() -> Vec<State> {
-    sample_states(reference_of::<R>().model(), 1000, 7)
+    sample_states(Reference::of::<R>().model(), 1000, 7)
 }
 
 fn bench_robot<R: Robot>(c: &mut Criterion, name: &str) {
     let states = states::<R>();
     let params = R::nominal_params().to_vec();
-    let reference = reference_of::<R>();
+    let reference = Reference::of::<R>();
     let mut group = c.benchmark_group(name);
     let mut k = 0;
     let mut tau = vec![0.0; R::NV];

@@ -13,13 +13,13 @@
 //! `scripts/bench_identification_pinocchio.py` (Pinocchio's regressor plus numpy
 //! least squares), to be run in the same sitting; see docs/benchmarks.md.
 
+use dyngen::reference::Reference;
 use std::time::{Duration, Instant};
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use dyngen::identify::faer::MatRef;
 use dyngen::identify::{Accumulator, Channels, Estimate};
 use dyngen::reference::{sample_states, SplitMix64};
-use dyngen_tests::reference_of;
 use robot_panda::Panda;
 
 const N: usize = 100_000;
@@ -52,7 +52,7 @@ fn gaussian(rng: &mut SplitMix64) -> f64 {
 }
 
 fn data() -> Data {
-    let reference = reference_of::<Panda>();
+    let reference = Reference::of::<Panda>();
     let states = sample_states(reference.model(), N, SEED);
     let mut rng = SplitMix64::new(SEED + 1);
     let mut d = Data {

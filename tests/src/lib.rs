@@ -14,18 +14,8 @@ pub mod tree12 {
     dyngen::robot!(name: Tree12, urdf: "fixtures/tree12.urdf");
 }
 
-use dyngen::reference::Reference;
-use dyngen::Robot;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
-
-/// The reference implementation of a generated robot, rebuilt from its URDF.
-pub fn reference_of<R: Robot>() -> Reference {
-    let mut model =
-        dyngen_model::parse_urdf(R::urdf()).unwrap_or_else(|e| panic!("{}: URDF does not parse back:\n{e}", R::NAME));
-    model.gravity = R::gravity();
-    Reference::new(&model)
-}
 
 /// Normwise relative error `‖x − y‖∞ / max(‖y‖∞, floor)`.
 pub fn rel_err(x: &[f64], y: &[f64], floor: f64) -> f64 {

@@ -1,10 +1,11 @@
 //! Generated code against the reference implementation on 1,000 random states per
 //! robot (fixed seeds), with nominal and with perturbed parameters.
 
+use dyngen::reference::Reference;
 use dyngen::reference::{perturbed_params, sample_states};
 use dyngen::{BodyRegressor, Pose, Robot, Wrench};
 use dyngen_tests::tree12::Tree12;
-use dyngen_tests::{pose_vec, reference_of, rel_err, wrench_vec};
+use dyngen_tests::{pose_vec, rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;
@@ -23,7 +24,7 @@ fn mat(rows: usize, cols: usize, data: &[f64]) -> nalgebra::DMatrix<f64> {
 /// crba, aba, torque regressor, wrench regressor, principal regressor, body
 /// regressors, body resultants).
 fn check<R: Robot>(seed: u64) -> [f64; 10] {
-    let reference = reference_of::<R>();
+    let reference = Reference::of::<R>();
     let model = reference.model().clone();
     let n = R::NV;
     let mut worst = [0.0f64; 10];

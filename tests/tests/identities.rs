@@ -5,10 +5,11 @@
 //! `aba(q, v, rnea(q, v, a)) = a`, `nle = rnea(q, v, 0)`, `g = rnea(q, 0, 0)`, and the
 //! paper's decoupling `A_i θ_i` = body resultants.
 
+use dyngen::reference::Reference;
 use dyngen::reference::{perturbed_params, sample_states};
 use dyngen::{BodyRegressor, Robot, Wrench};
 use dyngen_tests::tree12::Tree12;
-use dyngen_tests::{reference_of, rel_err, wrench_vec};
+use dyngen_tests::{rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;
@@ -49,7 +50,7 @@ fn is_spd(m: &[f64], n: usize) -> bool {
 }
 
 fn check<R: Robot>(seed: u64) {
-    let reference = reference_of::<R>();
+    let reference = Reference::of::<R>();
     let model = reference.model().clone();
     let (n, np, nt) = (R::NV, R::NPARAMS, R::NTHETA);
     let zeros = vec![0.0; n];

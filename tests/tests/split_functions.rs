@@ -2,7 +2,8 @@
 //! ones do: the same operations in the same order, only passed through an array.
 
 use dyngen::reference::sample_states;
-use dyngen_tests::{reference_of, split::Ur5Split};
+use dyngen::reference::Reference;
+use dyngen_tests::split::Ur5Split;
 use robot_ur5::Ur5;
 
 #[test]
@@ -30,7 +31,7 @@ fn the_functions_compared_are_split() {
 
 #[test]
 fn split_code_is_bit_identical_to_unsplit() {
-    let model = reference_of::<Ur5>().model().clone();
+    let model = Reference::of::<Ur5>().model().clone();
     for s in sample_states(&model, 200, 11) {
         let (q, v, a): ([f64; 6], [f64; 6], [f64; 6]) = (
             s.q.try_into().unwrap(),

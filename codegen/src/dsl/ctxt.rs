@@ -50,6 +50,7 @@ impl Drop for Ctxt {
     fn drop(&mut self) {
         // A programming error in this crate, never a user's: errors would be lost.
         if !std::thread::panicking() && self.errors.borrow().is_some() {
+            // ok: a bug of this crate (errors recorded but never reported), not bad input.
             panic!("dyngen DSL: forgot to check for errors");
         }
     }

@@ -105,6 +105,16 @@ struct Kinematics {
 }
 
 impl Reference {
+    /// The reference implementation of a generated robot, rebuilt from the URDF it was
+    /// generated from, with the gravity it was specialised for. Panics if that URDF does
+    /// not parse, which would be a bug of the generator.
+    pub fn of<R: crate::Robot>() -> Reference {
+        let mut model = dyngen_model::parse_urdf(R::urdf())
+            .unwrap_or_else(|e| panic!("dyngen: the URDF generated for `{}` does not parse: {e}", R::NAME));
+        model.gravity = R::gravity();
+        Reference::new(&model)
+    }
+
     pub fn new(model: &Model) -> Reference {
         let joints = model
             .joints

@@ -11,6 +11,7 @@
 //! link and removes the `<inertial>` of each merged link (they become massless
 //! frames), so the file describes the identified robot exactly.
 
+use crate::model::xml::{scan, Tag};
 use crate::model::Inertial;
 
 use super::ReportError;
@@ -146,27 +147,7 @@ fn line_of(text: &str, pos: usize) -> usize {
     1 + text.as_bytes()[..pos].iter().filter(|&&b| b == b'\n').count()
 }
 
-// ---------------------------------------------------------------------------------
-// A minimal XML scan (start tags, spans, nesting), like the model's URDF front end:
-// not a validating parser, only enough to find elements and their bytes.
-
-struct Tag {
-    name: String,
-    attrs: Vec<(String, String)>,
-    line: usize,
-    /// Bytes of the start tag.
-    start: std::ops::Range<usize>,
-    /// Bytes of the whole element.
-    span: std::ops::Range<usize>,
-    self_closing: bool,
-    parent: Option<usize>,
-}
-
-impl Tag {
-    fn attr(&self, name: &str) -> Option<&str> {
-        self.attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
-    }
-}
+// The outline of the text comes from `dyngen_model::xml`, the URDF front end's own scan.
 
 struct Document<'a> {
     text: &'a str,
@@ -186,7 +167,10 @@ struct Group<'a> {
 
 impl<'a> Document<'a> {
     fn scan(text: &'a str) -> Result<Document<'a>, ReportError> {
-        let tags = scan(text)?;
+        let tags = scan(text).map_err(|e| ReportError::Xml {
+            line: e.line,
+            message: e.message,
+        })?;
         let root = tags.iter().position(|t| t.parent.is_none());
         let top = |name: &str| -> Vec<usize> {
             (0..tags.len())
@@ -334,116 +318,4 @@ impl<'a> Document<'a> {
         let at = link.start.end;
         (at..at, format!("{newline}{child_indent}{}", element(&child_indent)))
     }
-}
-
-fn scan(text: &str) -> Result<Vec<Tag>, ReportError> {
-    let mut tags: Vec<Tag> = Vec::new();
-    let mut open: Vec<usize> = Vec::new();
-    let mut pos = 0;
-    while let Some(offset) = text[pos..].find('<') {
-        pos += offset;
-        let rest = &text[pos..];
-        let fail = |message: String| ReportError::Xml {
-            line: line_of(text, pos),
-            message,
-        };
-        let skip = |end: &str, what: &str| {
-            rest.find(end)
-                .map(|k| pos + k + end.len())
-                .ok_or_else(|| fail(format!("{what} is never closed")))
-        };
-        if rest.starts_with("<!--") {
-            pos = skip("-->", "comment")?;
-        } else if rest.starts_with("<![CDATA[") {
-            pos = skip("]]>", "CDATA section")?;
-        } else if rest.starts_with("<?") {
-            pos = skip("?>", "processing instruction")?;
-        } else if rest.starts_with("<!") {
-            let bracket = rest.find('[').is_some_and(|b| rest.find('>').is_some_and(|g| b < g));
-            pos = skip(if bracket { "]>" } else { ">" }, "declaration")?;
-        } else if let Some(after) = rest.strip_prefix("</") {
-            let end = after.find('>').ok_or_else(|| fail("end tag is never closed".into()))?;
-            let name = after[..end].trim();
-            match open.pop() {
-                Some(k) if tags[k].name == name => tags[k].span.end = pos + 2 + end + 1,
-                Some(k) => return Err(fail(format!("</{name}> closes <{}>", tags[k].name))),
-                None => return Err(fail(format!("</{name}> has no start tag"))),
-            }
-            pos += 2 + end + 1;
-        } else {
-            let (name, attrs, self_closing, len) = start_tag(rest).map_err(fail)?;
-            let k = tags.len();
-            tags.push(Tag {
-                name,
-                attrs,
-                line: line_of(text, pos),
-                start: pos..pos + len,
-                span: pos..pos + len,
-                self_closing,
-                parent: open.last().copied(),
-            });
-            if !self_closing {
-                open.push(k);
-            }
-            pos += len;
-        }
-    }
-    match open.pop() {
-        Some(k) => Err(ReportError::Xml {
-            line: tags[k].line,
-            message: format!("<{}> is never closed", tags[k].name),
-        }),
-        None => Ok(tags),
-    }
-}
-
-type StartTag = (String, Vec<(String, String)>, bool, usize);
-
-/// Reads the start tag at the beginning of `s`: name, attributes, whether it is
-/// self-closing, and its length in bytes.
-fn start_tag(s: &str) -> Result<StartTag, String> {
-    let is_delim = |c: char| c.is_whitespace() || c == '/' || c == '>';
-    let body = &s[1..];
-    let name_len = body.find(is_delim).unwrap_or(body.len());
-    let name = &body[..name_len];
-    if name.is_empty() {
-        return Err("a `<` that starts no tag".into());
-    }
-    let unclosed = || format!("tag <{name}> is never closed");
-    let mut attrs = Vec::new();
-    let mut i = 1 + name_len;
-    loop {
-        let rest = &s[i..];
-        let trimmed = rest.trim_start();
-        i += rest.len() - trimmed.len();
-        if trimmed.starts_with("/>") {
-            return Ok((name.to_string(), attrs, true, i + 2));
-        }
-        if trimmed.starts_with('>') {
-            return Ok((name.to_string(), attrs, false, i + 1));
-        }
-        let eq = trimmed.find('=').ok_or_else(unclosed)?;
-        let attr = trimmed[..eq].trim();
-        if attr.is_empty() || attr.contains(is_delim) {
-            return Err(format!("malformed attribute in <{name}>"));
-        }
-        let value = trimmed[eq + 1..].trim_start();
-        let quote = value
-            .chars()
-            .next()
-            .filter(|&c| c == '"' || c == '\'')
-            .ok_or_else(|| format!("attribute `{attr}` of <{name}> needs a quoted value"))?;
-        let close = value[1..].find(quote).ok_or_else(unclosed)?;
-        attrs.push((attr.to_string(), unescape(&value[1..1 + close])));
-        i += trimmed.len() - value.len() + 1 + close + 1;
-    }
-}
-
-/// The predefined XML entities, so names compare as urdf-rs reads them.
-fn unescape(s: &str) -> String {
-    s.replace("&lt;", "<")
-        .replace("&gt;", ">")
-        .replace("&quot;", "\"")
-        .replace("&apos;", "'")
-        .replace("&amp;", "&")
 }

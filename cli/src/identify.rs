@@ -1,10 +1,14 @@
-//! `dyngen identify`: standard inertial parameters from joint torques.
+//! `dyngen identify`: inertial parameters from measured data: the standard or the
+//! principal parameters from joint torques, or the principal parameters of every body
+//! by MIM from joint wrenches.
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
 use dyngen::data::{read_csv, Trajectory};
 use dyngen::dynamics::Dynamics;
-use dyngen::identify::{Accumulator, Channels, Estimate, Options, Status};
-use dyngen::report::{self, MergedLinks, ParameterReport, Parameterisation, ReportError};
+use dyngen::identify::{Accumulator, Channels, Estimate, Options};
+use dyngen::mim::{self, MimEstimate, MimOptions};
+use dyngen::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
+use dyngen::simulate::Recording;
 use dyngen::Reference;
 use dyngen_codegen::standard_param_names;
 use dyngen_model::{ErrorKind, Inertial, Model};
@@ -18,19 +22,42 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf measured.csv --method ridge --lambda 1e-3
   dyngen identify robots/ur5/ur5.urdf ur5.csv --params-json ur5.json --svg ur5.svg \\
       --truth-from-urdf --urdf-out ur5-identified.urdf --force
+  dyngen identify robots/ur5/ur5.urdf ur5.csv --mode principal
+  dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them.
-Parameters the data cannot determine are shown as —, with the identifiable
-combinations (base parameters) they enter.
+--mode mim also needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, … (what
+`dyngen simulate` writes).
+
+Modes: standard (default) identifies the 10 standard parameters per body from the
+joint torques; principal the paper's θ = (m, J1, J2, J3) per body (centre of mass and
+principal axes taken from the URDF) from the joint torques; mim the same θ body by
+body from the joint wrenches (the paper's MIM), where every θ that enters a body's
+equations is identifiable. Parameters the data cannot determine are shown as — (or
+n/i), with the identifiable combinations they enter.
 
 --params-json writes the estimate as JSON (schema dyngen-parameters/1).
---svg plots measured against predicted torques per joint (with --truth-from-urdf
-also the relative error of each identified parameter against the URDF's values).
---urdf-out writes the URDF with the identified inertial of every body whose ten
-standard parameters are all identified and physically valid; the other bodies
-keep their URDF inertials (from joint torques alone usually only a few bodies,
-if any, are fully identifiable). Existing files are kept unless --force.";
+--truth-from-urdf takes the URDF's inertials as the truth and prints each
+parameter's error; with --svg it also plots them.
+--svg plots measured against predicted torques per joint (mim: torques of the
+identified model by inverse dynamics; a θ that is not identified keeps the URDF's).
+--urdf-out writes the URDF with the identified inertial of every body whose
+parameters (10, or θ with the URDF's centre of mass and axes) are all identified and
+physically valid; the other bodies keep their URDF inertials. From joint torques
+usually few bodies, if any, are fully identifiable; by MIM usually all.
+Existing files are kept unless --force.";
+
+/// What is identified, from what.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    /// The 10 standard parameters per body from the joint torques.
+    Standard,
+    /// θ = (m, J1, J2, J3) per body from the joint torques (principal regressor).
+    Principal,
+    /// θ per body from the joint wrenches, body by body (the paper's MIM).
+    Mim,
+}
 
 /// The estimator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -53,9 +80,14 @@ pub struct IdentifyArgs {
     /// Measured data (CSV: t, q1..qn[, v1..vn, a1..an], tau1..taun[, wrenches]).
     pub data: PathBuf,
 
-    /// The estimator.
-    #[arg(long, value_enum, default_value_t = Method::Ols)]
-    pub method: Method,
+    /// What to identify, from what.
+    #[arg(long, value_enum, default_value_t = Mode::Standard)]
+    pub mode: Mode,
+
+    /// The estimator of --mode standard and principal (default ols). MIM always uses
+    /// least squares weighted per body axis (Gautier).
+    #[arg(long, value_enum)]
+    pub method: Option<Method>,
 
     /// Ridge: weight of the pull toward the nominal parameters.
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
@@ -88,9 +120,9 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "FILE")]
     pub svg: Option<PathBuf>,
 
-    /// With --svg: take the URDF's inertials as the true parameters and also plot
-    /// the relative error of each identified parameter.
-    #[arg(long, requires = "svg")]
+    /// Take the URDF's inertials as the true parameters: print each identified
+    /// parameter's error, and with --svg plot them.
+    #[arg(long)]
     pub truth_from_urdf: bool,
 
     /// Replace existing output files.
@@ -108,11 +140,24 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if !(args.lambda.is_finite() && args.lambda >= 0.0) {
         return Err(format!("--lambda must be non-negative, got {}", args.lambda));
     }
+    if args.mode == Mode::Mim && args.method.is_some() {
+        return Err(
+            "--method applies to --mode standard and principal; MIM always uses least squares weighted per body axis"
+                .into(),
+        );
+    }
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
     let n = model.dof();
     let data_err = |e: dyngen::data::DataError| format!("{}: {e}", args.data.display());
     let mut traj = read_csv(&args.data, Some(n)).map_err(data_err)?;
+    if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
+        return Err(format!(
+            "{}: --mode mim needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, mz{n}, which the file \
+             does not have; identify from the joint torques with --mode standard or principal instead",
+            args.data.display()
+        ));
+    }
     if traj.velocities().is_none() || traj.accelerations().is_none() {
         eprintln!(
             "{} has no velocities or accelerations: estimating them from positions (low-pass at {} Hz)",
@@ -121,26 +166,69 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         );
         traj = traj.with_derivatives(args.cutoff).map_err(data_err)?;
     }
+    println!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
+    let identified = match args.mode {
+        Mode::Standard | Mode::Principal => from_torques(args, &model, &traj, progress)?,
+        Mode::Mim => by_mim(args, &model, &traj)?,
+    };
 
-    let robot = Reference::new(&model);
-    let p = Dynamics::nparams(&robot);
+    if let Some(path) = &args.params_json {
+        identified
+            .report
+            .write(path, args.force)
+            .map_err(|e| report_error(path, e))?;
+        println!("wrote the parameters to {}", path.display());
+    }
+    if let Some(path) = &args.svg {
+        write_svg(args, path, &model, &traj, &identified, progress)?;
+    }
+    if let Some(path) = &args.urdf_out {
+        write_urdf(args, path, &model, &identified)?;
+    }
+    Ok(())
+}
+
+/// An identification, whatever the mode: the report (names, values, σ, status per
+/// parameter) and how to predict the joint torques.
+struct Identified {
+    report: ParameterReport,
+    /// Standard (10 per body) or θ (4 per body).
+    per_body: usize,
+    prediction: Prediction,
+}
+
+enum Prediction {
+    /// Rows of this regressor times the estimate's solution.
+    Regressor { estimate: Estimate, principal: bool },
+    /// Inverse dynamics with these standard parameters.
+    Parameters(Vec<f64>),
+}
+
+impl Identified {
+    fn truth(&self, model: &Model) -> Vec<f64> {
+        if self.per_body == 10 {
+            model.standard_params()
+        } else {
+            mim::true_theta(model)
+        }
+    }
+}
+
+/// Standard or principal parameters from the joint torques, through the stacked
+/// regressor.
+fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress: &Progress) -> Result<Identified> {
+    let principal = args.mode == Mode::Principal;
+    let robot = Reference::new(model);
+    let n = model.dof();
+    let p = if principal { 4 * n } else { 10 * n };
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n)).map_err(|e| e.to_string())?;
     let mut y = vec![0.0; n * p];
     let bar = progress.bar(traj.len() as u64, "stacking regressors");
     for k in 0..traj.len() {
-        let (q, tau) = (traj.q(k), traj.tau(k));
-        let (v, a) = match (traj.v(k), traj.a(k)) {
-            (Some(v), Some(a)) => (v, a),
-            _ => {
-                return Err(format!(
-                    "{}: sample {k} has no velocities or accelerations",
-                    args.data.display()
-                ))
-            }
-        };
-        Dynamics::joint_torque_regressor(&robot, q, v, a, &mut y);
+        let (q, v, a) = joint_state(args, traj, k)?;
+        regressor(&robot, principal, q, v, a, &mut y);
         for j in 0..n {
-            acc.push_row(&y[j * p..(j + 1) * p], tau[j])
+            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
                 .map_err(|e| format!("{}, {}: {e}", args.data.display(), traj.location(k)))?;
         }
         bar.inc(1);
@@ -148,34 +236,113 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     bar.finish_and_clear();
 
     let opts = Options::default();
-    let estimate = match args.method {
+    let estimate = match args.method.unwrap_or(Method::Ols) {
         Method::Ols => acc.ols(&opts),
         Method::Wls => acc.wls(&opts),
         Method::Tls => acc.tls(&opts),
-        Method::Ridge => acc.ridge(&model.standard_params(), args.lambda, &opts),
+        Method::Ridge => {
+            let prior = if principal {
+                mim::true_theta(model)
+            } else {
+                model.standard_params()
+            };
+            acc.ridge(&prior, args.lambda, &opts)
+        }
     }
     .map_err(|e| e.to_string())?;
 
-    let names = standard_param_names(n);
+    let names = if principal {
+        mim::theta_names(n)
+    } else {
+        standard_param_names(n)
+    };
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    println!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
     println!("{}", estimate.table(&names));
     print_fit(&estimate);
-
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    if let Some(path) = &args.params_json {
-        ParameterReport::from_estimate(&model.name, Parameterisation::Standard, &estimate, &names, &joint_names)
-            .write(path, args.force)
-            .map_err(|e| report_error(path, e))?;
-        println!("wrote the parameters to {}", path.display());
+    let parameterisation = if principal {
+        Parameterisation::Principal
+    } else {
+        Parameterisation::Standard
+    };
+    let report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &names, &joint_names);
+    let identified = Identified {
+        report,
+        per_body: if principal { 4 } else { 10 },
+        prediction: Prediction::Regressor { estimate, principal },
+    };
+    if args.truth_from_urdf {
+        print_errors(&identified, model);
     }
-    if let Some(path) = &args.svg {
-        write_svg(args, path, &model, &traj, &estimate, &names, &joint_names, progress)?;
+    Ok(identified)
+}
+
+/// The paper's MIM on measured joint wrenches: every body's θ from its resultant,
+/// the whole robot as one block-diagonal least-squares problem.
+fn by_mim(args: &IdentifyArgs, model: &Model, traj: &Trajectory) -> Result<Identified> {
+    let robot = Reference::new(model);
+    let recording = Recording::from_measurements(&robot, traj).map_err(|e| format!("{}: {e}", args.data.display()))?;
+    let truth = args.truth_from_urdf.then(|| mim::true_theta(model));
+    let estimate: MimEstimate =
+        mim::whole_robot(&recording, 0..recording.len(), truth.as_deref(), &MimOptions::default())
+            .map_err(|e| format!("{}: {e}", args.data.display()))?;
+    println!("{estimate}");
+    // The torques of the identified model: θ where identified, the URDF's elsewhere.
+    let nominal = mim::true_theta(model);
+    let theta: Vec<f64> = estimate
+        .theta()
+        .iter()
+        .zip(&nominal)
+        .map(|(x, t)| x.unwrap_or(*t))
+        .collect();
+    Ok(Identified {
+        report: ParameterReport::from_mim(&model.name, &estimate),
+        per_body: 4,
+        prediction: Prediction::Parameters(dyngen::reference::principal_params_to_standard(model, &theta)),
+    })
+}
+
+/// `(q, v, a)` of sample `k` (v and a exist once the derivatives are estimated).
+fn joint_state<'a>(args: &IdentifyArgs, traj: &'a Trajectory, k: usize) -> Result<(&'a [f64], &'a [f64], &'a [f64])> {
+    match (traj.v(k), traj.a(k)) {
+        (Some(v), Some(a)) => Ok((traj.q(k), v, a)),
+        _ => Err(format!(
+            "{}: sample {k} has no velocities or accelerations",
+            args.data.display()
+        )),
     }
-    if let Some(path) = &args.urdf_out {
-        write_urdf(args, path, &model, &estimate)?;
+}
+
+/// The joint torque regressor, standard (`n × 10n`) or principal (`n × 4n`).
+fn regressor(robot: &Reference, principal: bool, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
+    if principal {
+        Dynamics::principal_regressor(robot, q, v, a, y);
+    } else {
+        Dynamics::joint_torque_regressor(robot, q, v, a, y);
     }
-    Ok(())
+}
+
+/// Each identified parameter against the URDF's value (torque modes; MIM prints its
+/// own error table).
+fn print_errors(identified: &Identified, model: &Model) {
+    let truth = identified.truth(model);
+    let mut worst: Option<(f64, &str)> = None;
+    let mut count = 0;
+    for (p, t) in identified.report.parameters.iter().zip(&truth) {
+        if let (Some(v), true) = (p.value, t.abs() > 1e-12) {
+            let rel = ((v - t) / t).abs();
+            count += 1;
+            if worst.is_none_or(|(w, _)| rel > w) {
+                worst = Some((rel, &p.name));
+            }
+        }
+    }
+    match worst {
+        Some((w, name)) => println!(
+            "against the URDF: {count} identified parameters with a nonzero true value, largest relative error {w:.3e} ({name})"
+        ),
+        None => println!("against the URDF: no identified parameter with a nonzero true value"),
+    }
 }
 
 /// Refuses, before any work, existing output files without --force and two
@@ -213,56 +380,55 @@ fn report_error(path: &Path, e: ReportError) -> String {
 }
 
 /// Measured against predicted torques (regressor rows times the estimate's
-/// solution, valid on the identifiable subspace), and with --truth-from-urdf the
-/// relative errors of the parameters that have a value.
-#[allow(clippy::too_many_arguments)]
+/// solution, valid on the identifiable subspace; for MIM, inverse dynamics of the
+/// identified model), and with --truth-from-urdf the relative errors of the
+/// parameters that have a value.
 fn write_svg(
     args: &IdentifyArgs,
     path: &Path,
     model: &Model,
     traj: &Trajectory,
-    estimate: &Estimate,
-    names: &[&str],
-    joint_names: &[&str],
+    identified: &Identified,
     progress: &Progress,
 ) -> Result<()> {
     let robot = Reference::new(model);
     let n = model.dof();
-    let p = Dynamics::nparams(&robot);
-    let mut y = vec![0.0; n * p];
+    let mut y = Vec::new();
     let mut measured = Vec::with_capacity(traj.len());
     let mut predicted = Vec::with_capacity(traj.len());
     let bar = progress.bar(traj.len() as u64, "predicting torques");
     for k in 0..traj.len() {
-        let (Some(v), Some(a)) = (traj.v(k), traj.a(k)) else {
-            return Err(format!(
-                "{}: sample {k} has no velocities or accelerations",
-                args.data.display()
-            ));
-        };
-        Dynamics::joint_torque_regressor(&robot, traj.q(k), v, a, &mut y);
-        predicted.push((0..n).map(|j| estimate.predict(&y[j * p..(j + 1) * p])).collect());
+        let (q, v, a) = joint_state(args, traj, k)?;
+        predicted.push(match &identified.prediction {
+            Prediction::Regressor { estimate, principal } => {
+                let p = estimate.n_params();
+                y.resize(n * p, 0.0);
+                regressor(&robot, *principal, q, v, a, &mut y);
+                (0..n).map(|j| estimate.predict(&y[j * p..(j + 1) * p])).collect()
+            }
+            Prediction::Parameters(params) => robot.rnea(q, v, a, params),
+        });
         measured.push(traj.tau(k).to_vec());
         bar.inc(1);
     }
     bar.finish_and_clear();
 
     let errors = args.truth_from_urdf.then(|| {
-        let truth = model.standard_params();
+        let truth = identified.truth(model);
         let mut zero_truth = Vec::new();
-        let errors: Vec<(String, Option<f64>)> = estimate
-            .params
+        let errors: Vec<(String, Option<f64>)> = identified
+            .report
+            .parameters
             .iter()
             .zip(&truth)
-            .enumerate()
-            .filter_map(|(j, (est, &x))| match est.value {
-                None => Some((names[j].to_string(), None)),
+            .filter_map(|(p, &x)| match p.value {
+                None => Some((p.name.clone(), None)),
                 // A relative error needs a nonzero true value.
                 Some(_) if x.abs() < 1e-12 => {
-                    zero_truth.push(names[j]);
+                    zero_truth.push(p.name.as_str());
                     None
                 }
-                Some(v) => Some((names[j].to_string(), Some((v - x) / x))),
+                Some(v) => Some((p.name.clone(), Some((v - x) / x))),
             })
             .filter(|(_, e)| e.is_none_or(f64::is_finite))
             .collect();
@@ -277,28 +443,42 @@ fn write_svg(
     let title = format!(
         "{}: {} on {}",
         model.name,
-        estimate.method,
+        identified.report.method,
         args.data
             .file_name()
             .map_or_else(|| args.data.display().to_string(), |f| f.to_string_lossy().into_owned())
     );
-    let svg = report::svg_report(&title, traj.t(), &measured, &predicted, joint_names, errors.as_deref())
+    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let svg = report::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
         .map_err(|e| report_error(path, e))?;
     report::write_report(path, &svg, args.force).map_err(|e| report_error(path, e))?;
     println!("wrote the SVG report to {}", path.display());
     Ok(())
 }
 
-/// Why a body's inertial is not written, or its identified inertial.
-fn identified_inertial(estimate: &Estimate, body: usize) -> std::result::Result<Inertial, String> {
-    let params = &estimate.params[10 * body..10 * body + 10];
-    let missing = params.iter().filter(|p| p.status != Status::Identified).count();
+/// Why a body's inertial is not written, or its identified inertial: all of the
+/// body's parameters (10 standard, or θ with the URDF's centre of mass and principal
+/// axes) identified, and the result physically valid.
+fn identified_inertial(identified: &Identified, model: &Model, body: usize) -> std::result::Result<Inertial, String> {
+    let k = identified.per_body;
+    let params = &identified.report.parameters[k * body..k * (body + 1)];
+    let missing = params.iter().filter(|p| p.status != ParamStatus::Identified).count();
     if missing > 0 {
-        return Err(format!("{missing} of its 10 parameters not identified"));
+        return Err(format!("{missing} of its {k} parameters not identified"));
     }
+    let values: Vec<f64> = params
+        .iter()
+        .map(|p| p.value.ok_or("a parameter has no value"))
+        .collect::<std::result::Result<_, _>>()?;
     let mut x = [0.0; 10];
-    for (x, p) in x.iter_mut().zip(params) {
-        *x = p.value.ok_or("a parameter has no value")?;
+    if k == 10 {
+        x.copy_from_slice(&values);
+    } else {
+        // θ of this body, the URDF's θ elsewhere (only this body's 10 are used).
+        let mut theta = mim::true_theta(model);
+        theta[4 * body..4 * body + 4].copy_from_slice(&values);
+        let standard = dyngen::reference::principal_params_to_standard(model, &theta);
+        x.copy_from_slice(&standard[10 * body..10 * body + 10]);
     }
     let inertial = Inertial::from_standard_params(&x).ok_or("identified mass is not positive")?;
     dyngen_model::desc::check_inertial(&inertial).map_err(|e| match e {
@@ -316,12 +496,12 @@ fn identified_inertial(estimate: &Estimate, body: usize) -> std::result::Result<
 
 /// The input URDF with the inertials of the fully identified, physically valid
 /// bodies replaced; every other byte is kept.
-fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, estimate: &Estimate) -> Result<()> {
+fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Identified) -> Result<()> {
     let text = std::fs::read_to_string(&args.urdf).map_err(|e| format!("{}: {e}", args.urdf.display()))?;
     let mut updates: Vec<(&str, Inertial)> = Vec::new();
     let mut kept: Vec<String> = Vec::new();
     for (i, body) in model.bodies.iter().enumerate() {
-        match identified_inertial(estimate, i) {
+        match identified_inertial(identified, model, i) {
             Ok(inertial) => {
                 if !body.merged.is_empty() && !args.lump_merged {
                     return Err(format!(
@@ -348,7 +528,7 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, estimate: &Estima
     report::write_new(path, &out, args.force).map_err(|e| report_error(path, e))?;
     if updates.is_empty() {
         println!(
-            "wrote {} unchanged: no body has all 10 standard parameters identified, so every inertial is the URDF's",
+            "wrote {} unchanged: no body has all its parameters identified, so every inertial is the URDF's",
             path.display()
         );
     } else {
@@ -366,10 +546,13 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, estimate: &Estima
             model.bodies.len(),
             kept.join("; ")
         );
-        println!(
-            "note: this is expected: joint torques determine only the base parameters (combinations), \
-             so few bodies, if any, have all 10 parameters identifiable; see --params-json for the combinations"
-        );
+        if args.mode != Mode::Mim {
+            println!(
+                "note: this is expected: joint torques determine only the base parameters (combinations), \
+                 so few bodies, if any, have all their parameters identifiable; see --params-json for the \
+                 combinations, or identify body by body from joint wrenches with --mode mim"
+            );
+        }
     }
     Ok(())
 }

@@ -1,8 +1,8 @@
 //! `dyngen simulate`: an identification experiment on the nominal parameters, as CSV.
 
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
-use dyngen::data::{overwrite_csv, write_csv, Trajectory};
-use dyngen::simulate::{record, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
+use dyngen::data::{overwrite_csv, write_csv};
+use dyngen::simulate::{record, ExcitationDesign, Experiment, Motion, NoiseModel};
 use dyngen::Reference;
 use std::path::PathBuf;
 
@@ -158,7 +158,7 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     } else {
         clean
     };
-    let traj = to_trajectory(&recording).map_err(|e| e.to_string())?;
+    let traj = recording.to_trajectory().map_err(|e| e.to_string())?;
     if args.force {
         overwrite_csv(&args.output, &traj)
     } else {
@@ -174,22 +174,4 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         args.output.display()
     );
     Ok(())
-}
-
-/// The joint-space channels of a recording: t, q, v, a, tau and the joint wrenches.
-fn to_trajectory(rec: &Recording) -> std::result::Result<Trajectory, dyngen::data::DataError> {
-    let n = rec.nv();
-    let t = rec.samples.iter().map(|s| s.t).collect();
-    let flat = |f: fn(&dyngen::simulate::Sample) -> &Vec<f64>| -> Vec<f64> {
-        rec.samples.iter().flat_map(|s| f(s).iter().copied()).collect()
-    };
-    Trajectory::new(n, t, flat(|s| &s.q), flat(|s| &s.tau))?
-        .with_velocities(flat(|s| &s.v))?
-        .with_accelerations(flat(|s| &s.a))?
-        .with_wrenches(
-            rec.samples
-                .iter()
-                .flat_map(|s| s.joint_wrenches.iter().copied())
-                .collect(),
-        )
 }

@@ -447,8 +447,9 @@ pub fn samples(
 }
 
 /// The whole robot as one block-diagonal least-squares problem over `range`
-/// (the paper's eq. 19–20; [`Recording::robot_body_system`]). Same estimates as
-/// [`samples`] since the blocks decouple, but one report with one rank.
+/// (the paper's eq. 19–20; the rows of [`Recording::robot_body_system`], streamed
+/// so memory does not grow with the samples). Same estimates as [`samples`] since
+/// the blocks decouple, but one report with one rank.
 pub fn whole_robot(
     recording: &Recording,
     range: Range<usize>,
@@ -456,9 +457,41 @@ pub fn whole_robot(
     opts: &MimOptions,
 ) -> Result<MimEstimate, IdentifyError> {
     check_range(recording, &range)?;
-    check_truth(truth, 4 * recording.nv())?;
-    let (a, y) = recording.robot_body_system(range.clone());
-    let estimate = solve(&a, y.as_slice(), recording.nv(), opts)?;
+    let n = recording.nv();
+    check_truth(truth, 4 * n)?;
+    // The rows of `Recording::robot_body_system`, streamed into the accumulator
+    // (memory O(n²) whatever the number of samples), weighted as `solve` does.
+    let weighted = range.len() >= MIN_SAMPLES_FOR_WEIGHTING;
+    let channels = if weighted {
+        Channels::Interleaved(6 * n)
+    } else {
+        Channels::Single
+    };
+    let mut acc = Accumulator::with_channels(4 * n, channels)?;
+    let mut row = vec![0.0; 4 * n];
+    for k in range.clone() {
+        for i in 0..n {
+            let block = recording.body_regressor(k, i);
+            let wrench = recording.body_wrench(k, i);
+            for r in 0..6 {
+                let lhs = if r < 3 {
+                    block.force.row(r)
+                } else {
+                    block.moment.row(r - 3)
+                };
+                row.fill(0.0);
+                for c in 0..4 {
+                    row[4 * i + c] = lhs[c];
+                }
+                acc.push_row(&row, wrench[r])?;
+            }
+        }
+    }
+    let estimate = if weighted {
+        acc.wls(&opts.identify)?
+    } else {
+        acc.ols(&opts.identify)?
+    };
     Ok(MimEstimate {
         source: Source::WholeRobot { range },
         body_names: recording.body_names.clone(),

@@ -568,11 +568,14 @@ fn gaussian_draws_have_unit_variance() {
     assert_eq!(again.standard(), draws[0]);
 }
 
-/// Every scalar of one channel: (noise-free value, noisy value, sensor index).
-fn channel_values(clean: &Recording, noisy: &Recording, channel: Channel) -> Vec<(f64, f64, usize)> {
+/// Every scalar of one channel: (noise-free value, noisy value, sensor index), a
+/// sensor being a joint's scalar and a body's 3-vector, or with `per_axis` each axis
+/// of it.
+fn channel_values(clean: &Recording, noisy: &Recording, channel: Channel, per_axis: bool) -> Vec<(f64, f64, usize)> {
     let mut out = Vec::new();
     for (c, d) in clean.samples.iter().zip(&noisy.samples) {
         let mut push = |x: &[f64], y: &[f64], per: usize| {
+            let per = if per_axis { 1 } else { per };
             for (k, (a, b)) in x.iter().zip(y).enumerate() {
                 out.push((*a, *b, k / per));
             }
@@ -623,25 +626,8 @@ fn noise_is_seeded_and_has_the_requested_sigma() {
         Channel::ResultantMoment,
         Channel::JointForce,
     ] {
-        let values = channel_values(&clean, &noisy, channel);
-        let sensors = values.iter().map(|v| v.2).max().unwrap() + 1;
-        let mut z = Vec::new();
-        for s in 0..sensors {
-            let mine: Vec<&(f64, f64, usize)> = values.iter().filter(|v| v.2 == s).collect();
-            let rms = (mine.iter().map(|v| v.0 * v.0).sum::<f64>() / mine.len() as f64).sqrt();
-            let sigma = if channel == Channel::Q { 0.002 } else { 0.01 * rms };
-            if sigma > 0.0 {
-                z.extend(mine.iter().map(|v| (v.1 - v.0) / sigma));
-            }
-        }
-        let count = z.len() as f64;
-        let mean = z.iter().sum::<f64>() / count;
-        let var = z.iter().map(|x| x * x).sum::<f64>() / count;
-        assert!(mean.abs() < 4.0 / count.sqrt(), "{channel:?}: mean {mean}");
-        assert!(
-            (var - 1.0).abs() < 5.0 * (2.0 / count).sqrt(),
-            "{channel:?}: variance {var} over {count}"
-        );
+        let absolute = (channel == Channel::Q).then_some(0.002);
+        check_sigma(&channel_values(&clean, &noisy, channel, false), absolute, channel);
     }
 
     // One channel's noise does not depend on another's σ.
@@ -656,6 +642,54 @@ fn noise_is_seeded_and_has_the_requested_sigma() {
         .iter()
         .zip(&clean.samples)
         .all(|(a, b)| a.q == b.q && a.bodies == b.bodies));
+}
+
+/// The noise of every sensor has mean 0 and σ = `absolute`, or 1 % of that sensor's
+/// RMS, within sampling error.
+fn check_sigma(values: &[(f64, f64, usize)], absolute: Option<f64>, channel: Channel) {
+    let sensors = values.iter().map(|v| v.2).max().unwrap() + 1;
+    let mut z = Vec::new();
+    for s in 0..sensors {
+        let mine: Vec<&(f64, f64, usize)> = values.iter().filter(|v| v.2 == s).collect();
+        let rms = (mine.iter().map(|v| v.0 * v.0).sum::<f64>() / mine.len() as f64).sqrt();
+        let sigma = absolute.unwrap_or(0.01 * rms);
+        if sigma > 0.0 {
+            z.extend(mine.iter().map(|v| (v.1 - v.0) / sigma));
+        }
+    }
+    let count = z.len() as f64;
+    let mean = z.iter().sum::<f64>() / count;
+    let var = z.iter().map(|x| x * x).sum::<f64>() / count;
+    assert!(mean.abs() < 4.0 / count.sqrt(), "{channel:?}: mean {mean}");
+    assert!(
+        (var - 1.0).abs() < 5.0 * (2.0 / count).sqrt(),
+        "{channel:?}: variance {var} over {count}"
+    );
+}
+
+#[test]
+fn per_axis_noise_follows_each_axis_rms() {
+    let (m, r) = reference();
+    let mut experiment = Experiment::paper(&m);
+    experiment.steps = 400;
+    let clean = record(&r, &m.standard_params(), &experiment);
+    let noisy = NoiseModel::relative(0.01).per_axis().apply(&clean, 17);
+    for channel in [Channel::Tau, Channel::AngularVelocity, Channel::ResultantMoment] {
+        check_sigma(&channel_values(&clean, &noisy, channel, true), None, channel);
+    }
+    // Pooled and per-axis σ differ on a body axis that moves little: the moment
+    // about body 1's own axis.
+    let pooled = NoiseModel::relative(0.01).apply(&clean, 17);
+    let spread = |rec: &Recording| {
+        let d: Vec<f64> = rec
+            .samples
+            .iter()
+            .zip(&clean.samples)
+            .map(|(a, b)| a.bodies[0].resultant.torque.x - b.bodies[0].resultant.torque.x)
+            .collect();
+        (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt()
+    };
+    assert_ne!(spread(&pooled), spread(&noisy));
 }
 
 #[test]
@@ -677,4 +711,52 @@ fn mim_noise_touches_only_body_measurements() {
         let rel = (theta[k] - truth[8 + k]).abs() / truth[8 + k];
         assert!(rel < 0.05, "θ[{k}] {} vs {}", theta[k], truth[8 + k]);
     }
+}
+
+#[test]
+fn a_recording_rebuilt_from_its_csv_channels_has_the_same_body_measurements() {
+    let (m, r) = reference();
+    let clean = record(&r, &m.standard_params(), &Experiment::paper(&m));
+    let traj = clean.to_trajectory().unwrap();
+    let rebuilt = Recording::from_measurements(&r, &traj).unwrap();
+    assert_eq!(rebuilt.len(), clean.len());
+    let mut worst: f64 = 0.0;
+    for (a, b) in rebuilt.samples.iter().zip(&clean.samples) {
+        assert_eq!(
+            (a.t, &a.q, &a.tau, &a.joint_wrenches),
+            (b.t, &b.q, &b.tau, &b.joint_wrenches)
+        );
+        for (x, y) in a.bodies.iter().zip(&b.bodies) {
+            let scale = 1.0 + y.resultant.force.norm() + y.resultant.torque.norm();
+            worst = worst
+                .max((x.resultant.force - y.resultant.force).norm() / scale)
+                .max((x.resultant.torque - y.resultant.torque).norm() / scale)
+                .max((x.com_acceleration - y.com_acceleration).norm())
+                .max((x.angular_acceleration - y.angular_acceleration).norm())
+                .max((x.cardano - y.cardano).norm());
+        }
+    }
+    assert!(worst < 1e-12, "{worst:e}");
+}
+
+#[test]
+fn a_recording_from_measurements_needs_velocities_accelerations_and_wrenches() {
+    let (m, r) = reference();
+    let clean = record(&r, &m.standard_params(), &Experiment::paper(&m));
+    let n = m.dof();
+    let t: Vec<f64> = clean.samples.iter().map(|s| s.t).collect();
+    let q: Vec<f64> = clean.samples.iter().flat_map(|s| s.q.clone()).collect();
+    let tau: Vec<f64> = clean.samples.iter().flat_map(|s| s.tau.clone()).collect();
+    let v: Vec<f64> = clean.samples.iter().flat_map(|s| s.v.clone()).collect();
+    let a: Vec<f64> = clean.samples.iter().flat_map(|s| s.a.clone()).collect();
+    let bare = dyngen::data::Trajectory::new(n, t, q, tau).unwrap();
+    let err = Recording::from_measurements(&r, &bare).unwrap_err().to_string();
+    assert!(err.contains("no velocity columns (v1..v3)"), "{err}");
+    let kinematic = bare.with_velocities(v).unwrap().with_accelerations(a).unwrap();
+    let err = Recording::from_measurements(&r, &kinematic).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "the data have no joint wrench columns (fx1, fy1, fz1, mx1, my1, mz1, …, mz3); \
+         MIM from body measurements needs them"
+    );
 }

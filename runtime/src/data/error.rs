@@ -91,6 +91,13 @@ pub enum DataError {
         value: f64,
         expected: String,
     },
+    /// A whole optional group (`v`, `a`, joint wrenches) that a computation needs is
+    /// absent; `columns` names it, `needed_for` says what needs it.
+    MissingGroup {
+        group: &'static str,
+        columns: String,
+        needed_for: &'static str,
+    },
     /// The CSV layer itself failed (for example invalid UTF-8).
     Malformed { line: Option<u64>, message: String },
     /// Several errors found in one pass (at most [`MAX_ERRORS`](super::MAX_ERRORS));
@@ -205,6 +212,9 @@ impl fmt::Display for DataError {
             }
             DataError::InvalidArgument { name, value, expected } => {
                 write!(f, "invalid `{name}` = {value}: expected {expected}")
+            }
+            DataError::MissingGroup { group, columns, needed_for } => {
+                write!(f, "the data have no {group} columns ({columns}); {needed_for} needs them")
             }
             DataError::Malformed { line: Some(line), message } => write!(f, "line {line}: malformed CSV: {message}"),
             DataError::Malformed { line: None, message } => write!(f, "malformed CSV: {message}"),

@@ -102,7 +102,18 @@ impl Reference {
     /// that move a centre of mass or turn principal axes break that equality: `c_ia`
     /// and the principal frame stay the description's. Panics if a length differs.
     pub fn body_resultants(&self, q: &[f64], v: &[f64], a: &[f64], params: &[f64]) -> Vec<Wrench<f64>> {
-        let resultants = self.body_resultants_in_body_frames(q, v, a, params);
+        self.resultants_of_joint_wrenches(q, &self.joint_wrenches(q, v, a, params))
+    }
+
+    /// The body resultants of [`Reference::body_resultants`] from given (measured)
+    /// joint wrenches instead of the RNEA's: `wrenches[j]` is joint `j + 1`'s
+    /// reaction on its outboard body in that body's frame, moment about the joint
+    /// origin (the convention of [`Reference::joint_wrenches`] and of the CSV
+    /// wrench columns, [`crate::data`]). Only `q` enters (the geometry). Panics if a
+    /// length differs.
+    pub fn resultants_of_joint_wrenches(&self, q: &[f64], wrenches: &[Wrench<f64>]) -> Vec<Wrench<f64>> {
+        assert_eq!(wrenches.len(), self.nq(), "one joint wrench per joint");
+        let resultants = self.resultants_in_body_frames(q, wrenches);
         resultants[1..]
             .iter()
             .zip(&self.frames)
@@ -119,17 +130,10 @@ impl Reference {
     /// The resultants of [`Reference::body_resultants`] for bodies `0..=n` (the
     /// base included), in each body's own frame, moment about its centre of mass
     /// (about the base frame origin for body 0).
-    fn body_resultants_in_body_frames(
-        &self,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        params: &[f64],
-    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    fn resultants_in_body_frames(&self, q: &[f64], reactions: &[Wrench<f64>]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
         let n = self.nq();
         let s = graph::incidence(&self.model);
         let c = graph::body_joint_vectors(&self.model);
-        let reactions = self.joint_wrenches(q, v, a, params);
         let placements: Vec<Transform> = (1..=n).map(|j| self.joint_placement(j, q[j - 1])).collect();
 
         let mut resultants = vec![(Vector3::zeros(), Vector3::zeros()); n + 1];

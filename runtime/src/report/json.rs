@@ -24,7 +24,8 @@
 //! `status` is one of `identified` (value and σ from the data), `in_combination`
 //! (no value: only enters the listed combinations), `no_effect` (no value: the data
 //! carry nothing about it), `from_prior` (ridge: value mostly from the prior) and
-//! `constrained` (value shaped by physical-consistency constraints, no σ). A
+//! `constrained` (value shaped by physical-consistency constraints, no σ) and
+//! `not_significant` (MIM: the estimate is below 3σ, so no value). A
 //! parameter without a value is `null`, never a number. `combinations` lists only
 //! combinations of two or more parameters. Floats round-trip exactly.
 
@@ -34,6 +35,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{write_new, ReportError};
 use crate::identify::{Estimate, Status};
+use crate::mim::{theta_names, MimEstimate, Verdict};
 
 /// The `schema` field this module writes and accepts.
 pub const SCHEMA: &str = "dyngen-parameters/1";
@@ -59,6 +61,9 @@ pub enum ParamStatus {
     NoEffect,
     FromPrior,
     Constrained,
+    /// MIM: determined by the data but `|x̂| < kσ̂` ([`crate::mim::Verdict::NotSignificant`]);
+    /// no value.
+    NotSignificant,
 }
 
 impl From<Status> for ParamStatus {
@@ -174,6 +179,64 @@ impl ParameterReport {
             parameters,
             combinations,
         }
+    }
+
+    /// The report of a MIM estimate ([`crate::mim`]): `θ` named `m_1, J1_1, J2_1,
+    /// J3_1, m_2, …`, channels `<body>.Fx … <body>.Mz` (six per body), and the MIM
+    /// verdicts: a parameter below the significance threshold is `not_significant`,
+    /// without value or σ. A per-body estimate ([`crate::mim::samples`]) becomes one
+    /// report: ranks add up, the condition number is the worst body's.
+    pub fn from_mim(robot: &str, estimate: &MimEstimate) -> ParameterReport {
+        let names = theta_names(estimate.bodies());
+        let channels: Vec<String> = estimate
+            .body_names
+            .iter()
+            .flat_map(|b| ["Fx", "Fy", "Fz", "Mx", "My", "Mz"].map(|c| format!("{b}.{c}")))
+            .collect();
+        let parts: Vec<ParameterReport> = if estimate.estimates.len() == 1 {
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            let channels: Vec<&str> = channels.iter().map(String::as_str).collect();
+            vec![Self::from_estimate(
+                robot,
+                Parameterisation::Principal,
+                &estimate.estimates[0],
+                &names,
+                &channels,
+            )]
+        } else {
+            estimate
+                .estimates
+                .iter()
+                .enumerate()
+                .map(|(i, e)| {
+                    let names: Vec<&str> = names[4 * i..4 * i + 4].iter().map(String::as_str).collect();
+                    let channels: Vec<&str> = channels[6 * i..6 * i + 6].iter().map(String::as_str).collect();
+                    Self::from_estimate(robot, Parameterisation::Principal, e, &names, &channels)
+                })
+                .collect()
+        };
+        let mut parts = parts.into_iter();
+        let mut report = parts.next().expect("a MIM estimate has at least one body");
+        for part in parts {
+            report.rank += part.rank;
+            report.condition_number = match (report.condition_number, part.condition_number) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                _ => None,
+            };
+            report.residual_rms.extend(part.residual_rms);
+            report.channels.extend(part.channels);
+            report.parameters.extend(part.parameters);
+            report.combinations.extend(part.combinations);
+        }
+        for (j, p) in report.parameters.iter_mut().enumerate() {
+            if estimate.verdict(j / 4, j % 4) == Verdict::NotSignificant {
+                p.value = None;
+                p.sigma = None;
+                p.sigma_percent = None;
+                p.status = ParamStatus::NotSignificant;
+            }
+        }
+        report
     }
 
     /// Pretty-printed JSON. Non-finite numbers cannot be written in JSON: an

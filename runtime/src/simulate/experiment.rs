@@ -7,9 +7,11 @@
 use super::cardano::{cardano_angles, cardano_matrix, cardano_rates, unwrap_angle};
 use super::excitation::JointLimits;
 use super::motion::{FourierExcitation, RaisedCosine, Trajectory};
+use crate::data::DataError;
 use crate::dynamics::Dynamics;
 use crate::reference::spatial::{vec3 as vector3, Motion as SpatialMotion};
 use crate::reference::{euler_matrix, BodyMotion};
+use crate::Reference;
 use crate::{BodyRegressor, Pose, Wrench};
 use dyngen_model::{principal_frames, Model};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector6};
@@ -155,13 +157,7 @@ pub fn record_trajectory(
         params.len(),
         10 * n
     );
-    let frames = principal_frames(model);
-    let rotations: Vec<Matrix3<f64>> = frames
-        .iter()
-        .map(|f| Matrix3::from_fn(|r, c| f.rotation[r][c]))
-        .collect();
-    let coms: Vec<Vector3<f64>> = frames.iter().map(|f| vector3(&f.com)).collect();
-
+    let frames = Frames::of(model);
     let mut poses = vec![Pose::default(); n];
     let rest = SpatialMotion {
         linear: Vector3::zeros(),
@@ -186,27 +182,7 @@ pub fn record_trajectory(
         dynamics.forward_kinematics(&q, &mut poses);
         dynamics.body_motions(&q, &v, &a, &mut motions);
         dynamics.body_resultants(&q, &v, &a, params, &mut resultants);
-
-        let bodies = (0..n)
-            .map(|i| {
-                let to_principal = rotations[i].transpose();
-                let mut cardano = cardano_angles(&(poses[i].rotation * rotations[i]));
-                if let Some(previous) = samples.last() {
-                    let before = previous.bodies[i].cardano;
-                    cardano.x = unwrap_angle(cardano.x, before.x);
-                    cardano.z = unwrap_angle(cardano.z, before.z);
-                }
-                let angular_velocity = to_principal * motions[i].velocity.angular;
-                BodyMeasurement {
-                    cardano,
-                    cardano_rates: cardano_rates(&cardano, &angular_velocity),
-                    angular_velocity,
-                    angular_acceleration: to_principal * motions[i].acceleration.angular,
-                    com_acceleration: to_principal * motions[i].point_acceleration(&coms[i]),
-                    resultant: resultants[i],
-                }
-            })
-            .collect();
+        let bodies = frames.measure(&poses, &motions, &resultants, samples.last());
         samples.push(Sample {
             t,
             q,
@@ -225,7 +201,144 @@ pub fn record_trajectory(
     }
 }
 
+/// The bodies' centroidal principal frames, in which [`BodyMeasurement`]s are taken.
+struct Frames {
+    rotations: Vec<Matrix3<f64>>,
+    coms: Vec<Vector3<f64>>,
+}
+
+impl Frames {
+    fn of(model: &Model) -> Frames {
+        let frames = principal_frames(model);
+        Frames {
+            rotations: frames
+                .iter()
+                .map(|f| Matrix3::from_fn(|r, c| f.rotation[r][c]))
+                .collect(),
+            coms: frames.iter().map(|f| vector3(&f.com)).collect(),
+        }
+    }
+
+    /// Every body's measurement from its pose, motion and resultant (in principal
+    /// axes, as [`Dynamics::body_resultants`] gives it); Cardano angles unwrapped
+    /// against the `previous` sample.
+    fn measure(
+        &self,
+        poses: &[Pose<f64>],
+        motions: &[BodyMotion],
+        resultants: &[Wrench<f64>],
+        previous: Option<&Sample>,
+    ) -> Vec<BodyMeasurement> {
+        (0..poses.len())
+            .map(|i| {
+                let to_principal = self.rotations[i].transpose();
+                let mut cardano = cardano_angles(&(poses[i].rotation * self.rotations[i]));
+                if let Some(previous) = previous {
+                    let before = previous.bodies[i].cardano;
+                    cardano.x = unwrap_angle(cardano.x, before.x);
+                    cardano.z = unwrap_angle(cardano.z, before.z);
+                }
+                let angular_velocity = to_principal * motions[i].velocity.angular;
+                BodyMeasurement {
+                    cardano,
+                    cardano_rates: cardano_rates(&cardano, &angular_velocity),
+                    angular_velocity,
+                    angular_acceleration: to_principal * motions[i].acceleration.angular,
+                    com_acceleration: to_principal * motions[i].point_acceleration(&self.coms[i]),
+                    resultant: resultants[i],
+                }
+            })
+            .collect()
+    }
+}
+
 impl Recording {
+    /// A recording of measured data, for MIM on a user's own measurements: each
+    /// body's kinematics come from the measured `q, v, a` through `robot`'s
+    /// kinematics (the body-mounted sensors the paper assumes, reconstructed from
+    /// the joints), and each body's resultant from the measured joint wrenches
+    /// ([`Reference::resultants_of_joint_wrenches`]). Torques and joint wrenches
+    /// are kept as measured.
+    ///
+    /// Errors: the data have no velocities or accelerations (estimate them first,
+    /// [`Trajectory::with_derivatives`](crate::data::Trajectory::with_derivatives)),
+    /// no joint wrench columns, or a number of joints other than `robot`'s.
+    pub fn from_measurements(robot: &Reference, data: &crate::data::Trajectory) -> Result<Recording, DataError> {
+        let model = robot.model();
+        let n = model.dof();
+        if data.dof() != n {
+            return Err(DataError::LengthMismatch {
+                what: "joints of the data",
+                expected: n,
+                found: data.dof(),
+            });
+        }
+        let missing = |group, columns: &str| DataError::MissingGroup {
+            group,
+            columns: columns.replace('n', &n.to_string()),
+            needed_for: "MIM from body measurements",
+        };
+        if data.velocities().is_none() {
+            return Err(missing("velocity", "v1..vn"));
+        }
+        if data.accelerations().is_none() {
+            return Err(missing("acceleration", "a1..an"));
+        }
+        if data.joint_wrenches().is_none() {
+            return Err(missing("joint wrench", "fx1, fy1, fz1, mx1, my1, mz1, …, mzn"));
+        }
+        let frames = Frames::of(model);
+        let mut samples: Vec<Sample> = Vec::with_capacity(data.len());
+        for s in data.samples() {
+            let (v, a, wrenches) = (
+                s.v.unwrap_or_default(),
+                s.a.unwrap_or_default(),
+                s.wrenches.unwrap_or_default(),
+            );
+            let poses = robot.forward_kinematics(s.q);
+            let motions = robot.body_motions(s.q, v, a);
+            let resultants = robot.resultants_of_joint_wrenches(s.q, wrenches);
+            let bodies = frames.measure(&poses, &motions, &resultants, samples.last());
+            samples.push(Sample {
+                t: s.t,
+                q: s.q.to_vec(),
+                v: v.to_vec(),
+                a: a.to_vec(),
+                tau: s.tau.to_vec(),
+                joint_wrenches: wrenches.to_vec(),
+                bodies,
+            });
+        }
+        Ok(Recording {
+            gravity: vector3(&model.gravity),
+            joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+            body_names: model.bodies.iter().map(|b| b.name.clone()).collect(),
+            samples,
+        })
+    }
+
+    /// The joint-space channels (t, q, v, a, τ and the joint wrenches) as a
+    /// [`crate::data::Trajectory`], e.g. to write as CSV; the inverse of
+    /// [`Recording::from_measurements`] up to rounding. Errors only on a recording
+    /// that is not a valid trajectory (fewer than 2 samples, time not increasing,
+    /// a non-finite value).
+    pub fn to_trajectory(&self) -> Result<crate::data::Trajectory, DataError> {
+        let n = self.nv();
+        let t = self.samples.iter().map(|s| s.t).collect();
+        let flat = |f: fn(&Sample) -> &Vec<f64>| -> Vec<f64> {
+            self.samples.iter().flat_map(|s| f(s).iter().copied()).collect()
+        };
+        crate::data::Trajectory::new(n, t, flat(|s| &s.q), flat(|s| &s.tau))?
+            .with_velocities(flat(|s| &s.v))?
+            .with_accelerations(flat(|s| &s.a))?
+            .with_wrenches(
+                self.samples
+                    .iter()
+                    .flat_map(|s| s.joint_wrenches.iter().copied())
+                    .collect(),
+            )
+    }
+
     pub fn len(&self) -> usize {
         self.samples.len()
     }

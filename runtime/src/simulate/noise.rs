@@ -55,6 +55,11 @@ pub enum Sigma {
     /// pools its three axes, so a gyro whose x axis sees no motion still gets noise
     /// on x).
     Relative(f64),
+    /// A fraction of each recorded curve's own RMS: a 3-vector's x, y and z each get
+    /// `level ×` their own RMS (for scalars the same as [`Sigma::Relative`]). This is
+    /// "1 % noise on every measured channel" read component by component; an axis
+    /// that barely moves gets correspondingly little noise.
+    RelativePerAxis(f64),
 }
 
 impl Sigma {
@@ -62,7 +67,15 @@ impl Sigma {
         match self {
             Sigma::None => 0.0,
             Sigma::Absolute(s) => s,
-            Sigma::Relative(r) => r * rms,
+            Sigma::Relative(r) | Sigma::RelativePerAxis(r) => r * rms,
+        }
+    }
+
+    /// [`Sigma::Relative`] becomes [`Sigma::RelativePerAxis`]; the others stay.
+    fn per_axis(self) -> Sigma {
+        match self {
+            Sigma::Relative(r) => Sigma::RelativePerAxis(r),
+            s => s,
         }
     }
 }
@@ -168,6 +181,27 @@ impl NoiseModel {
         }
     }
 
+    /// The same model with every [`Sigma::Relative`] channel made
+    /// [`Sigma::RelativePerAxis`]: `NoiseModel::mim(0.01).per_axis()` is 1 % of each
+    /// measured curve's own RMS.
+    pub fn per_axis(self) -> NoiseModel {
+        NoiseModel {
+            q: self.q.per_axis(),
+            v: self.v.per_axis(),
+            a: self.a.per_axis(),
+            tau: self.tau.per_axis(),
+            cardano: self.cardano.per_axis(),
+            cardano_rates: self.cardano_rates.per_axis(),
+            angular_velocity: self.angular_velocity.per_axis(),
+            angular_acceleration: self.angular_acceleration.per_axis(),
+            com_acceleration: self.com_acceleration.per_axis(),
+            joint_force: self.joint_force.per_axis(),
+            joint_moment: self.joint_moment.per_axis(),
+            resultant_force: self.resultant_force.per_axis(),
+            resultant_moment: self.resultant_moment.per_axis(),
+        }
+    }
+
     pub fn sigma(&self, channel: Channel) -> Sigma {
         match channel {
             Channel::Q => self.q,
@@ -216,20 +250,25 @@ impl NoiseModel {
                 }
                 Kind::Vector(get, get_mut) => {
                     let sensors = recording.samples.first().map_or(0, |s| count_vectors(s, channel));
-                    let sigmas: Vec<f64> = (0..sensors)
+                    let sigmas: Vec<[f64; 3]> = (0..sensors)
                         .map(|k| {
-                            let values = recording.samples.iter().flat_map(|s| {
-                                let x = get(s, k);
-                                [x.x, x.y, x.z]
-                            });
-                            sigma.resolve(rms(values))
+                            let axis = |c: usize| rms(recording.samples.iter().map(|s| get(s, k)[c]));
+                            if let Sigma::RelativePerAxis(_) = sigma {
+                                [0, 1, 2].map(|c| sigma.resolve(axis(c)))
+                            } else {
+                                let values = recording.samples.iter().flat_map(|s| {
+                                    let x = get(s, k);
+                                    [x.x, x.y, x.z]
+                                });
+                                [sigma.resolve(rms(values)); 3]
+                            }
                         })
                         .collect();
                     for sample in &mut out.samples {
                         for (k, s) in sigmas.iter().enumerate() {
                             let x = get_mut(sample, k);
                             for c in 0..3 {
-                                x[c] += rng.normal(*s);
+                                x[c] += rng.normal(s[c]);
                             }
                         }
                     }

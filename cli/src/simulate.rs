@@ -2,7 +2,7 @@
 
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
 use dyngen::data::{overwrite_csv, write_csv};
-use dyngen::simulate::{record, ExcitationDesign, Experiment, Motion, NoiseModel};
+use dyngen::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
 use dyngen::Reference;
 use std::path::PathBuf;
 
@@ -11,6 +11,7 @@ Examples:
   dyngen simulate robots/ur5/ur5.urdf -o paper.csv                 # the paper's 2 s, 100 steps
   dyngen simulate robots/ur5/ur5.urdf -o ur5.csv --experiment fourier --noise 0.01 --seed 3
   dyngen simulate arm.urdf -o arm.csv --experiment fourier --duration 20 --steps 2000 --force
+  dyngen simulate arm.urdf -o mim.csv --experiment fourier --criterion body-model --base-frequency 0.5
 
 The CSV has the columns t, q1..qn, v1..vn, a1..an, tau1..taun and the joint wrenches
 fx1, fy1, fz1, mx1, my1, mz1, … (SI units; see the dyngen::data module docs).";
@@ -22,9 +23,20 @@ pub enum ExperimentKind {
     /// within its limits (default 2 s in 100 steps).
     Paper,
     /// A finite Fourier series per joint (Swevers et al. 1997), coefficients
-    /// optimised for the condition number of the base regressor within the joint
-    /// position and velocity limits (default one 10 s period in 100 steps).
+    /// optimised (--criterion) within the joint position and velocity limits
+    /// (default one 10 s period in 100 steps).
     Fourier,
+}
+
+/// What the Fourier coefficients are optimised for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CriterionArg {
+    /// The condition number of the stacked base torque regressor: for
+    /// `identify --mode standard|principal` (joint torques).
+    Torques,
+    /// The worst relative σ of a principal moment from each body's motion and
+    /// resultant: for `identify --mode mim` and `dyngen nim`.
+    BodyModel,
 }
 
 #[derive(Debug, clap::Args)]
@@ -61,6 +73,10 @@ pub struct SimulateArgs {
     /// Seed of the noise and of the excitation optimisation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+
+    /// Fourier: what the coefficients are optimised for.
+    #[arg(long, value_enum, default_value_t = CriterionArg::Torques)]
+    pub criterion: CriterionArg,
 
     /// Fourier: harmonics per joint.
     #[arg(long, default_value_t = 5)]
@@ -126,6 +142,10 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         }
         ExperimentKind::Fourier => {
             let mut design = ExcitationDesign::new(&model);
+            design.criterion = match args.criterion {
+                CriterionArg::Torques => Criterion::JointTorques,
+                CriterionArg::BodyModel => Criterion::BodyModel,
+            };
             design.harmonics = args.harmonics;
             design.base_frequency = args.base_frequency;
             design.duration = args.duration.unwrap_or(1.0 / args.base_frequency);
@@ -135,13 +155,21 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             let found = with_spinner(progress, "optimising the Fourier excitation", || {
                 design.optimise(&robot)
             });
-            eprintln!(
-                "excitation: condition number of the base regressor {:.4e} (start {:.4e}, {} evaluations, {} base columns)",
-                found.condition_number,
-                found.initial_condition_number,
-                found.evaluations,
-                found.base_columns.len()
-            );
+            match found.criterion {
+                Criterion::JointTorques => eprintln!(
+                    "excitation: condition number of the base regressor {:.4e} (start {:.4e}, {} evaluations, {} base \
+                     columns)",
+                    found.value,
+                    found.initial_value,
+                    found.evaluations,
+                    found.base_columns.len()
+                ),
+                Criterion::BodyModel => eprintln!(
+                    "excitation: worst relative σ of a principal moment {:.3} % at 1 % noise (start {:.3} %, {} \
+                     evaluations)",
+                    found.value, found.initial_value, found.evaluations
+                ),
+            }
             Experiment {
                 duration: design.duration,
                 steps: args.steps,

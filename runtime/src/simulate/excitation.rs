@@ -1,19 +1,28 @@
-//! Optimal excitation: Fourier coefficients that make the stacked regressor well
-//! conditioned (Swevers et al. 1997), within joint position and velocity limits.
+//! Optimal excitation: Fourier coefficients that make the identification problem
+//! well conditioned (Swevers et al. 1997), within joint position and velocity limits.
+//! Two criteria ([`Criterion`]):
 //!
-//! The criterion is the condition number `σ_max/σ_min` of the stacked base
-//! regressor `W_b = [Y(q_k, v_k, a_k)]_{k}` restricted to the identifiable columns of
-//! `Y`. Those columns are found once, numerically, by [`base_columns`]: with them,
-//! `Y π = Y_b β` where `Y_b = Y[:, base]` and `β` the base parameters built on those
-//! columns, so `cond(W_b)` is the condition number of the base-parameter least
-//! squares problem the trajectory will feed.
+//! * for identification from joint torques, the condition number `σ_max/σ_min` of
+//!   the stacked base regressor `W_b = [Y(q_k, v_k, a_k)]_{k}` restricted to the
+//!   identifiable columns of `Y`. Those columns are found once, numerically, by
+//!   [`base_columns`]: with them, `Y π = Y_b β` where `Y_b = Y[:, base]` and `β` the
+//!   base parameters built on those columns, so `cond(W_b)` is the condition number
+//!   of the base-parameter least squares problem the trajectory will feed;
+//! * for MIM on body measurements, the worst relative standard deviation of a
+//!   principal moment: per body `i`, with `B_i` stacked over the samples and
+//!   `M_i = B_i J_i` its moments at the nominal parameters,
+//!   `max_k √([(B_iᵀ B_i)⁻¹]_kk) · rms(M_i) / J_ik` over the bodies and the moments
+//!   that enter their equations. It is the relative σ of `Ĵ_ik` per unit of relative
+//!   noise on the moments (5.7 means 5.7 % at 1 % noise). Masses are left out: gravity
+//!   alone makes them well conditioned.
 
 use super::motion::{FourierExcitation, Trajectory};
 use super::nelder_mead;
 use crate::dynamics::Dynamics;
 use crate::reference::{sample_states, SplitMix64};
+use crate::BodyRegressor;
 use dyngen_model::{JointKind, Model};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Matrix3, Vector3};
 use std::f64::consts::PI;
 
 /// Where one joint may go: positions in `[lower, upper]`, speeds up to `velocity`.
@@ -120,9 +129,23 @@ fn pivoted_columns(mut w: DMatrix<f64>, tolerance: f64) -> Vec<usize> {
     chosen
 }
 
+/// What [`ExcitationDesign::optimise`] minimises (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Criterion {
+    /// `cond(W_b)` of the stacked base torque regressor: for identification from
+    /// joint torques.
+    #[default]
+    JointTorques,
+    /// The worst relative σ of a principal moment per unit of relative noise: for
+    /// MIM (and NIM) on each body's measured motion and resultant.
+    BodyModel,
+}
+
 /// Settings of [`ExcitationDesign::optimise`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExcitationDesign {
+    /// What to minimise.
+    pub criterion: Criterion,
     /// Harmonics `L` per joint (Swevers: 5).
     pub harmonics: usize,
     /// Base frequency `f_f`, Hz; the trajectory repeats every `1/f_f` s.
@@ -137,7 +160,7 @@ pub struct ExcitationDesign {
     /// duration.
     pub limits: Vec<JointLimits>,
     /// Objective evaluations allowed in total (each one evaluates `samples`
-    /// regressors and one SVD).
+    /// regressors and one SVD or a few 3 × 3 inverses).
     pub max_evaluations: usize,
     /// Nelder–Mead runs; each after the first restarts from the best point with a
     /// fresh simplex.
@@ -150,11 +173,12 @@ pub struct ExcitationDesign {
 }
 
 impl ExcitationDesign {
-    /// Defaults for `model`: `L = 5`, `f_f = 0.1` Hz, one 10 s period sampled 100
-    /// times, the model's [`JointLimits`], 3000 evaluations in 3 runs, free start,
-    /// seed 1.
+    /// Defaults for `model`: the joint-torque criterion, `L = 5`, `f_f = 0.1` Hz, one
+    /// 10 s period sampled 100 times, the model's [`JointLimits`], 3000 evaluations
+    /// in 3 runs, free start, seed 1.
     pub fn new(model: &Model) -> ExcitationDesign {
         ExcitationDesign {
+            criterion: Criterion::JointTorques,
             harmonics: 5,
             base_frequency: 0.1,
             duration: 10.0,
@@ -167,11 +191,11 @@ impl ExcitationDesign {
         }
     }
 
-    /// Optimises the Fourier coefficients and offsets for the smallest condition
-    /// number of the stacked base regressor (see the module docs) within the limits.
+    /// Optimises the Fourier coefficients and offsets for the smallest value of the
+    /// [`Criterion`] (see the module docs) within the limits.
     ///
     /// Variables: per joint `q0_i` and the free `a_il`, `b_il`. Objective:
-    /// `log10 cond(W_b)` on feasible points, `10⁶ +` (total limit violation,
+    /// `log10` of the criterion on feasible points, `10⁶ +` (total limit violation,
     /// relative to each joint's range or speed) on infeasible ones, so infeasible
     /// points always lose to feasible ones yet still point back to feasibility. The
     /// start is random (seeded): `a_il, b_il ~ U(−1, 1)/l`, `q0` mid-range, scaled
@@ -227,7 +251,7 @@ impl ExcitationDesign {
             }
         }
         let initial = layout.decode(&x);
-        let initial_condition_number = objective.condition_number(&initial);
+        let initial_value = objective.criterion(&initial);
 
         // Simplex steps: a tenth of the half-range for offsets, a quarter of the
         // speed share of one harmonic for coefficients.
@@ -258,18 +282,18 @@ impl ExcitationDesign {
         }
 
         let excitation = layout.decode(&best.0);
-        let condition_number = objective.condition_number(&excitation);
-        let (condition_number, excitation) = if objective.violation(&excitation) > 0.0 || !condition_number.is_finite()
-        {
+        let value = objective.criterion(&excitation);
+        let (value, excitation) = if objective.violation(&excitation) > 0.0 || !(value <= initial_value) {
             // Never happens from a feasible start, but never return worse than it.
-            (initial_condition_number, initial)
+            (initial_value, initial)
         } else {
-            (condition_number, excitation)
+            (value, excitation)
         };
         OptimisedExcitation {
             excitation,
-            condition_number,
-            initial_condition_number,
+            criterion: self.criterion,
+            value,
+            initial_value,
             evaluations,
             base_columns: base,
         }
@@ -280,10 +304,13 @@ impl ExcitationDesign {
 #[derive(Clone, Debug, PartialEq)]
 pub struct OptimisedExcitation {
     pub excitation: FourierExcitation,
-    /// `cond(W_b)` of the result over the design's samples.
-    pub condition_number: f64,
-    /// `cond(W_b)` of the random feasible start.
-    pub initial_condition_number: f64,
+    /// The criterion minimised.
+    pub criterion: Criterion,
+    /// Its value for the result over the design's samples: `cond(W_b)`, or the worst
+    /// relative σ of a principal moment per unit of relative noise.
+    pub value: f64,
+    /// Its value for the random feasible start.
+    pub initial_value: f64,
     /// Objective evaluations spent.
     pub evaluations: usize,
     /// The identifiable columns of `Y` the criterion used ([`base_columns`]).
@@ -366,23 +393,44 @@ impl Layout {
 /// The criterion with its sample times and base columns fixed.
 struct Objective<'a> {
     dynamics: &'a dyn Dynamics,
+    criterion: Criterion,
     base: &'a [usize],
     samples: Vec<f64>,
     grid: Vec<f64>,
     limits: &'a [JointLimits],
+    /// [`Criterion::BodyModel`]: the nominal principal moments of each body and
+    /// whether each enters the body's equations at all.
+    moments: Vec<([f64; 3], [bool; 3])>,
 }
 
 impl<'a> Objective<'a> {
     fn new(design: &'a ExcitationDesign, dynamics: &'a dyn Dynamics, base: &'a [usize]) -> Objective<'a> {
         let times = |count: usize| (0..count).map(|k| k as f64 * design.duration / count as f64).collect();
         let grid = (4 * design.samples).max(64 * design.harmonics);
+        let moments = match design.criterion {
+            Criterion::JointTorques => Vec::new(),
+            Criterion::BodyModel => body_moments(dynamics, design.seed),
+        };
         Objective {
             dynamics,
+            criterion: design.criterion,
             base,
             samples: times(design.samples),
             grid: times(grid),
             limits: &design.limits,
+            moments,
         }
+    }
+
+    fn criterion(&self, e: &FourierExcitation) -> f64 {
+        match self.criterion {
+            Criterion::JointTorques => self.condition_number(e),
+            Criterion::BodyModel => self.worst_moment_sigma(e),
+        }
+    }
+
+    fn worst_moment_sigma(&self, e: &FourierExcitation) -> f64 {
+        worst_moment_sigma(self.dynamics, &self.moments, e, &self.samples)
     }
 
     /// Total relative violation of the position and velocity limits on the grid.
@@ -436,13 +484,98 @@ impl<'a> Objective<'a> {
         if violation > 0.0 {
             return 1e6 + violation;
         }
-        let c = self.condition_number(e);
+        let c = self.criterion(e);
         if c.is_finite() {
             c.log10()
         } else {
             1e5
         }
     }
+}
+
+/// [`Criterion::BodyModel`] of any trajectory sampled at `times`: the worst relative
+/// σ of a principal moment per unit of relative moment noise (see the module docs;
+/// ∞ when a moment that enters the equations is not determined). It says how well
+/// an experiment suits MIM before it is run:
+///
+/// ```
+/// use dyngen::dynamics::Dynamics;
+/// use dyngen::simulate::{moment_sigma, Experiment};
+/// let model = dyngen::model::parse_urdf(include_str!("../../../tests/fixtures/paper6.urdf")).unwrap();
+/// let robot = dyngen::Reference::new(&model);
+/// let paper = Experiment::paper(&model);
+/// let s = moment_sigma(&robot, &paper.motion, &paper.times());
+/// assert!(s > 1.0 && s.is_finite()); // > 1 % σ at 1 % noise: some moment is barely excited
+/// ```
+pub fn moment_sigma(dynamics: &dyn Dynamics, trajectory: &dyn Trajectory, times: &[f64]) -> f64 {
+    worst_moment_sigma(dynamics, &body_moments(dynamics, 1), trajectory, times)
+}
+
+fn worst_moment_sigma(
+    dynamics: &dyn Dynamics,
+    moments: &[([f64; 3], [bool; 3])],
+    trajectory: &dyn Trajectory,
+    times: &[f64],
+) -> f64 {
+    let n = trajectory.nv();
+    let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut blocks = vec![BodyRegressor::default(); n];
+    let mut grams = vec![Matrix3::<f64>::zeros(); n];
+    let mut squares = vec![0.0; n];
+    for &t in times {
+        trajectory.eval(t, &mut q, &mut v, &mut a);
+        dynamics.body_regressors(&q, &v, &a, &mut blocks);
+        for (i, block) in blocks.iter().enumerate() {
+            let b: Matrix3<f64> = block.moment.fixed_columns::<3>(1).into_owned();
+            grams[i] += b.transpose() * b;
+            squares[i] += (b * Vector3::from(moments[i].0)).norm_squared();
+        }
+    }
+    let mut worst = 0.0f64;
+    for (i, (j, enters)) in moments.iter().enumerate() {
+        let active: Vec<usize> = (0..3).filter(|&k| enters[k]).collect();
+        if active.is_empty() {
+            continue;
+        }
+        let g = DMatrix::from_fn(active.len(), active.len(), |r, c| grams[i][(active[r], active[c])]);
+        let Some(inverse) = g.cholesky().map(|c| c.inverse()) else {
+            return f64::INFINITY;
+        };
+        let rms = (squares[i] / (3 * times.len()) as f64).sqrt();
+        for (r, &k) in active.iter().enumerate() {
+            worst = worst.max(inverse[(r, r)].max(0.0).sqrt() * rms / j[k]);
+        }
+    }
+    worst
+}
+
+/// Per body, the nominal principal moments `(J1, J2, J3)` and which of them enter
+/// the body's equations: a column of `B(ω, ω̇)` that is zero (relative to the
+/// body's largest) on 40 random states from [`sample_states`] is zero for every
+/// motion (a turret turning about its own axis never feels its `J1`, `J2`).
+fn body_moments(dynamics: &dyn Dynamics, seed: u64) -> Vec<([f64; 3], [bool; 3])> {
+    let model = dynamics.model();
+    let n = dynamics.nv();
+    let theta = crate::mim::true_theta(model);
+    let mut norms = vec![[0.0f64; 3]; n];
+    let mut blocks = vec![BodyRegressor::default(); n];
+    for s in sample_states(model, 40, seed) {
+        dynamics.body_regressors(&s.q, &s.v, &s.a, &mut blocks);
+        for (i, block) in blocks.iter().enumerate() {
+            for k in 0..3 {
+                norms[i][k] += block.moment.column(k + 1).norm_squared();
+            }
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let largest = norms[i].iter().copied().fold(0.0, f64::max);
+            (
+                [theta[4 * i + 1], theta[4 * i + 2], theta[4 * i + 3]],
+                norms[i].map(|x| x > 1e-20 * largest && largest > 0.0),
+            )
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -199,7 +199,7 @@ struct Identified {
 
 enum Prediction {
     /// Rows of this regressor times the estimate's solution.
-    Regressor { estimate: Estimate, principal: bool },
+    Regressor { estimate: Box<Estimate>, principal: bool },
     /// Inverse dynamics with these standard parameters.
     Parameters(Vec<f64>),
 }
@@ -269,7 +269,10 @@ fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress:
     let identified = Identified {
         report,
         per_body: if principal { 4 } else { 10 },
-        prediction: Prediction::Regressor { estimate, principal },
+        prediction: Prediction::Regressor {
+            estimate: Box::new(estimate),
+            principal,
+        },
     };
     if args.truth_from_urdf {
         print_errors(&identified, model);

@@ -10,6 +10,7 @@ mod demo;
 mod generate;
 mod identify;
 mod info;
+mod nim;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -21,6 +22,7 @@ Examples:
   dyngen generate robots/ur5/ur5.urdf --name Ur5 -o ur5.rs
   dyngen simulate robots/ur5/ur5.urdf -o ur5.csv --experiment fourier --noise 0.01
   dyngen identify robots/ur5/ur5.urdf ur5.csv --method wls
+  dyngen nim train robots/ur5/ur5.urdf ur5.csv -o ur5-nim.json
   dyngen demo
 
 Run `dyngen <command> --help` for the options of one command.";
@@ -52,11 +54,19 @@ pub enum Command {
     /// write the measurements as CSV.
     #[command(after_help = simulate::EXAMPLES)]
     Simulate(simulate::SimulateArgs),
-    /// Identify the standard inertial parameters from joint torques in a CSV file.
+    /// Identify the inertial parameters from measured data in a CSV file: from joint
+    /// torques (standard or principal parameters) or body by body from joint
+    /// wrenches (MIM).
     #[command(after_help = identify::EXAMPLES)]
     Identify(identify::IdentifyArgs),
-    /// The paper's experiment on its 6-DOF manipulator, identified by MIM: Tables 2–3
-    /// from one instant and from all samples, noise-free and with sensor noise.
+    /// The neural-network identifier (NIM): train it for a robot and a joint motion,
+    /// or identify with it.
+    #[command(after_help = nim::EXAMPLES)]
+    Nim(nim::NimArgs),
+    /// The paper's experiment on its 6-DOF manipulator end to end: MIM (Tables 2–3,
+    /// noise study), NIM as the paper describes it (Tables 4–5, Fig. 5), the
+    /// generalising NIM, all three side by side on unseen parameters, and a payload
+    /// followed online by NIM and recursive least squares.
     #[command(after_help = demo::EXAMPLES)]
     Demo(demo::DemoArgs),
 }
@@ -78,6 +88,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(args, &progress),
         Command::Simulate(args) => simulate::run(args, &progress),
         Command::Identify(args) => identify::run(args, &progress),
+        Command::Nim(args) => nim::run(args, &progress),
         Command::Demo(args) => demo::run(args, &progress),
     };
     match result {

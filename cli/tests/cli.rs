@@ -9,10 +9,20 @@ fn help_has_examples() {
     let o = run!("--help");
     assert_ok(&o);
     assert!(stdout(&o).contains("Examples:"));
-    for cmd in ["info", "generate", "simulate", "identify"] {
-        let o = run!(cmd, "--help");
+    for cmd in [
+        &["info"][..],
+        &["generate"],
+        &["simulate"],
+        &["identify"],
+        &["demo"],
+        &["nim", "train"],
+        &["nim", "predict"],
+    ] {
+        let mut args: Vec<&str> = cmd.to_vec();
+        args.push("--help");
+        let o = common::dyngen(&args.iter().map(std::ffi::OsStr::new).collect::<Vec<_>>());
         assert_ok(&o);
-        assert!(stdout(&o).contains("Examples:"), "{cmd}: {}", stdout(&o));
+        assert!(stdout(&o).contains("Examples:"), "{cmd:?}: {}", stdout(&o));
     }
 }
 
@@ -183,15 +193,26 @@ fn bad_inputs_name_the_file_and_line() {
 
 /// `dyngen demo` reproduces the paper's Tables 2–3 on paper6: noise-free MIM from the
 /// single instant recovers every identifiable parameter, and the turret's J1, J2 are
-/// reported as not identifiable rather than as numbers.
+/// reported as not identifiable rather than as numbers; the NIM sections run (on a
+/// small training budget here: the accuracy of the full one is tested in the tests
+/// crate) and write their figures.
 #[test]
 fn demo_prints_the_papers_tables() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dyngen"))
-        .args(["demo", "--quiet"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = String::from_utf8_lossy(&out.stdout);
+    let dir = temp_dir("dyngen-cli", "demo");
+    let o = run!(
+        "demo",
+        "--quiet",
+        "--draws",
+        "60",
+        "--steps",
+        "150",
+        "--test-draws",
+        "3",
+        "--out",
+        dir
+    );
+    assert_ok(&o);
+    let text = stdout(&o);
     assert!(text.contains("single instant t = 1.500 s (sample 75)"), "{text}");
     let body1 = text.lines().find(|l| l.starts_with("body1")).expect("a row for body 1");
     assert_eq!(body1.matches("n/i").count(), 2, "{body1}");
@@ -202,4 +223,30 @@ fn demo_prints_the_papers_tables() {
         .and_then(|x| x.parse().ok())
         .expect("a largest relative error line");
     assert!(first_error < 1e-9, "noise-free single-instant MIM: {first_error:e}");
+    for section in [
+        "== noise study",
+        "(cf. the paper's Table 4)",
+        "(cf. the paper's Table 5)",
+        "== the generalising NIM ==",
+        "== side by side",
+        "generalising NIM (windows of 20)",
+        "== a payload picked up mid-motion",
+        "RLS, memory 20 samples",
+    ] {
+        assert!(text.contains(section), "missing `{section}`:\n{text}");
+    }
+    for (figure, legend) in [
+        ("fig5_paper_nim_mse.svg", ["body1", "body6", "threshold"]),
+        ("nim_training.svg", ["body1", "body3", "body6"]),
+        ("payload_tracking.svg", ["NIM", "RLS, memory 20 samples", "true mass"]),
+    ] {
+        let svg = std::fs::read_to_string(dir.join(figure)).unwrap();
+        assert!(svg.starts_with("<svg"), "{figure}");
+        for name in legend {
+            assert!(svg.contains(&format!(">\n{name}")), "{figure} has no line `{name}`");
+        }
+    }
+    // The figures are not replaced without --force, and nothing is computed first.
+    let o = run!("demo", "--quiet", "--out", dir);
+    assert_error(&o, "--force");
 }

@@ -11,6 +11,7 @@ pub mod data;
 pub mod dynamics;
 pub mod identify;
 pub mod mim;
+pub mod nim;
 pub mod reference;
 pub mod report;
 mod robot;

@@ -268,6 +268,43 @@ impl fmt::Display for MimEstimate {
     /// The paper's Tables 2–3: identified parameters per body, then absolute (and
     /// relative) errors when the truth is known.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "MIM, {}", self.source)?;
+        let cells: Vec<Result<f64, &str>> = (0..self.bodies())
+            .flat_map(|i| (0..4).map(move |k| (i, k)))
+            .map(|(i, k)| self.value(i, k).ok_or(self.verdict(i, k).short()))
+            .collect();
+        let table = ThetaTable {
+            body_names: &self.body_names,
+            cells: &cells,
+            truth: self.truth.as_deref(),
+            tables: [2, 3],
+        };
+        write!(f, "{table}")?;
+        if cells.iter().any(Result::is_err) {
+            writeln!(
+                f,
+                "n/i: not identifiable (does not enter the equations); n/s: not significant (|x̂| < {}σ̂); \
+                 comb.: only in combination",
+                self.significance
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// θ per body in the layout of the paper's tables: the values (or why there is
+/// none), then, with the truth, the absolute errors and the largest relative one.
+/// `tables` are the paper's table numbers to cite (2–3 for MIM, 4–5 for NIM).
+pub(crate) struct ThetaTable<'a> {
+    pub body_names: &'a [String],
+    /// `4n` cells, body 1 first: a value or a short note (`n/i`, …).
+    pub cells: &'a [Result<f64, &'a str>],
+    pub truth: Option<&'a [f64]>,
+    pub tables: [u32; 2],
+}
+
+impl fmt::Display for ThetaTable<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let width = self
             .body_names
             .iter()
@@ -275,65 +312,62 @@ impl fmt::Display for MimEstimate {
             .max()
             .unwrap_or(4)
             .max(6);
-        writeln!(f, "MIM, {}", self.source)?;
-        writeln!(f, "identified parameters (cf. the paper's Table 2)")?;
+        let [values, errors] = self.tables;
+        writeln!(f, "identified parameters (cf. the paper's Table {values})")?;
         writeln!(
             f,
             "{:<width$}  {:>13}  {:>13}  {:>13}  {:>13}",
             "body", "m (kg)", "J1 (kg·m²)", "J2 (kg·m²)", "J3 (kg·m²)"
         )?;
-        let mut notes = false;
-        for i in 0..self.bodies() {
-            write!(f, "{:<width$}", self.body_names[i])?;
-            for k in 0..4 {
-                let cell = match self.value(i, k) {
-                    Some(v) => format!("{v:.6}"),
-                    None => {
-                        notes = true;
-                        self.verdict(i, k).short().to_string()
-                    }
+        for (i, name) in self.body_names.iter().enumerate() {
+            write!(f, "{name:<width$}")?;
+            for cell in &self.cells[4 * i..4 * i + 4] {
+                let cell = match cell {
+                    Ok(v) => format!("{v:.6}"),
+                    Err(note) => note.to_string(),
                 };
                 write!(f, "  {cell:>13}")?;
             }
             writeln!(f)?;
         }
-        if let Some(errors) = self.errors() {
-            writeln!(f, "absolute errors (cf. the paper's Table 3)")?;
-            writeln!(
-                f,
-                "{:<width$}  {:>13}  {:>13}  {:>13}  {:>13}",
-                "body", "Δm (kg)", "ΔJ1 (kg·m²)", "ΔJ2 (kg·m²)", "ΔJ3 (kg·m²)"
-            )?;
-            for i in 0..self.bodies() {
-                write!(f, "{:<width$}", self.body_names[i])?;
-                for e in &errors[4 * i..4 * i + 4] {
-                    let cell = e
-                        .absolute
-                        .map_or_else(|| e.verdict.short().to_string(), |a| format!("{a:.3e}"));
-                    write!(f, "  {cell:>13}")?;
-                }
-                writeln!(f)?;
+        let Some(truth) = self.truth else {
+            return Ok(());
+        };
+        writeln!(f, "absolute errors (cf. the paper's Table {errors})")?;
+        writeln!(
+            f,
+            "{:<width$}  {:>13}  {:>13}  {:>13}  {:>13}",
+            "body", "Δm (kg)", "ΔJ1 (kg·m²)", "ΔJ2 (kg·m²)", "ΔJ3 (kg·m²)"
+        )?;
+        let mut worst: Option<(f64, usize)> = None;
+        for (i, name) in self.body_names.iter().enumerate() {
+            write!(f, "{name:<width$}")?;
+            for j in 4 * i..4 * i + 4 {
+                let cell = match self.cells[j] {
+                    Ok(v) => {
+                        let absolute = (v - truth[j]).abs();
+                        let relative = if truth[j] == 0.0 {
+                            absolute
+                        } else {
+                            absolute / truth[j].abs()
+                        };
+                        if worst.is_none_or(|(w, _)| relative > w) {
+                            worst = Some((relative, j));
+                        }
+                        format!("{absolute:.3e}")
+                    }
+                    Err(note) => note.to_string(),
+                };
+                write!(f, "  {cell:>13}")?;
             }
-            if let Some(worst) = errors
-                .iter()
-                .filter(|e| e.relative.is_some())
-                .max_by(|a, b| a.relative.unwrap().total_cmp(&b.relative.unwrap()))
-            {
-                writeln!(
-                    f,
-                    "largest relative error {:.3e} ({} of {})",
-                    worst.relative.unwrap(),
-                    THETA_NAMES[worst.index],
-                    self.body_names[worst.body]
-                )?;
-            }
+            writeln!(f)?;
         }
-        if notes {
+        if let Some((w, j)) = worst {
             writeln!(
                 f,
-                "n/i: not identifiable (does not enter the equations); n/s: not significant (|x̂| < {}σ̂); \
-                 comb.: only in combination",
-                self.significance
+                "largest relative error {w:.3e} ({} of {})",
+                THETA_NAMES[j % 4],
+                self.body_names[j / 4]
             )?;
         }
         Ok(())

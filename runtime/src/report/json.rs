@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 use super::{write_new, ReportError};
 use crate::identify::{Estimate, Status};
 use crate::mim::{theta_names, MimEstimate, Verdict};
+use crate::nim::NimEstimate;
 
 /// The `schema` field this module writes and accepts.
 pub const SCHEMA: &str = "dyngen-parameters/1";
@@ -237,6 +238,51 @@ impl ParameterReport {
             }
         }
         report
+    }
+
+    /// The report of a NIM estimate ([`crate::nim::Nim::identify`]): `θ` named
+    /// `m_1, J1_1, …`; a parameter the body's equations do not carry is
+    /// `no_effect`, one whose window predictions disagree `not_significant`, both
+    /// without value. `sigma` is the standard error of the mean of the window
+    /// predictions (their spread over the square root of the number of windows
+    /// that share no sample); `rank` counts the parameters with a value.
+    pub fn from_nim(robot: &str, estimate: &NimEstimate) -> ParameterReport {
+        let names = theta_names(estimate.body_names.len());
+        let parameters: Vec<ParamReport> = names
+            .into_iter()
+            .enumerate()
+            .map(|(j, name)| {
+                let value = estimate.theta[j].filter(|v| v.is_finite());
+                let sigma = value.and(estimate.standard_error(j));
+                ParamReport {
+                    name,
+                    value,
+                    sigma,
+                    sigma_percent: value.zip(sigma).map(|(v, s)| 100.0 * s / v.abs()),
+                    status: match estimate.verdicts[j] {
+                        Verdict::Identified => ParamStatus::Identified,
+                        Verdict::NotSignificant => ParamStatus::NotSignificant,
+                        Verdict::InCombination => ParamStatus::InCombination,
+                        Verdict::NoEffect => ParamStatus::NoEffect,
+                    },
+                }
+            })
+            .collect();
+        ParameterReport {
+            schema: SCHEMA.to_string(),
+            robot: robot.to_string(),
+            parameterisation: Parameterisation::Principal,
+            method: format!(
+                "NIM: window network, mean over {} windows of {} samples",
+                estimate.windows, estimate.window
+            ),
+            rank: parameters.iter().filter(|p| p.value.is_some()).count(),
+            condition_number: None,
+            residual_rms: Vec::new(),
+            channels: Vec::new(),
+            parameters,
+            combinations: Vec::new(),
+        }
     }
 
     /// Pretty-printed JSON. Non-finite numbers cannot be written in JSON: an

@@ -1,6 +1,7 @@
 //! What identification hands to people and to other tools: the parameters as JSON
 //! ([`ParameterReport`]), the URDF rewritten with identified inertials
-//! ([`rewrite_urdf_inertials`]) and an SVG report of the fit ([`svg_report`]).
+//! ([`rewrite_urdf_inertials`]), an SVG report of the fit ([`svg_report`]) and line
+//! charts such as training curves ([`svg_lines`]).
 //!
 //! Each output is built as a string with no I/O; [`write_new`] writes it and never
 //! replaces an existing file unless asked to.
@@ -12,7 +13,7 @@ mod urdf;
 
 pub use error::ReportError;
 pub use json::{CombinationReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, Term, SCHEMA};
-pub use svg::{svg_report, svg_report_with, SvgOptions};
+pub use svg::{svg_lines, svg_report, svg_report_with, LineChart, SvgOptions};
 pub use urdf::{rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;

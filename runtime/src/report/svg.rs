@@ -306,3 +306,113 @@ fn error_chart(area: &DrawingArea<SVGBackend<'_>, Shift>, errors: &[(String, Opt
     }
     Ok(())
 }
+
+/// A chart of lines, for [`svg_lines`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LineChart<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    /// A logarithmic y axis (every y must then be > 0).
+    pub log_y: bool,
+    /// `(name, [(x, y)])` per line.
+    pub curves: &'a [(String, Vec<(f64, f64)>)],
+    /// A horizontal reference line: `(name, y)`.
+    pub reference: Option<(&'a str, f64)>,
+}
+
+/// Lines against a common x axis, e.g. the paper's Fig. 5 (MSE against training
+/// step, log scale) or estimates against time. Non-finite points, and points with
+/// `y ≤ 0` on a log axis, are an error.
+pub fn svg_lines(chart: &LineChart<'_>) -> Result<String, ReportError> {
+    for (c, (_, points)) in chart.curves.iter().enumerate() {
+        if let Some(k) = points
+            .iter()
+            .position(|&(x, y)| !(x.is_finite() && y.is_finite() && (!chart.log_y || y > 0.0)))
+        {
+            return Err(ReportError::NonFinite {
+                what: format!(
+                    "curves[{c}] (x and y finite{})",
+                    if chart.log_y { ", y > 0 on a log axis" } else { "" }
+                ),
+                index: k,
+            });
+        }
+    }
+    let points = || chart.curves.iter().flat_map(|(_, p)| p.iter());
+    let x = range(points().map(|p| p.0));
+    let ys = || points().map(|p| p.1).chain(chart.reference.map(|r| r.1));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 520)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        if chart.log_y {
+            let lo = ys().filter(|y| *y > 0.0).fold(f64::INFINITY, f64::min);
+            let hi = ys().fold(f64::NEG_INFINITY, f64::max);
+            let (lo, hi) = if lo.is_finite() && hi > lo {
+                (lo / 2.0, hi * 2.0)
+            } else {
+                (1e-6, 1.0)
+            };
+            draw_lines(&root, chart, x, (lo..hi).log_scale(), &|v| format!("{v:.0e}"))?;
+        } else {
+            draw_lines(&root, chart, x, range(ys()), &|v| format!("{v:.3}"))?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
+
+fn draw_lines<Y>(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    chart: &LineChart<'_>,
+    x: std::ops::Range<f64>,
+    y: Y,
+    y_format: &dyn Fn(&f64) -> String,
+) -> Result<(), ReportError>
+where
+    Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+    Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    let (x_lo, x_hi) = (x.start, x.end);
+    let mut plot = ChartBuilder::on(root)
+        .caption(chart.title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x, y)
+        .map_err(plot_error)?;
+    plot.configure_mesh()
+        .x_desc(chart.x_label)
+        .y_desc(chart.y_label)
+        .y_label_formatter(y_format)
+        .label_style(("sans-serif", 12))
+        .axis_desc_style(("sans-serif", 12))
+        .light_line_style(WHITE)
+        .draw()
+        .map_err(plot_error)?;
+    for (c, (name, points)) in chart.curves.iter().enumerate() {
+        let colour = Palette99::pick(c).to_rgba();
+        plot.draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(2)))
+            .map_err(plot_error)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+    }
+    if let Some((name, level)) = chart.reference {
+        plot.draw_series(LineSeries::new(
+            [(x_lo, level), (x_hi, level)],
+            BLACK.mix(0.5).stroke_width(1),
+        ))
+        .map_err(plot_error)?
+        .label(name)
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.5).stroke_width(1)));
+    }
+    plot.configure_series_labels()
+        .label_font(("sans-serif", 12))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK.mix(0.3))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(plot_error)?;
+    Ok(())
+}

@@ -283,7 +283,8 @@ impl ExcitationDesign {
 
         let excitation = layout.decode(&best.0);
         let value = objective.criterion(&excitation);
-        let (value, excitation) = if objective.violation(&excitation) > 0.0 || !(value <= initial_value) {
+        let worse = value.is_nan() || value > initial_value;
+        let (value, excitation) = if objective.violation(&excitation) > 0.0 || worse {
             // Never happens from a feasible start, but never return worse than it.
             (initial_value, initial)
         } else {

@@ -212,3 +212,64 @@ impl Trajectory for FourierExcitation {
         }
     }
 }
+
+/// A joint motion given by samples (measured, say): `q`, `v`, `a` at the times `t`,
+/// linearly interpolated in between and held constant outside, so that replaying it
+/// at the sample times gives the samples back exactly. Lets the simulator run a
+/// robot, with other parameters, along a motion that was recorded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampledMotion {
+    t: Vec<f64>,
+    n: usize,
+    /// `q`, `v`, `a` of sample `k`: `states[k][0..n]`, `[n..2n]`, `[2n..3n]`.
+    states: Vec<Vec<f64>>,
+}
+
+impl SampledMotion {
+    /// From a checked [`Trajectory`](crate::data::Trajectory) of measured data with
+    /// velocities and accelerations; `None` when it has neither (estimate them
+    /// first with [`with_derivatives`](crate::data::Trajectory::with_derivatives)).
+    pub fn from_data(data: &crate::data::Trajectory) -> Option<SampledMotion> {
+        let states = (0..data.len())
+            .map(|k| {
+                let (v, a) = (data.v(k)?, data.a(k)?);
+                Some([data.q(k), v, a].concat())
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some(SampledMotion {
+            t: data.t().to_vec(),
+            n: data.dof(),
+            states,
+        })
+    }
+
+    /// The sample times.
+    pub fn times(&self) -> &[f64] {
+        &self.t
+    }
+}
+
+impl Trajectory for SampledMotion {
+    fn nv(&self) -> usize {
+        self.n
+    }
+
+    fn eval(&self, t: f64, q: &mut [f64], v: &mut [f64], a: &mut [f64]) {
+        check_out(self.n, q, v, a);
+        let k = self.t.partition_point(|&s| s <= t);
+        let (lo, hi, w) = if k == 0 {
+            (0, 0, 0.0)
+        } else if k == self.t.len() {
+            (k - 1, k - 1, 0.0)
+        } else {
+            (k - 1, k, (t - self.t[k - 1]) / (self.t[k] - self.t[k - 1]))
+        };
+        let (x, y) = (&self.states[lo], &self.states[hi]);
+        for (i, out) in [q, v, a].into_iter().enumerate() {
+            for (j, o) in out.iter_mut().enumerate() {
+                let c = i * self.n + j;
+                *o = x[c] + w * (y[c] - x[c]);
+            }
+        }
+    }
+}

@@ -1,0 +1,358 @@
+//! `dyngen nim`: the generalising neural-network identifier on any URDF: `train`
+//! along the joint motion of a CSV file (on simulated parameter draws), `predict`
+//! the principal parameters from measured data.
+
+use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use clap::{Args, Subcommand};
+use dyngen::data::{read_csv, Trajectory};
+use dyngen::mim;
+use dyngen::nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
+use dyngen::reference::{principal_params_to_standard, SplitMix64};
+use dyngen::report::{self, ParameterReport};
+use dyngen::simulate::{record_trajectory, Recording, SampledMotion};
+use dyngen::Reference;
+use dyngen_model::Model;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+pub const EXAMPLES: &str = "\
+Examples:
+  dyngen simulate arm.urdf -o run.csv --experiment fourier --criterion body-model --base-frequency 0.5 --duration 4 --steps 200
+  dyngen nim train arm.urdf run.csv -o arm-nim.json
+  dyngen nim predict arm.urdf arm-nim.json measured.csv --params-json nim.json
+
+train simulates the robot along the joint motion of the CSV (t, q and, if present,
+v and a) with many parameter draws around the URDF's inertials and trains one
+network per body; predict reads measured data along that motion (with the joint
+wrench columns fx1..mzn) and prints each body's (m, J1, J2, J3). A network only
+knows the motion it was trained on: predict warns when the data move otherwise.";
+
+#[derive(Debug, Args)]
+pub struct NimArgs {
+    #[command(subcommand)]
+    pub command: NimCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum NimCommand {
+    /// Train the identifier along the joint motion of a CSV file.
+    #[command(after_help = EXAMPLES)]
+    Train(TrainArgs),
+    /// Identify every body's (m, J1, J2, J3) from measured data with a trained
+    /// identifier.
+    #[command(after_help = EXAMPLES)]
+    Predict(PredictArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    /// The robot (URDF); its inertials are the centre of the parameter draws.
+    pub urdf: PathBuf,
+    /// The joint motion to train along (CSV: t, q1..qn[, v, a], tau1..taun; v and a
+    /// are estimated from q when missing).
+    pub motion: PathBuf,
+    /// Where to write the identifier (JSON). An existing file is kept unless --force.
+    #[arg(long, short)]
+    pub output: PathBuf,
+    #[arg(long)]
+    pub force: bool,
+    /// Samples per window.
+    #[arg(long, default_value_t = 20)]
+    pub window: usize,
+    /// Parameter draws to train on.
+    #[arg(long, default_value_t = 1500)]
+    pub draws: usize,
+    /// Relative half-width of the draws: masses and principal second moments
+    /// within ±spread of the URDF's.
+    #[arg(long, default_value_t = 0.3)]
+    pub spread: f64,
+    /// Relative sensor noise added to the training windows (0.01 = 1 %).
+    #[arg(long, default_value_t = 0.01)]
+    pub noise: f64,
+    /// Adam steps per body.
+    #[arg(long, default_value_t = 6000)]
+    pub steps: usize,
+    /// After training, identify this many further unseen draws simulated along the
+    /// motion and print the worst errors.
+    #[arg(long, default_value_t = 50)]
+    pub test_draws: usize,
+    /// Bodies trained at once; 0 = one per core.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
+    #[arg(long, default_value_t = 10.0)]
+    pub cutoff: f64,
+    /// Also write the training curves (MSE against step, per body) as SVG.
+    #[arg(long, value_name = "FILE")]
+    pub loss_svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub gravity: GravityArg,
+}
+
+#[derive(Debug, Args)]
+pub struct PredictArgs {
+    /// The robot (URDF) the identifier was trained for.
+    pub urdf: PathBuf,
+    /// The identifier written by `dyngen nim train`.
+    pub nim: PathBuf,
+    /// Measured data (CSV with t, q, tau and the joint wrench columns fx1..mzn).
+    pub data: PathBuf,
+    /// Windows start every `stride` samples (default: half a window).
+    #[arg(long)]
+    pub stride: Option<usize>,
+    /// Write the estimate as JSON (schema dyngen-parameters/1).
+    #[arg(long, value_name = "FILE")]
+    pub params_json: Option<PathBuf>,
+    /// Take the URDF's inertials as the truth and print the errors.
+    #[arg(long)]
+    pub truth_from_urdf: bool,
+    #[arg(long)]
+    pub force: bool,
+    /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
+    #[arg(long, default_value_t = 10.0)]
+    pub cutoff: f64,
+    #[command(flatten)]
+    pub gravity: GravityArg,
+}
+
+pub fn run(args: &NimArgs, progress: &Progress) -> Result<()> {
+    match &args.command {
+        NimCommand::Train(a) => train(a, progress),
+        NimCommand::Predict(a) => predict(a),
+    }
+}
+
+/// A CSV with v and a (estimated when missing, with a note on stderr).
+fn read_data(path: &Path, model: &Model, cutoff: f64) -> Result<Trajectory> {
+    let data_err = |e: dyngen::data::DataError| format!("{}: {e}", path.display());
+    let traj = read_csv(path, Some(model.dof())).map_err(data_err)?;
+    if traj.velocities().is_some() && traj.accelerations().is_some() {
+        return Ok(traj);
+    }
+    eprintln!(
+        "{} has no velocities or accelerations: estimating them from positions (low-pass at {cutoff} Hz)",
+        path.display()
+    );
+    traj.with_derivatives(cutoff).map_err(data_err)
+}
+
+fn nim_error(path: &Path, e: NimError) -> String {
+    match e {
+        NimError::AlreadyExists { .. } => format!("{} already exists; pass --force to overwrite it", path.display()),
+        e => format!("{}: {e}", path.display()),
+    }
+}
+
+fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
+    check_overwrite(&args.output, args.force)?;
+    if let Some(svg) = &args.loss_svg {
+        if svg == &args.output {
+            return Err("--output and --loss-svg name the same file; give each its own".into());
+        }
+        check_overwrite(svg, args.force)?;
+    }
+    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let traj = read_data(&args.motion, &model, args.cutoff)?;
+    let motion = SampledMotion::from_data(&traj).ok_or("the motion has no velocities or accelerations")?;
+    let robot = Reference::new(&model);
+    let nominal = mim::true_theta(&model);
+    let recording = record_trajectory(&robot, &model.standard_params(), &motion, motion.times());
+
+    let mut config = NimConfig {
+        window: args.window,
+        draws: args.draws,
+        spread: args.spread,
+        noise: args.noise,
+        seed: args.seed,
+        threads: args.threads,
+        ..NimConfig::default()
+    };
+    config.train.max_steps = args.steps;
+    config.train.seed = args.seed;
+    let batch_size = match config.train.optimizer {
+        Optimizer::Adam { batch_size, .. } => batch_size,
+        Optimizer::GradientDescent { .. } => config.draws,
+    };
+    println!(
+        "training one network per body of {} along {} samples of {}: {} draws within ±{}%, windows of {}, {} steps \
+         of {} windows, {}% training noise",
+        model.name,
+        recording.len(),
+        args.motion.display(),
+        config.draws,
+        100.0 * config.spread,
+        config.window,
+        args.steps,
+        batch_size,
+        100.0 * config.noise
+    );
+    let bar = progress.bar(model.dof() as u64, "training bodies");
+    let start = Instant::now();
+    let (nim, training) = Nim::train(&model.name, &recording, &nominal, &config, &|_| bar.inc(1))
+        .map_err(|e| format!("{}: {e}", args.motion.display()))?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    for (i, (body, history)) in nim.bodies.iter().zip(&training.histories).enumerate() {
+        let outputs: Vec<&str> = body.outputs.iter().map(|&k| mim::THETA_NAMES[k]).collect();
+        match history {
+            // The targets are logarithms: the RMS error is a relative error.
+            Some(h) => println!(
+                "  {}: predicts {}; {} windows per draw; RMS relative error of one window's prediction: training \
+                 {:.2}%, validation draws {}",
+                nim.body_names[i],
+                outputs.join(", "),
+                training.windows_per_draw[i],
+                100.0 * h.train_mse_original.last().copied().unwrap_or(f64::NAN).sqrt(),
+                h.validation_mse_original
+                    .last()
+                    .map_or_else(|| "—".to_string(), |v| format!("{:.2}%", 100.0 * v.sqrt()))
+            ),
+            None => println!(
+                "  {}: none of m, J1, J2, J3 enters its equations along this motion; no network",
+                nim.body_names[i]
+            ),
+        }
+    }
+    println!("trained in {seconds:.1} s");
+    nim.save(&args.output, args.force)
+        .map_err(|e| nim_error(&args.output, e))?;
+    println!("wrote the identifier to {}", args.output.display());
+    if let Some(svg) = &args.loss_svg {
+        let curves: Vec<(String, Vec<(f64, f64)>)> = training
+            .histories
+            .iter()
+            .zip(&nim.body_names)
+            .filter_map(|(h, name)| {
+                h.as_ref().map(|h| {
+                    (
+                        name.clone(),
+                        h.steps
+                            .iter()
+                            .map(|&s| s as f64)
+                            .zip(h.train_mse.iter().copied())
+                            .collect(),
+                    )
+                })
+            })
+            .collect();
+        let title = format!("{}: NIM training", model.name);
+        let text = report::svg_lines(&report::LineChart {
+            title: &title,
+            x_label: "training step",
+            y_label: "MSE (standardised)",
+            log_y: true,
+            curves: &curves,
+            reference: None,
+        })
+        .map_err(|e| format!("{}: {e}", svg.display()))?;
+        report::write_new(svg, &text, args.force).map_err(|e| format!("{}: {e}", svg.display()))?;
+        println!("wrote the training curves to {}", svg.display());
+    }
+    if args.test_draws > 0 {
+        test_on_unseen_draws(args, &model, &robot, &motion, &nim, &nominal)?;
+    }
+    Ok(())
+}
+
+/// Identifies `--test-draws` further draws (a stream the training never saw),
+/// simulated along the motion by the full dynamics, and prints the worst errors.
+fn test_on_unseen_draws(
+    args: &TrainArgs,
+    model: &Model,
+    robot: &Reference,
+    motion: &SampledMotion,
+    nim: &Nim,
+    nominal: &[f64],
+) -> Result<()> {
+    let mut rng = SplitMix64::new(args.seed ^ 0x7465_7374_0000);
+    let (mut mass, mut moments): (f64, f64) = (0.0, 0.0);
+    for _ in 0..args.test_draws {
+        let theta = draw_theta(nominal, args.spread, &mut rng);
+        let recording: Recording = record_trajectory(
+            robot,
+            &principal_params_to_standard(model, &theta),
+            motion,
+            motion.times(),
+        );
+        let estimate = nim
+            .identify(&recording, (nim.window / 2).max(1))
+            .map_err(|e| e.to_string())?
+            .with_truth(&theta);
+        let (m, j) = estimate.max_relative_errors().unwrap_or((f64::NAN, f64::NAN));
+        mass = mass.max(m);
+        moments = moments.max(j);
+    }
+    println!(
+        "on {} unseen draws (noise-free, full dynamics): worst relative error {:.3}% on a mass, {:.3}% on a principal \
+         moment",
+        args.test_draws,
+        100.0 * mass,
+        100.0 * moments
+    );
+    Ok(())
+}
+
+fn predict(args: &PredictArgs) -> Result<()> {
+    if let Some(path) = &args.params_json {
+        check_overwrite(path, args.force)?;
+    }
+    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let nim = Nim::load(&args.nim).map_err(|e| nim_error(&args.nim, e))?;
+    let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+    if nim.body_names != body_names {
+        return Err(format!(
+            "{} was trained for {} with bodies [{}], but {} has bodies [{}]; train an identifier for this robot \
+             with `dyngen nim train`",
+            args.nim.display(),
+            nim.robot,
+            nim.body_names.join(", "),
+            args.urdf.display(),
+            body_names.join(", ")
+        ));
+    }
+    let traj = read_data(&args.data, &model, args.cutoff)?;
+    if traj.joint_wrenches().is_none() {
+        return Err(format!(
+            "{}: NIM reads each body's resultant from the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, \
+             mz{}, which the file does not have",
+            args.data.display(),
+            model.dof()
+        ));
+    }
+    let robot = Reference::new(&model);
+    let recording = Recording::from_measurements(&robot, &traj).map_err(|e| format!("{}: {e}", args.data.display()))?;
+    let unfamiliar = nim.unfamiliar_fraction(&recording);
+    if unfamiliar > 0.01 {
+        eprintln!(
+            "warning: {:.0}% of the body samples of {} move unlike the training motion (beyond 6σ of a training \
+             feature); the estimate is an extrapolation",
+            100.0 * unfamiliar,
+            args.data.display()
+        );
+    }
+    let stride = args.stride.unwrap_or((nim.window / 2).max(1));
+    let estimate = nim
+        .identify(&recording, stride)
+        .map_err(|e| format!("{}: {e}", args.data.display()))?;
+    let estimate = if args.truth_from_urdf {
+        estimate.with_truth(&mim::true_theta(&model))
+    } else {
+        estimate
+    };
+    println!(
+        "{} samples of {} joints from {}",
+        traj.len(),
+        model.dof(),
+        args.data.display()
+    );
+    println!("{estimate}");
+    if let Some(path) = &args.params_json {
+        ParameterReport::from_nim(&model.name, &estimate)
+            .write(path, args.force)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote the parameters to {}", path.display());
+    }
+    Ok(())
+}

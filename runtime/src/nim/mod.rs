@@ -1,0 +1,68 @@
+//! NIM, the neural-network identification method: the machinery of the identifier
+//! that predicts a body's principal inertial parameters `θ = (m, J1, J2, J3)` from
+//! features of its measured motion and wrench.
+//!
+//! The network is a multilayer perceptron written directly over faer (no machine
+//! learning framework):
+//!
+//! * [`Mlp`]: layer sizes `[n_in, h1, …, hk, n_out]`, ReLU hidden layers, a linear
+//!   output layer, He initialisation ([`Mlp::new`]), and a [`Standardizer`] on the
+//!   inputs and on the outputs, so callers work in original units throughout;
+//! * [`Dataset`]: checked (input, target) samples, one per row, with the paper's
+//!   ordered split ([`Dataset::split`]: the first 80 of 100 samples train, the last
+//!   20 validate) and a seeded shuffled one;
+//! * [`train`]: the MSE loss with hand-written backpropagation over faer matrix
+//!   products (samples as columns), full-batch gradient descent (the paper) or
+//!   mini-batch Adam ([`Optimizer`]), stopping at an MSE threshold or a step budget
+//!   ([`TrainOptions`]), returning the loss curves ([`TrainHistory`]);
+//! * inference: [`Mlp::predict`] for one sample without allocation (through a
+//!   reusable [`Workspace`]), [`Mlp::predict_batch`] for many, [`Mlp::evaluate`] for
+//!   the MSE on a dataset;
+//! * JSON files: [`Mlp::to_json`] / [`Mlp::from_json`] (schema [`SCHEMA`]),
+//!   [`Mlp::save`] / [`Mlp::load`]; numbers round-trip exactly, so a loaded net
+//!   predicts bit-identically.
+//!
+//! Everything is deterministic: initialisation and shuffling draw from
+//! [`SplitMix64`](crate::reference::SplitMix64) streams seeded by
+//! [`TrainOptions::seed`], and faer runs sequentially, so the same call gives the
+//! same bits on the same build and machine. Failures are [`NimError`]s naming the
+//! offending row, column, layer or field.
+//!
+//! ```
+//! use dyngen::nim::{train, Dataset, Optimizer, TrainOptions};
+//! // y = (x0 x1, x0 − x1) on a grid.
+//! let x: Vec<[f64; 2]> = (0..100).map(|k| [(k % 10) as f64 / 9.0, (k / 10) as f64 / 9.0]).collect();
+//! let y: Vec<[f64; 2]> = x.iter().map(|x| [x[0] * x[1], x[0] - x[1]]).collect();
+//! let data = Dataset::from_rows(&x, &y).unwrap();
+//! let (fit, check) = data.shuffled_split(0.8, 1).unwrap();
+//! let options = TrainOptions { optimizer: Optimizer::adam(1e-2), max_steps: 1500, ..TrainOptions::default() };
+//! let (net, history) = train(&[2, 16, 16, 2], &fit, Some(&check), &options).unwrap();
+//! assert!(history.validation_mse_original.last().unwrap() < &1e-3);
+//! let mut ws = net.workspace();
+//! let mut out = [0.0; 2];
+//! net.predict(&[0.5, 0.5], &mut ws, &mut out);
+//! assert!((out[0] - 0.25).abs() < 0.05 && out[1].abs() < 0.05);
+//! ```
+
+mod data;
+mod error;
+mod identifier;
+mod mlp;
+pub mod online;
+mod paper;
+mod train;
+mod window;
+
+#[cfg(test)]
+mod tests;
+
+pub use data::{Dataset, Standardizer};
+pub use error::{NimError, Part};
+pub use identifier::{
+    draw_theta, window_features, BodyNim, BodySample, Nim, NimConfig, NimEstimate, NimPredictor, NimTraining, FEATURES,
+    NIM_SCHEMA,
+};
+pub use mlp::{Mlp, Mse, Workspace, SCHEMA};
+pub use paper::{paper_inputs, paper_nim, PaperNim, PaperNimConfig, PAPER_INPUTS};
+pub use train::{train, Decay, Optimizer, StopReason, TrainHistory, TrainOptions};
+pub use window::{train_windows, WindowNet, WindowShape, WindowSource, WindowWorkspace, WINDOW_SCHEMA};

@@ -346,3 +346,73 @@ impl Standardizer {
         z * self.std[j] + self.mean[j]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_datasets_name_the_row_and_column() {
+        let err = |r: Result<Dataset, NimError>| r.unwrap_err().to_string();
+        assert_eq!(
+            err(Dataset::from_rows(&[[1.0, 2.0], [3.0, f64::INFINITY]], &[[0.0], [0.0]])),
+            "non-finite input value inf at row 1, input column 1 (0-based); every value must be finite"
+        );
+        assert_eq!(
+            err(Dataset::from_rows(&[vec![1.0, 2.0], vec![3.0]], &[[0.0], [0.0]])),
+            "input row 1 has 1 values, expected 2 (the length of input row 0)"
+        );
+        assert_eq!(
+            err(Dataset::from_rows(&[[1.0]], &[[0.0], [1.0]])),
+            "dimension mismatch in number of target rows (one per input row): expected 1, found 2"
+        );
+        assert_eq!(
+            err(Dataset::from_rows::<[f64; 1], [f64; 1]>(&[], &[])),
+            "the dataset has no samples; at least one is needed"
+        );
+        assert!(err(Dataset::from_flat(2, 1, vec![1.0; 5], vec![0.0; 2])).contains("not a whole number of rows of 2"));
+        assert!(err(Dataset::from_flat(0, 1, vec![], vec![])).contains("n_inputs"));
+        let d = Dataset::from_rows(&[[0.0], [1.0], [2.0]], &[[0.0], [1.0], [2.0]]).unwrap();
+        assert!(d
+            .split_at(3)
+            .unwrap_err()
+            .to_string()
+            .contains("expected 1 ≤ n_train ≤ 2"));
+        assert!(d
+            .split(1.0)
+            .unwrap_err()
+            .to_string()
+            .contains("not in the open interval (0, 1)"));
+    }
+
+    #[test]
+    fn the_papers_split_keeps_the_order_and_the_shuffled_one_is_seeded() {
+        let x: Vec<[f64; 1]> = (0..100).map(|k| [k as f64]).collect();
+        let d = Dataset::from_rows(&x, &x).unwrap();
+        let (fit, check) = d.split(0.8).unwrap();
+        assert_eq!((fit.len(), check.len()), (80, 20));
+        assert_eq!((fit.input(79)[0], check.input(0)[0]), (79.0, 80.0));
+        let (a, _) = d.shuffled_split(0.8, 3).unwrap();
+        let (b, _) = d.shuffled_split(0.8, 3).unwrap();
+        let (c, _) = d.shuffled_split(0.8, 4).unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        let mut seen: Vec<f64> = (0..80).map(|k| a.input(k)[0]).collect();
+        seen.sort_by(f64::total_cmp);
+        seen.dedup();
+        assert_eq!(seen.len(), 80, "a shuffle draws without repetition");
+    }
+
+    #[test]
+    fn a_constant_feature_is_scaled_by_its_size() {
+        let data = MatRef::from_row_major_slice(&[2.0, 0.0, 1.0, 2.0, 0.0, 3.0, 2.0, 0.0, 5.0], 3, 3);
+        let s = Standardizer::fit(data);
+        assert_eq!(s.mean(), &[2.0, 0.0, 3.0]);
+        assert_eq!(&s.std()[..2], &[2.0, 1.0]);
+        assert!((s.std()[2] - (8.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        // A constant feature standardises to its relative deviation.
+        assert!((s.apply(0, 2.2) - 0.1).abs() < 1e-15);
+        assert_eq!(s.invert(2, s.apply(2, 7.0)), 7.0);
+        assert!(Standardizer::new(vec![0.0], vec![-1.0], "input").is_err());
+    }
+}

@@ -958,3 +958,233 @@ impl WindowSource for Windows<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::{record, Experiment, NoiseModel};
+    use crate::Reference;
+
+    fn paper6() -> (dyngen_model::Model, Reference) {
+        let model = dyngen_model::parse_urdf(include_str!("../../../tests/fixtures/paper6.urdf")).unwrap();
+        let robot = Reference::new(&model);
+        (model, robot)
+    }
+
+    fn small_config() -> NimConfig {
+        let mut config = NimConfig {
+            draws: 60,
+            validation_draws: 10,
+            window: 10,
+            ..NimConfig::default()
+        };
+        config.train.max_steps = 150;
+        config.train.record_every = 50;
+        config
+    }
+
+    #[test]
+    fn draws_are_physically_consistent_and_within_the_spread() {
+        let (model, _) = paper6();
+        let nominal = mim::true_theta(&model);
+        let mut rng = SplitMix64::new(4);
+        for _ in 0..200 {
+            let theta = draw_theta(&nominal, 0.3, &mut rng);
+            for (body, nom) in theta.chunks_exact(4).zip(nominal.chunks_exact(4)) {
+                assert!(body[0] > 0.0 && (body[0] / nom[0] - 1.0).abs() <= 0.3);
+                let j = [body[1], body[2], body[3]];
+                for k in 0..3 {
+                    assert!(j[k] > 0.0);
+                    // Triangle inequalities, by construction.
+                    assert!(j[(k + 1) % 3] + j[(k + 2) % 3] >= j[k] * (1.0 - 1e-12));
+                }
+            }
+        }
+        let a = draw_theta(&nominal, 0.3, &mut SplitMix64::new(9));
+        assert_eq!(a, draw_theta(&nominal, 0.3, &mut SplitMix64::new(9)));
+        // No spread: the nominal θ, up to the rounding of J → s → J.
+        for (d, n) in draw_theta(&nominal, 0.0, &mut SplitMix64::new(9)).iter().zip(&nominal) {
+            assert!((d - n).abs() <= 1e-14 * n);
+        }
+    }
+
+    #[test]
+    fn features_do_not_change_when_the_wrench_scales() {
+        let (model, robot) = paper6();
+        let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
+        let samples: Vec<BodySample> = (30..50).map(|k| BodySample::from_recording(&recording, k, 2)).collect();
+        let scaled: Vec<BodySample> = samples
+            .iter()
+            .map(|s| BodySample {
+                force: 3.0 * s.force,
+                moment: 3.0 * s.moment,
+                ..*s
+            })
+            .collect();
+        let (mut a, mut b) = (vec![0.0; 20 * FEATURES], vec![0.0; 20 * FEATURES]);
+        let (rf, rm) = window_features(&samples, &mut a);
+        let (sf, sm) = window_features(&scaled, &mut b);
+        assert!((sf / rf - 3.0).abs() < 1e-12 && (sm / rm - 3.0).abs() < 1e-12);
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()));
+        }
+    }
+
+    /// The training data's shortcut, `[F; M] = A_i θ_i`, is the simulated
+    /// resultant: the wrench a body measures along a prescribed motion.
+    #[test]
+    fn the_wrench_of_a_draw_is_the_simulated_one() {
+        let (model, robot) = paper6();
+        let nominal = mim::true_theta(&model);
+        let theta = draw_theta(&nominal, 0.3, &mut SplitMix64::new(2));
+        let params = crate::reference::principal_params_to_standard(&model, &theta);
+        let drawn = record(&robot, &params, &Experiment::paper(&model));
+        let base = record(&robot, &model.standard_params(), &Experiment::paper(&model));
+        for k in (1..drawn.len()).step_by(7) {
+            for i in 0..6 {
+                let t: [f64; 4] = theta[4 * i..4 * i + 4].try_into().unwrap();
+                let made = BodySample::from_recording(&base, k, i).with_theta(&t);
+                let measured = BodySample::from_recording(&drawn, k, i);
+                let scale = 1.0 + measured.force.norm() + measured.moment.norm();
+                assert!(
+                    (made.force - measured.force).norm() < 1e-10 * scale,
+                    "body {i} sample {k}"
+                );
+                assert!(
+                    (made.moment - measured.moment).norm() < 1e-10 * scale,
+                    "body {i} sample {k}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_small_nim_trains_saves_and_identifies() {
+        let (model, robot) = paper6();
+        let nominal = mim::true_theta(&model);
+        let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let (nim, training) = Nim::train("paper6", &recording, &nominal, &small_config(), &|_| {
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
+        .unwrap();
+        assert_eq!(done.into_inner(), 6);
+        // The turret turns about its own axis only: J1, J2 are not outputs.
+        assert_eq!(nim.bodies[0].outputs, [0, 3]);
+        assert!(nim.bodies[1..].iter().all(|b| b.outputs == [0, 1, 2, 3]));
+        assert_eq!(training.windows_per_draw, [92; 6]);
+        assert!(training
+            .histories
+            .iter()
+            .all(|h| h.as_ref().unwrap().steps_taken == 150));
+
+        let estimate = nim.identify(&recording, 5).unwrap().with_truth(&nominal);
+        assert_eq!(estimate.windows, 19);
+        assert_eq!((estimate.theta[1], estimate.verdicts[1]), (None, Verdict::NoEffect));
+        let (mass, _) = estimate.max_relative_errors().unwrap();
+        assert!(mass < 0.3, "{estimate}");
+        let text = estimate.to_string();
+        assert!(
+            text.contains("(cf. the paper's Table 4)") && text.contains("n/i"),
+            "{text}"
+        );
+
+        // JSON round trip, bit for bit.
+        let again = Nim::from_json(&nim.to_json()).unwrap();
+        assert_eq!(again, nim);
+        assert_eq!(
+            again.identify(&recording, 5).unwrap().theta,
+            nim.identify(&recording, 5).unwrap().theta
+        );
+
+        // Data like the training data are familiar; far noisier data are not.
+        assert!(nim.unfamiliar_fraction(&recording) < 0.01);
+        let noisy = NoiseModel::relative(0.5).apply(&recording, 1);
+        assert!(nim.unfamiliar_fraction(&noisy) > 0.1);
+
+        // Misuse is an error, not a panic.
+        let short = Recording {
+            samples: recording.samples[..5].to_vec(),
+            ..recording.clone()
+        };
+        let err = nim.identify(&short, 1).unwrap_err().to_string();
+        assert_eq!(err, "invalid recording: 5 samples, fewer than one window of 10");
+        assert!(nim
+            .identify(&recording, 0)
+            .unwrap_err()
+            .to_string()
+            .contains("invalid stride"));
+    }
+
+    #[test]
+    fn damaged_identifier_files_are_refused() {
+        let (model, robot) = paper6();
+        let nominal = mim::true_theta(&model);
+        let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
+        let mut config = small_config();
+        config.train.max_steps = 1;
+        let (nim, _) = Nim::train("paper6", &recording, &nominal, &config, &|_| {}).unwrap();
+        let json = nim.to_json();
+        let err = |text: String| Nim::from_json(&text).unwrap_err().to_string();
+        assert!(err(json.replace(NIM_SCHEMA, "dyngen-nim/0")).contains("this version reads \"dyngen-nim/1\""));
+        assert_eq!(
+            err(json.replacen(
+                "\"outputs\": [\n        0,\n        3\n      ]",
+                "\"outputs\": [3, 0]",
+                1
+            )),
+            "`bodies[0].outputs` has shape [3, 0], expected ascending indices into (m, J1, J2, J3), each 0..=3"
+        );
+        let mut file: serde_json::Value = serde_json::from_str(&json).unwrap();
+        file["bodies"][2]["net"] = serde_json::Value::Null;
+        assert_eq!(
+            err(file.to_string()),
+            "`bodies[2].net` has shape null, expected a net for the listed outputs"
+        );
+        let mut file: serde_json::Value = serde_json::from_str(&json).unwrap();
+        file["bodies"][1]["net"]["decoder"]["output"]["std"][0] = serde_json::json!(-1.0);
+        assert_eq!(
+            err(file.to_string()),
+            "bodies[1].net: decoder: invalid value in `output.std[0]`: -1; a standard deviation must be finite and > 0"
+        );
+        let mut file: serde_json::Value = serde_json::from_str(&json).unwrap();
+        file["nominal"].as_array_mut().unwrap().pop();
+        assert!(err(file.to_string()).contains("6 bodies and 4 × 6 nominal values"));
+    }
+
+    #[test]
+    fn bad_training_settings_are_errors() {
+        let (model, robot) = paper6();
+        let nominal = mim::true_theta(&model);
+        let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
+        let train = |config: NimConfig, nominal: &[f64]| {
+            Nim::train("paper6", &recording, nominal, &config, &|_| {})
+                .unwrap_err()
+                .to_string()
+        };
+        assert_eq!(
+            train(small_config(), &nominal[..20]),
+            "dimension mismatch in nominal θ (4 per body): expected 24, found 20"
+        );
+        let window = NimConfig {
+            window: 500,
+            ..small_config()
+        };
+        assert!(train(window, &nominal).contains("expected 1 ≤ window ≤ 101"));
+        let spread = NimConfig {
+            spread: 1.0,
+            ..small_config()
+        };
+        assert!(train(spread, &nominal).contains("invalid spread: 1; expected 0 ≤ spread < 1"));
+        let noise = NimConfig {
+            noise: -0.1,
+            ..small_config()
+        };
+        assert!(train(noise, &nominal).contains("invalid noise"));
+        let draws = NimConfig {
+            draws: 0,
+            ..small_config()
+        };
+        assert!(train(draws, &nominal).contains("invalid draws"));
+    }
+}

@@ -591,3 +591,131 @@ impl From<&Standardizer> for StandardizerFile {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn net() -> Mlp {
+        let mut net = Mlp::new(&[3, 7, 5, 2], 11).unwrap();
+        net.set_standardizers(
+            Standardizer::new(vec![0.5, -1.0, 2.0], vec![2.0, 0.5, 1.5], "input").unwrap(),
+            Standardizer::new(vec![10.0, -3.0], vec![4.0, 0.25], "output").unwrap(),
+        )
+        .unwrap();
+        net
+    }
+
+    #[test]
+    fn one_sample_and_batch_inference_agree() {
+        let net = net();
+        let inputs = Mat::from_fn(13, 3, |i, j| ((i * 3 + j) as f64 * 0.37).sin() * 3.0);
+        let batch = net.predict_batch(inputs.as_ref());
+        let mut ws = net.workspace();
+        let mut out = [0.0; 2];
+        for i in 0..13 {
+            let x: Vec<f64> = (0..3).map(|j| inputs[(i, j)]).collect();
+            net.predict(&x, &mut ws, &mut out);
+            for k in 0..2 {
+                assert!((out[k] - batch[(i, k)]).abs() <= 1e-12 * (1.0 + out[k].abs()));
+            }
+        }
+        // A wider workspace fits too.
+        let mut wide = Mlp::new(&[3, 40, 2], 1).unwrap().workspace();
+        net.predict(&[0.1, 0.2, 0.3], &mut wide, &mut out);
+    }
+
+    #[test]
+    #[should_panic(expected = "the workspace holds 3 values per buffer, this net needs 7")]
+    fn a_workspace_of_a_smaller_net_is_refused() {
+        let net = net();
+        let mut small = Mlp::new(&[2, 3, 1], 1).unwrap().workspace();
+        net.predict(&[0.0; 3], &mut small, &mut [0.0; 2]);
+    }
+
+    #[test]
+    fn json_round_trips_exactly_and_names_what_is_wrong() {
+        let net = net();
+        let json = net.to_json();
+        assert_eq!(Mlp::from_json(&json).unwrap(), net);
+
+        let error = |text: String| Mlp::from_json(&text).unwrap_err().to_string();
+        assert_eq!(
+            error(json.replace(SCHEMA, "dyngen-mlp/9")),
+            "unsupported schema \"dyngen-mlp/9\": this version reads \"dyngen-mlp/1\""
+        );
+        assert_eq!(
+            error(json.replacen(&format!("\"schema\": \"{SCHEMA}\","), "", 1)),
+            "missing `schema` field: expected \"schema\": \"dyngen-mlp/1\""
+        );
+        let mut file = net.to_file();
+        file.layers[1].weights[2].pop();
+        assert_eq!(
+            Mlp::from_file(file).unwrap_err().to_string(),
+            "layer 1: `weights` has shape row 2 of length 6, expected 5 × 7 (5 rows of 7: outputs × inputs)"
+        );
+        let mut file = net.to_file();
+        file.output.std[1] = 0.0;
+        assert_eq!(
+            Mlp::from_file(file).unwrap_err().to_string(),
+            "invalid value in `output.std[1]`: 0; a standard deviation must be finite and > 0"
+        );
+        let mut file = net.to_file();
+        file.layers[2].bias.push(1.0);
+        assert!(Mlp::from_file(file)
+            .unwrap_err()
+            .to_string()
+            .contains("layer 2: `bias` has shape 3 values"));
+        assert!(
+            error("{\"schema\": \"dyngen-mlp/1\", \"sizes\": [2, 1], \"extra\": 1}".into())
+                .starts_with("invalid network JSON")
+        );
+        assert!(Mlp::new(&[3], 1)
+            .unwrap_err()
+            .to_string()
+            .contains("at least 2 are needed"));
+        assert!(Mlp::new(&[3, 0, 1], 1)
+            .unwrap_err()
+            .to_string()
+            .contains("size 1 is zero"));
+    }
+
+    #[test]
+    fn save_keeps_an_existing_file_unless_told() {
+        let dir = std::env::temp_dir().join(format!("dyngen-mlp-save-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("net.json");
+        let net = net();
+        std::fs::write(&path, "keep me").unwrap();
+        let err = net.save(&path, false).unwrap_err();
+        assert!(matches!(err, NimError::AlreadyExists { .. }), "{err}");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "keep me");
+        net.save(&path, true).unwrap();
+        assert_eq!(Mlp::load(&path).unwrap(), net);
+        let err = Mlp::load(dir.join("missing.json")).unwrap_err();
+        assert!(err.to_string().contains("missing.json"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn evaluate_reports_both_units() {
+        let net = net();
+        let x: Vec<[f64; 3]> = (0..20).map(|k| [k as f64, 1.0, -(k as f64)]).collect();
+        let y: Vec<[f64; 2]> = (0..20).map(|k| [k as f64, 0.0]).collect();
+        let data = Dataset::from_rows(&x, &y).unwrap();
+        let mse = net.evaluate(&data).unwrap();
+        let p = net.predict_batch(data.inputs());
+        let original: f64 = (0..20)
+            .flat_map(|i| (0..2).map(move |k| (i, k)))
+            .map(|(i, k)| (p[(i, k)] - y[i][k]).powi(2))
+            .sum::<f64>()
+            / 40.0;
+        assert!((mse.original - original).abs() < 1e-9 * original);
+        let standardised: f64 = (0..20)
+            .flat_map(|i| (0..2).map(move |k| (i, k)))
+            .map(|(i, k)| ((p[(i, k)] - y[i][k]) / [4.0, 0.25][k]).powi(2))
+            .sum::<f64>()
+            / 40.0;
+        assert!((mse.standardised - standardised).abs() < 1e-9 * standardised);
+    }
+}

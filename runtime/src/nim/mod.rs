@@ -53,9 +53,6 @@ mod paper;
 mod train;
 mod window;
 
-#[cfg(test)]
-mod tests;
-
 pub use data::{Dataset, Standardizer};
 pub use error::{NimError, Part};
 pub use identifier::{

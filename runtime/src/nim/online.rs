@@ -190,3 +190,89 @@ fn summarise(
         seconds_per_sample,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nim::NimConfig;
+    use crate::simulate::{record, Experiment};
+    use crate::Reference;
+
+    #[test]
+    fn both_estimators_follow_a_change_and_bad_settings_are_errors() {
+        let model = dyngen_model::parse_urdf(include_str!("../../../tests/fixtures/paper6.urdf")).unwrap();
+        let robot = Reference::new(&model);
+        let nominal = crate::mim::true_theta(&model);
+        let experiment = Experiment::paper(&model);
+        let base = record(&robot, &model.standard_params(), &experiment);
+        let mut config = NimConfig {
+            draws: 40,
+            window: 10,
+            ..NimConfig::default()
+        };
+        config.train.max_steps = 100;
+        let (nim, _) = Nim::train("paper6", &base, &nominal, &config, &|_| {}).unwrap();
+
+        // The flange 10 % heavier from sample 60 on.
+        let mut heavier = nominal.clone();
+        for x in &mut heavier[20..24] {
+            *x *= 1.1;
+        }
+        let changed = record(
+            &robot,
+            &crate::reference::principal_params_to_standard(&model, &heavier),
+            &experiment,
+        );
+        let mut spliced = base.clone();
+        spliced.samples[60..].clone_from_slice(&changed.samples[60..]);
+        let tracking = Tracking {
+            body: 5,
+            change: 60,
+            before: nominal[20..24].try_into().unwrap(),
+            after: heavier[20..24].try_into().unwrap(),
+            lambda: 1.0 - 1.0 / 60.0,
+            tolerance: (0.02, 0.05),
+        };
+        let (followed, [by_nim, by_rls]) = track(&nim, &spliced, &tracking).unwrap();
+        assert_eq!(followed.t.len(), 101);
+        assert!(followed.nim[..9].iter().all(|v| v.iter().all(Option::is_none)));
+        assert!(followed.nim[9..].iter().all(|v| v.iter().all(Option::is_some)));
+        assert_eq!(
+            (followed.truth[59], followed.truth[60]),
+            (tracking.before, tracking.after)
+        );
+        // Noise-free data: RLS is exact before the change and settles after it.
+        assert!(
+            by_rls.error_before.0 < 1e-9 && by_rls.error_before.1 < 1e-9,
+            "{by_rls:?}"
+        );
+        let delay = by_rls.delay_mass.expect("RLS settles");
+        assert!(delay > 0.0 && delay < 0.8, "{by_rls:?}");
+        assert!(by_nim.seconds_per_sample > 0.0);
+
+        let err = track(
+            &nim,
+            &spliced,
+            &Tracking {
+                body: 6,
+                ..tracking.clone()
+            },
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("body 6 and change at sample 60 outside 6 bodies"),
+            "{err}"
+        );
+        let err = track(
+            &nim,
+            &spliced,
+            &Tracking {
+                lambda: 0.0,
+                ..tracking
+            },
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("forgetting factor"), "{err}");
+    }
+}

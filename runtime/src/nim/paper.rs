@@ -272,3 +272,87 @@ impl fmt::Display for PaperNim {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::{record, Experiment};
+    use crate::Reference;
+
+    fn recording() -> (Vec<f64>, Recording) {
+        let model = dyngen_model::parse_urdf(include_str!("../../../tests/fixtures/paper6.urdf")).unwrap();
+        let robot = Reference::new(&model);
+        (
+            mim::true_theta(&model),
+            record(&robot, &model.standard_params(), &Experiment::paper(&model)),
+        )
+    }
+
+    /// Trained as the paper trains it, the net reaches the threshold in hundreds of
+    /// steps (the paper's Fig. 5: about 400) and returns roughly its labels; trained
+    /// on labels 20 % high, it returns values about 20 % high.
+    #[test]
+    fn the_papers_nim_returns_its_labels() {
+        let (truth, recording) = recording();
+        let config = PaperNimConfig::default();
+        let nim = paper_nim(&recording, 1..101, &truth, &config)
+            .unwrap()
+            .with_truth(&truth);
+        assert_eq!((nim.n_train, nim.n_validate), (80, 20));
+        for (i, h) in nim.histories.iter().enumerate() {
+            assert_eq!(h.stopped, crate::nim::StopReason::Threshold, "body {i}");
+            assert!(h.steps_taken < 1000, "body {i}: {} steps", h.steps_taken);
+        }
+        assert_eq!(&nim.identifiable[..4], &[true, false, false, true]);
+        assert!(nim.identifiable[4..].iter().all(|&x| x));
+        let deviation = nim.max_deviation_from_labels();
+        assert!(deviation < 0.3, "{nim}");
+        let text = nim.to_string();
+        assert!(
+            text.contains("(cf. the paper's Table 5)") && text.contains("n/i"),
+            "{text}"
+        );
+
+        let high: Vec<f64> = truth.iter().map(|x| 1.2 * x).collect();
+        let relabelled = paper_nim(&recording, 1..101, &high, &config).unwrap();
+        let offsets: Vec<f64> = relabelled
+            .theta
+            .iter()
+            .zip(&truth)
+            .zip(&relabelled.identifiable)
+            .filter(|(_, &ok)| ok)
+            .map(|((v, t), _)| v / t - 1.0)
+            .collect();
+        let mean = offsets.iter().sum::<f64>() / offsets.len() as f64;
+        assert!((mean - 0.2).abs() < 0.05, "mean offset {mean}: {offsets:?}");
+        // The nets applied to the same recording give back the table's values.
+        let again = nim.predict(&recording, 81..101).unwrap();
+        for (a, b) in again.iter().zip(&nim.theta) {
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()));
+        }
+    }
+
+    #[test]
+    fn the_papers_nim_checks_its_arguments() {
+        let (truth, recording) = recording();
+        let config = PaperNimConfig::default();
+        let err = paper_nim(&recording, 1..101, &truth[..8], &config).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "dimension mismatch in labels (4 per body): expected 24, found 8"
+        );
+        let err = paper_nim(&recording, 50..200, &truth, &config).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("not a non-empty range within the recording's 101 samples"),
+            "{err}"
+        );
+        let few = PaperNimConfig {
+            n_train: 100,
+            max_steps: 1,
+            ..config
+        };
+        let err = paper_nim(&recording, 1..101, &truth, &few).unwrap_err();
+        assert!(err.to_string().contains("expected 1 ≤ n_train ≤ 99"), "{err}");
+    }
+}

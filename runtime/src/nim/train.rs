@@ -592,3 +592,190 @@ impl<'a> Trainer<'a> {
         loss
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::Gaussian;
+
+    /// Random inputs and targets, samples as columns (already "standardised").
+    fn batch(n_in: usize, n_out: usize, count: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
+        let mut g = Gaussian::new(seed);
+        let x = (0..n_in * count).map(|_| g.standard()).collect();
+        let y = (0..n_out * count).map(|_| g.standard()).collect();
+        (x, y)
+    }
+
+    fn loss(mlp: &Mlp, x: &[f64], y: &[f64], count: usize) -> f64 {
+        let mut bp = Backprop::new(mlp, count, false);
+        bp.acts[0][..x.len()].copy_from_slice(x);
+        mlp.forward(&mut bp.acts, count);
+        bp.mse_delta(mlp, y, count)
+    }
+
+    /// Backpropagation against central differences, every weight and bias, and the
+    /// input gradient, on nets of several shapes.
+    #[test]
+    fn gradients_match_finite_differences() {
+        for (sizes, count, seed) in [
+            (&[3, 5, 2][..], 7, 1),
+            (&[4, 6, 5, 3], 5, 2),
+            (&[2, 3, 3, 3, 3, 3, 1], 9, 3),
+        ] {
+            let mut mlp = Mlp::new(sizes, seed).unwrap();
+            // Non-zero biases: with a zero bias, a unit whose inputs are all dead sits
+            // exactly on the ReLU's kink, where no finite difference is a derivative.
+            for b in mlp.parameters_mut().skip(sizes.len() - 1) {
+                for (k, v) in b.iter_mut().enumerate() {
+                    *v = 0.1 * (k % 3) as f64 - 0.05;
+                }
+            }
+            let (n_in, n_out) = (sizes[0], sizes[sizes.len() - 1]);
+            let (x, y) = batch(n_in, n_out, count, seed + 10);
+            let mut bp = Backprop::new(&mlp, count, true);
+            bp.acts[0].copy_from_slice(&x);
+            mlp.forward(&mut bp.acts, count);
+            bp.mse_delta(&mlp, &y, count);
+            bp.backward(&mlp, count);
+            let analytic: Vec<Vec<f64>> = bp.grads.buffers().map(<[f64]>::to_vec).collect();
+
+            let h = 1e-6;
+            let mut worst: f64 = 0.0;
+            for (b, grad) in analytic.iter().enumerate() {
+                for k in 0..grad.len() {
+                    let bump = |mlp: &mut Mlp, delta: f64| {
+                        mlp.parameters_mut().nth(b).unwrap()[k] += delta;
+                    };
+                    bump(&mut mlp, h);
+                    let up = loss(&mlp, &x, &y, count);
+                    bump(&mut mlp, -2.0 * h);
+                    let down = loss(&mlp, &x, &y, count);
+                    bump(&mut mlp, h);
+                    let numeric = (up - down) / (2.0 * h);
+                    worst = worst.max((numeric - grad[k]).abs() / (1e-3 + grad[k].abs()));
+                }
+            }
+            assert!(worst < 1e-5, "{sizes:?}: worst relative gradient error {worst:e}");
+            // ∂L/∂input.
+            for j in 0..n_in * count {
+                let mut xp = x.clone();
+                xp[j] += h;
+                let up = loss(&mlp, &xp, &y, count);
+                xp[j] -= 2.0 * h;
+                let down = loss(&mlp, &xp, &y, count);
+                let numeric = (up - down) / (2.0 * h);
+                assert!(
+                    (numeric - bp.deltas[0][j]).abs() < 1e-6 * (1.0 + numeric.abs()),
+                    "input {j}"
+                );
+            }
+        }
+    }
+
+    fn linear_data(count: usize) -> Dataset {
+        let x: Vec<[f64; 2]> = (0..count).map(|k| [k as f64 / count as f64, (k % 7) as f64]).collect();
+        let y: Vec<[f64; 1]> = x.iter().map(|x| [2.0 * x[0] - 0.5 * x[1] + 1.0]).collect();
+        Dataset::from_rows(&x, &y).unwrap()
+    }
+
+    #[test]
+    fn training_is_deterministic_for_a_seed() {
+        let data = linear_data(50);
+        let options = TrainOptions {
+            max_steps: 300,
+            record_every: 50,
+            seed: 7,
+            ..TrainOptions::default()
+        };
+        let (a, ha) = train(&[2, 8, 1], &data, None, &options).unwrap();
+        let (b, hb) = train(&[2, 8, 1], &data, None, &options).unwrap();
+        assert_eq!(a.to_json(), b.to_json());
+        assert_eq!(ha, hb);
+        let (c, _) = train(&[2, 8, 1], &data, None, &TrainOptions { seed: 8, ..options }).unwrap();
+        assert_ne!(a.to_json(), c.to_json());
+    }
+
+    #[test]
+    fn history_records_every_step_asked_and_the_last() {
+        let data = linear_data(40);
+        let options = TrainOptions {
+            max_steps: 25,
+            record_every: 10,
+            ..TrainOptions::default()
+        };
+        let (_, h) = train(&[2, 4, 1], &data, Some(&data), &options).unwrap();
+        assert_eq!(h.steps, [0, 10, 20, 25]);
+        assert_eq!((h.train_mse.len(), h.validation_mse.len()), (4, 4));
+        assert_eq!((h.stopped, h.steps_taken), (StopReason::Budget, 25));
+        // Adam lowers the loss on a linear target.
+        assert!(h.train_mse[3] < h.train_mse[0]);
+    }
+
+    #[test]
+    fn cosine_decay_runs_from_the_rate_to_its_fraction() {
+        let d = Decay::Cosine { final_fraction: 0.1 };
+        assert_eq!(d.factor(0, 100), 1.0);
+        assert!((d.factor(50, 100) - 0.55).abs() < 1e-12);
+        assert!((d.factor(100, 100) - 0.1).abs() < 1e-12);
+        assert_eq!(Decay::Constant.factor(70, 100), 1.0);
+    }
+
+    #[test]
+    fn bad_options_and_divergence_are_errors() {
+        let data = linear_data(20);
+        let invalid = |options: TrainOptions, field: &str| {
+            let err = train(&[2, 4, 1], &data, None, &options).unwrap_err();
+            assert!(
+                matches!(&err, NimError::InvalidOption { field: f, .. } if *f == field),
+                "{err}"
+            );
+        };
+        invalid(
+            TrainOptions {
+                optimizer: Optimizer::GradientDescent { learning_rate: -1.0 },
+                ..TrainOptions::default()
+            },
+            "learning_rate",
+        );
+        invalid(
+            TrainOptions {
+                record_every: 0,
+                ..TrainOptions::default()
+            },
+            "record_every",
+        );
+        invalid(
+            TrainOptions {
+                mse_threshold: Some(f64::NAN),
+                ..TrainOptions::default()
+            },
+            "mse_threshold",
+        );
+        invalid(
+            TrainOptions {
+                decay: Decay::Cosine { final_fraction: 2.0 },
+                ..TrainOptions::default()
+            },
+            "final_fraction",
+        );
+        let wide = Dataset::from_rows(&[[1.0, 2.0, 3.0]], &[[1.0]]).unwrap();
+        let err = train(&[2, 4, 1], &wide, None, &TrainOptions::default()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "dimension mismatch in training set inputs per sample: expected 2, found 3"
+        );
+        let err = train(
+            &[2, 4, 1],
+            &data,
+            None,
+            &TrainOptions {
+                optimizer: Optimizer::GradientDescent { learning_rate: 1e6 },
+                max_steps: 200,
+                ..TrainOptions::default()
+            },
+        )
+        .unwrap_err();
+        assert!(matches!(err, NimError::Diverged { .. }), "{err}");
+        assert!(err.to_string().contains("lower the learning rate"), "{err}");
+    }
+}

@@ -247,9 +247,9 @@ pub fn train_windows(
         if source.is_empty() {
             return Err(NimError::Empty {
                 what: if what == "training" {
-                    "the training windows"
+                    "the training set of windows"
                 } else {
-                    "the validation windows"
+                    "the validation set of windows"
                 },
             });
         }
@@ -534,5 +534,205 @@ impl Pass {
         }
         let denom = (windows.len() * o) as f64;
         (standardised / denom, original / denom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::Gaussian;
+
+    /// Windows of `(a, b)` pairs with `b = slope · a + noise`, target the least
+    /// squares slope `Σab / Σa²`: a ratio of window means, what a deep set is for.
+    struct Slopes {
+        windows: Vec<(Vec<f64>, f64)>,
+        window: usize,
+    }
+
+    impl Slopes {
+        fn new(count: usize, window: usize, seed: u64) -> Slopes {
+            let mut g = Gaussian::new(seed);
+            let windows = (0..count)
+                .map(|_| {
+                    let slope = 1.0 + 0.5 * g.standard();
+                    let mut features = Vec::with_capacity(2 * window);
+                    let (mut ab, mut aa) = (0.0, 0.0);
+                    for _ in 0..window {
+                        let a = 1.0 + g.standard();
+                        let b = slope * a + 0.1 * g.standard();
+                        features.extend([a, b]);
+                        ab += a * b;
+                        aa += a * a;
+                    }
+                    (features, ab / aa)
+                })
+                .collect();
+            Slopes { windows, window }
+        }
+    }
+
+    impl WindowSource for Slopes {
+        fn n_features(&self) -> usize {
+            2
+        }
+        fn n_outputs(&self) -> usize {
+            1
+        }
+        fn window(&self) -> usize {
+            self.window
+        }
+        fn len(&self) -> usize {
+            self.windows.len()
+        }
+        fn fill(&self, index: usize, features: &mut [f64], target: &mut [f64]) {
+            features.copy_from_slice(&self.windows[index].0);
+            target[0] = self.windows[index].1;
+        }
+    }
+
+    fn shape() -> WindowShape {
+        WindowShape {
+            encoder: vec![16, 16, 8],
+            decoder: vec![16],
+        }
+    }
+
+    /// The loss of one batch through [`Pass::step`] against central differences on
+    /// every parameter of both nets.
+    #[test]
+    fn window_gradients_match_finite_differences() {
+        let source = Slopes::new(5, 4, 3);
+        let mut net = WindowNet::new(2, &shape(), 1, 5).unwrap();
+        for b in net.encoder.parameters_mut().chain(net.decoder.parameters_mut()) {
+            for (k, v) in b.iter_mut().enumerate() {
+                *v += 0.01 * (k % 5) as f64 + 0.003;
+            }
+        }
+        let mut pass = Pass::new(&net, 5, 4);
+        let (mut f, mut t) = (vec![0.0; 8], [0.0]);
+        let load = |pass: &mut Pass, net: &WindowNet| {
+            let (mut f, mut t) = (vec![0.0; 8], [0.0]);
+            for slot in 0..5 {
+                source.fill(slot, &mut f, &mut t);
+                pass.load(net, slot, &f, &t);
+            }
+        };
+        source.fill(0, &mut f, &mut t);
+        load(&mut pass, &net);
+        pass.step(&net, 5);
+        let analytic: Vec<Vec<f64>> = pass
+            .encoder
+            .grads
+            .buffers()
+            .chain(pass.decoder.grads.buffers())
+            .map(<[f64]>::to_vec)
+            .collect();
+        let loss = |net: &WindowNet| {
+            let mut p = Pass::new(net, 5, 4);
+            load(&mut p, net);
+            p.forward(net, 5);
+            p.decoder.mse_delta(&net.decoder, &p.targets, 5)
+        };
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        for (b, grad) in analytic.iter().enumerate() {
+            for k in 0..grad.len() {
+                let bump = |net: &mut WindowNet, d: f64| {
+                    net.encoder
+                        .parameters_mut()
+                        .chain(net.decoder.parameters_mut())
+                        .nth(b)
+                        .unwrap()[k] += d;
+                };
+                bump(&mut net, h);
+                let up = loss(&net);
+                bump(&mut net, -2.0 * h);
+                let down = loss(&net);
+                bump(&mut net, h);
+                worst = worst.max(((up - down) / (2.0 * h) - grad[k]).abs() / (1e-3 + grad[k].abs()));
+            }
+        }
+        assert!(worst < 1e-5, "worst relative gradient error {worst:e}");
+    }
+
+    #[test]
+    fn a_window_net_learns_a_least_squares_slope() {
+        let train = Slopes::new(3000, 12, 1);
+        let check = Slopes::new(300, 12, 2);
+        let options = TrainOptions {
+            optimizer: Optimizer::adam(3e-3),
+            max_steps: 2500,
+            record_every: 500,
+            seed: 3,
+            ..TrainOptions::default()
+        };
+        let (net, history) = train_windows(2, &shape(), &train, Some(&check), &options).unwrap();
+        let rms = history.validation_mse_original.last().unwrap().sqrt();
+        // The slopes spread with σ = 0.5; the net gets them within a few percent.
+        assert!(rms < 0.05, "validation RMS {rms}, history {history:?}");
+        // One window through `predict` agrees with the batch path, and survives JSON.
+        let mut ws = net.workspace();
+        let (mut f, mut t, mut out) = (vec![0.0; 24], [0.0], [0.0]);
+        check.fill(7, &mut f, &mut t);
+        net.predict(&f, &mut ws, &mut out);
+        assert!((out[0] - t[0]).abs() < 0.2, "{} vs {}", out[0], t[0]);
+        let again = WindowNet::from_json(&net.to_json()).unwrap();
+        let mut out2 = [0.0];
+        again.predict(&f, &mut again.workspace(), &mut out2);
+        assert_eq!(out[0].to_bits(), out2[0].to_bits());
+        // The mean makes the order of the samples irrelevant.
+        let mut reversed: Vec<f64> = f.chunks_exact(2).rev().flatten().copied().collect();
+        net.predict(&reversed, &mut ws, &mut out2);
+        assert!((out[0] - out2[0]).abs() < 1e-12);
+        reversed.truncate(4);
+        net.predict(&reversed, &mut ws, &mut out2); // any window length
+    }
+
+    #[test]
+    fn window_training_refuses_what_it_cannot_do() {
+        let data = Slopes::new(10, 4, 1);
+        let gd = TrainOptions {
+            optimizer: Optimizer::GradientDescent { learning_rate: 0.1 },
+            ..TrainOptions::default()
+        };
+        let err = train_windows(2, &shape(), &data, None, &gd).unwrap_err();
+        assert!(err.to_string().contains("trains with Optimizer::Adam"), "{err}");
+        let err = train_windows(3, &shape(), &data, None, &TrainOptions::default()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "dimension mismatch in features per sample of the windows: expected 3, found 2"
+        );
+        let other = Slopes::new(10, 5, 1);
+        let err = train_windows(2, &shape(), &data, Some(&other), &TrainOptions::default()).unwrap_err();
+        assert!(
+            err.to_string().contains("samples per window: expected 4, found 5"),
+            "{err}"
+        );
+        let empty = Slopes::new(0, 4, 1);
+        let err = train_windows(2, &shape(), &empty, None, &TrainOptions::default()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "the training set of windows has no samples; at least one is needed"
+        );
+        let err = WindowNet::new(
+            2,
+            &WindowShape {
+                encoder: vec![],
+                decoder: vec![4],
+            },
+            1,
+            1,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string().contains("the encoder needs at least one layer"),
+            "{err}"
+        );
+        let json = WindowNet::new(2, &shape(), 1, 1).unwrap().to_json();
+        let err = WindowNet::from_json(&json.replace(WINDOW_SCHEMA, "x")).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "unsupported schema \"x\": this version reads \"dyngen-window-net/1\""
+        );
     }
 }

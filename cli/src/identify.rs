@@ -5,7 +5,7 @@
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
 use dyngen::data::{read_csv, Trajectory};
 use dyngen::dynamics::Dynamics;
-use dyngen::identify::{Accumulator, Channels, Estimate, Options};
+use dyngen::identify::{Accumulation, Accumulator, Channels, Estimate, Options};
 use dyngen::mim::{self, MimEstimate, MimOptions};
 use dyngen::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
 use dyngen::simulate::Recording;
@@ -59,6 +59,13 @@ pub enum Mode {
     Mim,
 }
 
+/// How the rows are compressed (dyngen::identify::Accumulation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AccumulationArg {
+    Qr,
+    NormalEquations,
+}
+
 /// The estimator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
@@ -88,6 +95,12 @@ pub struct IdentifyArgs {
     /// least squares weighted per body axis (Gautier).
     #[arg(long, value_enum)]
     pub method: Option<Method>,
+
+    /// How --mode standard and principal compress the rows: Householder QR
+    /// (backward stable), or the normal equations (faster; directions weaker than
+    /// 1e-6 of the strongest are then reported as not identifiable).
+    #[arg(long, value_enum, default_value_t = AccumulationArg::Qr)]
+    pub accumulation: AccumulationArg,
 
     /// Ridge: weight of the pull toward the nominal parameters.
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
@@ -145,6 +158,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             "--method applies to --mode standard and principal; MIM always uses least squares weighted per body axis"
                 .into(),
         );
+    }
+    if args.mode == Mode::Mim && args.accumulation != AccumulationArg::Qr {
+        return Err("--accumulation applies to --mode standard and principal; MIM accumulates by QR".into());
     }
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
@@ -221,7 +237,12 @@ fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress:
     let robot = Reference::new(model);
     let n = model.dof();
     let p = if principal { 4 * n } else { 10 * n };
-    let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n)).map_err(|e| e.to_string())?;
+    let accumulation = match args.accumulation {
+        AccumulationArg::Qr => Accumulation::Qr,
+        AccumulationArg::NormalEquations => Accumulation::NormalEquations,
+    };
+    let mut acc =
+        Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation).map_err(|e| e.to_string())?;
     let mut y = vec![0.0; n * p];
     let bar = progress.bar(traj.len() as u64, "stacking regressors");
     for k in 0..traj.len() {

@@ -105,8 +105,16 @@ fn simulate_then_identify_recovers_the_torques() {
     assert_error(&o, "--force");
     assert_eq!(dyngen::data::read_csv(&csv, None).unwrap(), traj);
 
-    for method in ["ols", "wls", "tls"] {
-        let o = run!("identify", ur5(), csv, "--method", method);
+    for (method, accumulation) in [("ols", "qr"), ("wls", "qr"), ("tls", "qr"), ("ols", "normal-equations")] {
+        let o = run!(
+            "identify",
+            ur5(),
+            csv,
+            "--method",
+            method,
+            "--accumulation",
+            accumulation
+        );
         assert_ok(&o);
         let out = stdout(&o);
         assert!(out.contains("Izz6"), "{out}");
@@ -117,7 +125,10 @@ fn simulate_then_identify_recovers_the_torques() {
             .and_then(|l| l.split_whitespace().next())
             .and_then(|x| x.parse().ok())
             .unwrap_or_else(|| panic!("no residual line in:\n{out}"));
-        assert!(rms < 1e-9, "{method}: residual RMS {rms}");
+        // The normal equations resolve residuals only down to about √ε of the
+        // torques (tens of N·m here): noise-free data leave ~1e-7 instead of ~1e-14.
+        let limit = if accumulation == "qr" { 1e-9 } else { 1e-5 };
+        assert!(rms < limit, "{method} ({accumulation}): residual RMS {rms}");
     }
 }
 

@@ -4,10 +4,14 @@
 //! `finish()` solves (OLS with rank handling). States and measured torques are
 //! prepared outside the timed region.
 //!
-//! Two variants:
+//! Two regressors:
 //! - `full`: the joint torque regressor, 7 × 70; the estimator finds the rank (43)
 //!   and the identifiable combinations itself;
-//! - `base`: the generated base regressor, 7 × 43, full column rank (the fast path).
+//! - `base`: the generated base regressor, 7 × 43, full column rank (the fast path);
+//!
+//! each accumulated by Householder QR (the default, backward stable) and, as
+//! `*_ne`, by the normal equations ([`Accumulation::NormalEquations`]: faster,
+//! squares the condition number, which is 15–20 here).
 //!
 //! `*/regressor_only` and `*/finish_only` split the end-to-end time. The peer is
 //! `scripts/bench_identification_pinocchio.py` (Pinocchio's regressor plus numpy
@@ -18,7 +22,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use dyngen::identify::faer::MatRef;
-use dyngen::identify::{Accumulator, Channels, Estimate};
+use dyngen::identify::{Accumulation, Accumulator, Channels, Estimate};
 use dyngen::reference::{sample_states, SplitMix64};
 use robot_panda::Panda;
 
@@ -88,8 +92,13 @@ fn fill_block<const P: usize>(d: &Data, start: usize, block: &mut [[[f64; P]; NV
 
 /// Regressor evaluation and accumulation over all samples; the accumulator is
 /// returned unsolved.
-fn accumulate<const P: usize>(d: &Data, block: &mut [[[f64; P]; NV]], regressor: Regressor<P>) -> Accumulator {
-    let mut acc = Accumulator::with_channels(P, Channels::Interleaved(NV)).expect("7 channels");
+fn accumulate<const P: usize>(
+    d: &Data,
+    block: &mut [[[f64; P]; NV]],
+    regressor: Regressor<P>,
+    accumulation: Accumulation,
+) -> Accumulator {
+    let mut acc = Accumulator::with_accumulation(P, Channels::Interleaved(NV), accumulation).expect("7 channels");
     for start in (0..N).step_by(BLOCK) {
         fill_block(d, start, block, regressor);
         let rows = block.as_flattened().as_flattened();
@@ -100,8 +109,15 @@ fn accumulate<const P: usize>(d: &Data, block: &mut [[[f64; P]; NV]], regressor:
     acc
 }
 
-fn end_to_end<const P: usize>(d: &Data, block: &mut [[[f64; P]; NV]], regressor: Regressor<P>) -> Estimate {
-    accumulate(d, block, regressor).finish().expect("solvable")
+fn end_to_end<const P: usize>(
+    d: &Data,
+    block: &mut [[[f64; P]; NV]],
+    regressor: Regressor<P>,
+    accumulation: Accumulation,
+) -> Estimate {
+    accumulate(d, block, regressor, accumulation)
+        .finish()
+        .expect("solvable")
 }
 
 fn full_regressor(q: &[f64; NV], v: &[f64; NV], a: &[f64; NV], y: &mut [[f64; 70]; NV]) {
@@ -167,28 +183,27 @@ fn identification(c: &mut Criterion) {
     let mut full_block = vec![[[0.0; 70]; NV]; BLOCK];
     let mut base_block = vec![[[0.0; 43]; NV]; BLOCK];
 
-    let t = Instant::now();
-    let est = end_to_end(&d, &mut full_block, full_regressor);
-    let s = t.elapsed().as_secs_f64();
-    assert_eq!(est.rank, Panda::NBASE, "full regressor: rank");
-    let x: [f64; 70] = est.solution.as_slice().try_into().expect("70 parameters");
-    verify(&d, "full (7x70)", &est, Panda::base_params(&x), s);
+    for (suffix, accumulation) in [("", Accumulation::Qr), ("_ne", Accumulation::NormalEquations)] {
+        let t = Instant::now();
+        let est = end_to_end(&d, &mut full_block, full_regressor, accumulation);
+        let s = t.elapsed().as_secs_f64();
+        assert_eq!(est.rank, Panda::NBASE, "full regressor: rank");
+        let x: [f64; 70] = est.solution.as_slice().try_into().expect("70 parameters");
+        verify(&d, &format!("full{suffix} (7x70)"), &est, Panda::base_params(&x), s);
 
-    let t = Instant::now();
-    let est = end_to_end(&d, &mut base_block, base_regressor);
-    let s = t.elapsed().as_secs_f64();
-    assert_eq!(est.rank, Panda::NBASE, "base regressor: rank");
-    let x: [f64; 43] = est.solution.as_slice().try_into().expect("43 parameters");
-    verify(&d, "base (7x43)", &est, x, s);
+        let t = Instant::now();
+        let est = end_to_end(&d, &mut base_block, base_regressor, accumulation);
+        let s = t.elapsed().as_secs_f64();
+        assert_eq!(est.rank, Panda::NBASE, "base regressor: rank");
+        let x: [f64; 43] = est.solution.as_slice().try_into().expect("43 parameters");
+        verify(&d, &format!("base{suffix} (7x43)"), &est, x, s);
+    }
 
     let mut group = c.benchmark_group("identification_panda_100k");
     group.sample_size(10);
     group.warm_up_time(Duration::from_secs(2));
     group.measurement_time(Duration::from_secs(15));
 
-    group.bench_function("full/end_to_end", |b| {
-        b.iter(|| black_box(end_to_end(black_box(&d), &mut full_block, full_regressor)))
-    });
     group.bench_function("full/regressor_only", |b| {
         b.iter(|| {
             for start in (0..N).step_by(BLOCK) {
@@ -196,14 +211,6 @@ fn identification(c: &mut Criterion) {
                 black_box(&full_block);
             }
         })
-    });
-    let acc = accumulate(&d, &mut full_block, full_regressor);
-    group.bench_function("full/finish_only", |b| {
-        b.iter(|| black_box(acc.finish().expect("solvable")))
-    });
-
-    group.bench_function("base/end_to_end", |b| {
-        b.iter(|| black_box(end_to_end(black_box(&d), &mut base_block, base_regressor)))
     });
     group.bench_function("base/regressor_only", |b| {
         b.iter(|| {
@@ -213,10 +220,22 @@ fn identification(c: &mut Criterion) {
             }
         })
     });
-    let acc = accumulate(&d, &mut base_block, base_regressor);
-    group.bench_function("base/finish_only", |b| {
-        b.iter(|| black_box(acc.finish().expect("solvable")))
-    });
+    for (suffix, accumulation) in [("", Accumulation::Qr), ("_ne", Accumulation::NormalEquations)] {
+        group.bench_function(format!("full{suffix}/end_to_end"), |b| {
+            b.iter(|| black_box(end_to_end(black_box(&d), &mut full_block, full_regressor, accumulation)))
+        });
+        let acc = accumulate(&d, &mut full_block, full_regressor, accumulation);
+        group.bench_function(format!("full{suffix}/finish_only"), |b| {
+            b.iter(|| black_box(acc.finish().expect("solvable")))
+        });
+        group.bench_function(format!("base{suffix}/end_to_end"), |b| {
+            b.iter(|| black_box(end_to_end(black_box(&d), &mut base_block, base_regressor, accumulation)))
+        });
+        let acc = accumulate(&d, &mut base_block, base_regressor, accumulation);
+        group.bench_function(format!("base{suffix}/finish_only"), |b| {
+            b.iter(|| black_box(acc.finish().expect("solvable")))
+        });
+    }
     group.finish();
 }
 

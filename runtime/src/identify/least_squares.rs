@@ -19,7 +19,7 @@ impl Accumulator {
     pub fn ols(&self, opts: &Options) -> Result<Estimate, IdentifyError> {
         let factors = self.factors()?;
         let tri = combine(&factors, None, self.n_params());
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let x = sub.min_norm_solution(&tri.z);
         let dof = tri.rows as f64 - sub.rank as f64;
         let residuals = Residuals::from_factors(&factors, &x, dof);
@@ -65,7 +65,7 @@ impl Accumulator {
         let factors = self.factors()?;
         let p = self.n_params();
         let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let m = tri.rows;
         if m <= sub.rank {
             return Err(IdentifyError::TooFewRows {
@@ -78,7 +78,7 @@ impl Accumulator {
         for _ in 1..iterations {
             let weights: Vec<f64> = var.iter().map(|v| 1.0 / v.sqrt()).collect();
             let wtri = combine(&factors, Some(&weights), p);
-            let wsub = Subspace::analyse(wtri.r.as_ref(), wtri.rows, opts)?;
+            let wsub = Subspace::analyse(wtri.r.as_ref(), wtri.rows, wtri.floor, opts)?;
             x = wsub.min_norm_solution(&wtri.z);
             let next = channel_variances(&factors, &x, wsub.rank);
             let change = next
@@ -108,7 +108,7 @@ impl Accumulator {
         }
         let weights: Vec<f64> = variances.iter().map(|v| 1.0 / v.sqrt()).collect();
         let tri = combine(&factors, Some(&weights), self.n_params());
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let x = sub.min_norm_solution(&tri.z);
         let dof = tri.rows as f64 - sub.rank as f64;
         let wrss: f64 = channel_rss(&factors, &x)
@@ -148,7 +148,7 @@ impl Accumulator {
         let factors = self.factors()?;
         let p = self.n_params();
         let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let r = sub.rank;
         // B = [R V₁, z; 0, ρ] has the singular values of [A V₁, y].
         let rv = tri.r.as_ref() * sub.v.as_ref().subcols(0, r);
@@ -214,7 +214,7 @@ impl Accumulator {
         }
         let factors = self.factors()?;
         let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         // d = x − x₀ = V diag(sᵢ/(sᵢ²+λ)) Uᵀ (z − R x₀).
         let rx0 = super::dense::mat_vec(tri.r.as_ref(), x0);
         let b: Vec<f64> = tri.z.iter().zip(&rx0).map(|(z, r)| z - r).collect();

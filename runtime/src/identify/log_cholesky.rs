@@ -330,7 +330,7 @@ impl Accumulator {
         }
         let factors = self.factors()?;
         let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let x_ols = sub.min_norm_solution(&tri.z);
         let start = match &lopts.start {
             Some(s) => {

@@ -41,7 +41,7 @@ mod subspace;
 
 pub use faer;
 
-pub use accumulate::Accumulator;
+pub use accumulate::{Accumulation, Accumulator, NORMAL_EQUATIONS_RESOLUTION};
 pub use error::{IdentifyError, Input};
 pub use estimate::{
     ActiveConstraint, Combination, ConstraintKind, Estimate, Method, ParamEstimate, Residuals, Status, Table,

@@ -146,7 +146,7 @@ impl Accumulator {
         };
         let factors = self.factors()?;
         let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, opts)?;
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
         let x_ols = sub.min_norm_solution(&tri.z);
         let dof = tri.rows as f64 - sub.rank as f64;
         let rss_ols: f64 = channel_rss(&factors, &x_ols).iter().sum();

@@ -33,8 +33,10 @@ pub(crate) struct Subspace {
 }
 
 impl Subspace {
-    /// Analyses the `p × p` triangle of a problem with `rows` data rows.
-    pub fn analyse(r: MatRef<'_, f64>, rows: usize, opts: &Options) -> Result<Self, IdentifyError> {
+    /// Analyses the `p × p` triangle of a problem with `rows` data rows, whose
+    /// accumulation resolves singular values down to `floor · σ₁` (0: all of them;
+    /// see [`super::Accumulation`]).
+    pub fn analyse(r: MatRef<'_, f64>, rows: usize, floor: f64, opts: &Options) -> Result<Self, IdentifyError> {
         let p = r.ncols();
         let svd = r.svd().map_err(|_| IdentifyError::DecompositionFailed {
             what: "SVD of the regressor",
@@ -45,11 +47,13 @@ impl Subspace {
             RankTolerance::Default => rows.max(p) as f64 * f64::EPSILON * s1,
             RankTolerance::Relative(t) => t * s1,
             RankTolerance::Absolute(t) => t,
-        };
+        }
+        .max(floor * s1);
         let rank = s.iter().filter(|&&si| si > tolerance).count();
         if rank == 0 {
             return Err(IdentifyError::RankZero { tolerance });
         }
+
         let column_norms: Vec<f64> = (0..p)
             .map(|j| (0..p).map(|i| r[(i, j)] * r[(i, j)]).sum::<f64>().sqrt())
             .collect();

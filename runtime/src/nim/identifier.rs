@@ -169,7 +169,7 @@ pub struct NimConfig {
 impl Default for NimConfig {
     /// Windows of 20 samples; 1,500 draws (+ 200 for validation) within ±30 %, 1 %
     /// training noise;
-    /// encoder 18 → 32 → 32 → 32, decoder 32 → 32 → 32 → outputs; 4,000 Adam steps
+    /// encoder 18 → 32 → 32 → 32, decoder 32 → 32 → 32 → outputs; 6,000 Adam steps
     /// of 64 windows, learning rate 5·10⁻³ annealed to 5 %; seed 1.
     fn default() -> NimConfig {
         NimConfig {
@@ -190,7 +190,7 @@ impl Default for NimConfig {
                     epsilon: 1e-8,
                     batch_size: 64,
                 },
-                max_steps: 4000,
+                max_steps: 6000,
                 mse_threshold: None,
                 seed: 1,
                 record_every: 250,

@@ -13,7 +13,7 @@ use dyngen::mim::{self, MimOptions, Verdict, THETA_NAMES};
 use dyngen::nim::online::{track, Tracking, TrackingSummary};
 use dyngen::nim::{draw_theta, paper_nim, Nim, NimConfig, PaperNim, PaperNimConfig};
 use dyngen::reference::{principal_params_to_standard, SplitMix64};
-use dyngen::report::{self, LineChart};
+use dyngen::report::{self, Corner, LineChart};
 use dyngen::simulate::{moment_sigma, record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
 use robot_paper6::Paper6;
 use std::ops::Range;
@@ -257,37 +257,40 @@ fn paper_faithful_nim(
         100.0 * offsets.iter().copied().fold(f64::NEG_INFINITY, f64::max),
     );
     write_figure(figure, force, || {
-        let curves = loss_curves(&paper.body_names, paper.histories.iter().map(Some));
+        let curves = loss_curves(&paper.body_names, paper.histories.iter().map(Some), |h, k| {
+            h.train_mse[k]
+        });
         report::svg_lines(&LineChart {
             title: "paper-faithful NIM: MSE against training step (cf. the paper's Fig. 5)",
             x_label: "training step (full-batch gradient descent)",
-            y_label: "MSE (standardised)",
+            y_label: "MSE (each target over its own size)",
             log_y: true,
             curves: &curves,
             reference: Some(("threshold", config.mse_threshold)),
+            legend: Corner::UpperRight,
         })
     })?;
     Ok(paper)
 }
 
-/// Each body's training curve, `(step, MSE)`.
+/// Each body's training curve, `(step, value(history, record point))`.
 fn loss_curves<'a>(
     names: &[String],
     histories: impl Iterator<Item = Option<&'a dyngen::nim::TrainHistory>>,
+    value: impl Fn(&dyngen::nim::TrainHistory, usize) -> f64,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
     names
         .iter()
         .zip(histories)
         .filter_map(|(name, h)| {
             h.map(|h| {
-                (
-                    name.clone(),
-                    h.steps
-                        .iter()
-                        .map(|&s| s as f64)
-                        .zip(h.train_mse.iter().copied())
-                        .collect(),
-                )
+                let points = h
+                    .steps
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &s)| (s as f64, value(h, k)))
+                    .collect();
+                (name.clone(), points)
             })
         })
         .collect()
@@ -374,14 +377,21 @@ fn generalising_nim(
         }
     }
     write_figure(figure, args.force, || {
-        let curves = loss_curves(&nim.body_names, training.histories.iter().map(Option::as_ref));
+        // The targets are ln θ: the RMS error of a window's prediction is a relative
+        // error of θ.
+        let curves = loss_curves(
+            &nim.body_names,
+            training.histories.iter().map(Option::as_ref),
+            |h, k| h.validation_mse_original[k].sqrt(),
+        );
         report::svg_lines(&LineChart {
-            title: "generalising NIM: training MSE (ln θ, standardised) against Adam step",
+            title: "generalising NIM: RMS relative error of one window's θ, on validation draws",
             x_label: "Adam step (64 windows each)",
-            y_label: "MSE (standardised)",
+            y_label: "RMS relative error",
             log_y: true,
             curves: &curves,
             reference: None,
+            legend: Corner::UpperRight,
         })
     })?;
     Ok(Trained { nim, seconds, config })
@@ -648,6 +658,7 @@ fn payload(
             log_y: false,
             curves: &curves,
             reference: None,
+            legend: Corner::LowerRight,
         })
     })
 }

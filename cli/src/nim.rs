@@ -220,31 +220,32 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         .map_err(|e| nim_error(&args.output, e))?;
     println!("wrote the identifier to {}", args.output.display());
     if let Some(svg) = &args.loss_svg {
+        // The targets are ln θ: the RMS error of a window's prediction is a relative
+        // error of θ.
         let curves: Vec<(String, Vec<(f64, f64)>)> = training
             .histories
             .iter()
             .zip(&nim.body_names)
             .filter_map(|(h, name)| {
-                h.as_ref().map(|h| {
-                    (
-                        name.clone(),
-                        h.steps
-                            .iter()
-                            .map(|&s| s as f64)
-                            .zip(h.train_mse.iter().copied())
-                            .collect(),
-                    )
-                })
+                let h = h.as_ref()?;
+                let errors = if h.validation_mse_original.is_empty() {
+                    &h.train_mse_original
+                } else {
+                    &h.validation_mse_original
+                };
+                let points = h.steps.iter().map(|&s| s as f64).zip(errors.iter().map(|e| e.sqrt()));
+                Some((name.clone(), points.collect()))
             })
             .collect();
-        let title = format!("{}: NIM training", model.name);
+        let title = format!("{}: NIM training, RMS relative error of one window's θ", model.name);
         let text = report::svg_lines(&report::LineChart {
             title: &title,
-            x_label: "training step",
-            y_label: "MSE (standardised)",
+            x_label: "Adam step",
+            y_label: "RMS relative error",
             log_y: true,
             curves: &curves,
             reference: None,
+            legend: report::Corner::UpperRight,
         })
         .map_err(|e| format!("{}: {e}", svg.display()))?;
         report::write_new(svg, &text, args.force).map_err(|e| format!("{}: {e}", svg.display()))?;

@@ -5,7 +5,7 @@
 //! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a
 //! URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
 //! a type implementing [`Robot`], with generated functions that agree with the
-//! readable [`reference`] implementation (and with Pinocchio) to 1e-10.
+//! readable [`reference`](mod@reference) implementation (and with Pinocchio) to 1e-10.
 
 pub mod data;
 pub mod dynamics;

@@ -132,7 +132,7 @@ fn single_body(kind: &str) -> Model {
     parse_urdf(&text).expect("test URDF is valid")
 }
 
-/// The models exercise what the brief asks for: a branched tree with two roots, all
+/// The models exercise what a serious library must handle: a branched tree with two roots, all
 /// three joint kinds, a merged fixed link, and every body's principal axes turned
 /// away from its frame's axes; a chain with no branches.
 #[test]

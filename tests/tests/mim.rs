@@ -1,4 +1,4 @@
-//! Accuracy targets of MIM (issue 4, item 7): the paper's experiment on paper6,
+//! Accuracy targets of MIM: the paper's experiment on paper6,
 //! noise-free and with 1 % noise, and joint-torque identification on ur5 and the
 //! 7-DOF panda validated on a separate trajectory.
 

@@ -1,4 +1,4 @@
-//! Targets of the generalising NIM (issue 5, item 5) on the paper's 6-DOF arm, with
+//! Targets of the generalising NIM on the paper's 6-DOF arm, with
 //! the generated dynamics: trained with the default settings along the excitation
 //! designed for MIM, judged on 100 parameter draws it has never seen, simulated by
 //! the full dynamics; then a payload followed online against recursive least
@@ -81,10 +81,10 @@ fn generalising_nim_meets_its_targets_on_unseen_draws() {
         100.0 * noisy_worst.0,
         100.0 * noisy_worst.1
     );
-    // The issue's targets, noise-free.
+    // The targets: noise-free, ≤ 2 % on every mass and ≤ 5 % on every principal moment.
     assert!(clean_worst.0 <= 0.02, "mass {:.3}%", 100.0 * clean_worst.0);
     assert!(clean_worst.1 <= 0.05, "moment {:.3}%", 100.0 * clean_worst.1);
-    // With 1 % noise per curve: no target in the issue; a guard against regressions.
+    // With 1 % noise per curve: no stated target; a guard against regressions.
     assert!(noisy_worst.0 <= 0.02 && noisy_worst.1 <= 0.10, "{noisy_worst:?}");
 
     payload_is_followed_within_a_window(&robot, &experiment, &nim, &nominal);

@@ -1,32 +1,5 @@
-//! The generalising NIM: per body, a [`WindowNet`] that reads a short window of the
-//! body's own measurements and returns its principal parameters `θ_i = (m, J1, J2,
-//! J3)`, trained on many simulated parameter draws along one joint motion and
-//! judged on draws it has never seen.
-//!
-//! **Inputs.** Per sample, in the body's centroidal principal frame (what a
-//! wrench sensor and an IMU on the body give, [`BodySample`]): the resultant force
-//! `F` and moment `M`, the specific force `s = a_c − g` (an accelerometer at the
-//! centre of mass), the angular velocity `ω` and acceleration `ω̇`, and the
-//! gyroscopic products `ω2ω3, ω3ω1, ω1ω2`: 18 features. `F` and `M` are divided by
-//! their RMS over the window (`ρ_F`, `ρ_M`), and the net predicts `ln(m/ρ_F)` and
-//! `ln(J_k/ρ_M)`: since `F = m s` and `M = B(ω, ω̇) J`, a body twice as heavy gives
-//! the same inputs and twice the output, so the net only has to learn how the motion
-//! shapes the wrench, not the scale of the parameters; in logarithms an error is a
-//! relative error, and a window that barely moves (small `ρ`, large ratio) does not
-//! dominate the loss.
-//!
-//! **Training data.** The joint motion is fixed (a prescribed experiment, or the
-//! joint samples of a measurement); the kinematics of every body along it are
-//! recorded once. A draw ([`draw_theta`]) changes every body's mass by a factor in
-//! `[1 − spread, 1 + spread]` and each of its three principal second moments of mass
-//! `s_k = ∫ x_k² dm` likewise, so every draw is physically consistent (`J1 = s2 +
-//! s3`, … satisfy the triangle inequalities by construction). Each body's resultant
-//! under a draw is `[F; M] = A_i θ_i` (DESIGN §5), exact along a prescribed motion;
-//! windows of `window` consecutive samples start anywhere along the motion.
-//!
-//! **Identifiability.** A parameter that does not enter its body's equations along
-//! the motion (a turret's `J1`, `J2`) is not an output: it is reported `n/i`, never
-//! guessed.
+//! The generalising NIM ([`Nim`]): window networks trained on parameter draws along
+//! one joint motion.
 
 use super::error::NimError;
 use super::train::{Decay, Optimizer, TrainHistory, TrainOptions};
@@ -39,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::Path;
 
-/// Features per sample ([module docs](self)).
+/// Features per sample (see [`Nim`]).
 pub const FEATURES: usize = 18;
 
 /// The `schema` of [`Nim::to_json`].
@@ -236,8 +209,36 @@ pub struct BodyNim {
     pub net: Option<WindowNet>,
 }
 
-/// The generalising NIM of one robot and one joint motion; see the
-/// [module docs](self).
+/// The generalising NIM: per body, a [`WindowNet`] that reads a short window of the
+/// body's own measurements and returns its principal parameters `θ_i = (m, J1, J2,
+/// J3)`, trained on many simulated parameter draws along one joint motion and
+/// judged on draws it has never seen.
+///
+/// **Inputs.** Per sample, in the body's centroidal principal frame (what a
+/// wrench sensor and an IMU on the body give, [`BodySample`]): the resultant force
+/// `F` and moment `M`, the specific force `s = a_c − g` (an accelerometer at the
+/// centre of mass), the angular velocity `ω` and acceleration `ω̇`, and the
+/// gyroscopic products `ω2ω3, ω3ω1, ω1ω2`: 18 features. `F` and `M` are divided by
+/// their RMS over the window (`ρ_F`, `ρ_M`), and the net predicts `ln(m/ρ_F)` and
+/// `ln(J_k/ρ_M)`: since `F = m s` and `M = B(ω, ω̇) J`, a body twice as heavy gives
+/// the same inputs and twice the output, so the net only has to learn how the motion
+/// shapes the wrench, not the scale of the parameters; in logarithms an error is a
+/// relative error, and a window that barely moves (small `ρ`, large ratio) does not
+/// dominate the loss.
+///
+/// **Training data.** The joint motion is fixed (a prescribed experiment, or the
+/// joint samples of a measurement); the kinematics of every body along it are
+/// recorded once. A draw ([`draw_theta`]) changes every body's mass by a factor in
+/// `[1 − spread, 1 + spread]` and each of its three principal second moments of mass
+/// `s_k = ∫ x_k² dm` likewise, so every draw is physically consistent (`J1 = s2 +
+/// s3`, … satisfy the triangle inequalities by construction). Each body's resultant
+/// under a draw is `[F; M] = A_i θ_i` (DESIGN §5), exact along a prescribed motion;
+/// windows of `window` consecutive samples start anywhere along the motion.
+///
+/// **Identifiability.** A parameter that does not enter its body's equations along
+/// the motion (a turret's `J1`, `J2`) is not an output: it is reported `n/i`, never
+/// guessed.
+///
 #[derive(Clone, Debug, PartialEq)]
 pub struct Nim {
     pub robot: String,
@@ -693,7 +694,7 @@ pub struct NimEstimate {
 }
 
 impl NimEstimate {
-    /// The estimate with the true θ attached (for [`NimEstimate::max_relative_error`]
+    /// The estimate with the true θ attached (for [`NimEstimate::max_relative_errors`]
     /// and the error table).
     pub fn with_truth(mut self, truth: &[f64]) -> NimEstimate {
         self.truth = Some(truth.to_vec());

@@ -1,9 +1,24 @@
-//! NIM, the neural-network identification method: the machinery of the identifier
-//! that predicts a body's principal inertial parameters `θ = (m, J1, J2, J3)` from
-//! features of its measured motion and wrench.
+//! NIM, the neural-network identification method: networks that read a body's
+//! measured motion and wrench and return its principal inertial parameters
+//! `θ = (m, J1, J2, J3)`. No machine-learning framework: the networks are written
+//! over faer.
 //!
-//! The network is a multilayer perceptron written directly over faer (no machine
-//! learning framework):
+//! Two identifiers:
+//!
+//! * [`paper_nim`]: the paper's NIM as described (per body six inputs, five ReLU
+//!   layers, gradient descent to an MSE threshold on the first 80 of 100 samples,
+//!   the 20 validation predictions averaged; Tables 4–5 and Fig. 5). Its targets
+//!   are the true parameters of the one simulated robot, so it returns its labels:
+//!   [`PaperNim`] says so, and the demo shows it by training on wrong labels.
+//! * [`Nim`]: the generalising NIM. Per body a window network ([`WindowNet`]: an
+//!   encoder per sample, a mean over the window, a decoder) on physically meaningful
+//!   features in body axes, trained on many physically consistent parameter draws
+//!   ([`draw_theta`]) along one joint motion, judged on draws it has never seen;
+//!   parameters that do not enter a body's equations are reported, not guessed.
+//!   [`online::track`] follows a body whose θ changes, against recursive least
+//!   squares.
+//!
+//! The machinery under both:
 //!
 //! * [`Mlp`]: layer sizes `[n_in, h1, …, hk, n_out]`, ReLU hidden layers, a linear
 //!   output layer, He initialisation ([`Mlp::new`]), and a [`Standardizer`] on the
@@ -11,22 +26,23 @@
 //! * [`Dataset`]: checked (input, target) samples, one per row, with the paper's
 //!   ordered split ([`Dataset::split`]: the first 80 of 100 samples train, the last
 //!   20 validate) and a seeded shuffled one;
-//! * [`train`]: the MSE loss with hand-written backpropagation over faer matrix
-//!   products (samples as columns), full-batch gradient descent (the paper) or
-//!   mini-batch Adam ([`Optimizer`]), stopping at an MSE threshold or a step budget
-//!   ([`TrainOptions`]), returning the loss curves ([`TrainHistory`]);
-//! * inference: [`Mlp::predict`] for one sample without allocation (through a
-//!   reusable [`Workspace`]), [`Mlp::predict_batch`] for many, [`Mlp::evaluate`] for
-//!   the MSE on a dataset;
-//! * JSON files: [`Mlp::to_json`] / [`Mlp::from_json`] (schema [`SCHEMA`]),
-//!   [`Mlp::save`] / [`Mlp::load`]; numbers round-trip exactly, so a loaded net
+//! * [`train`] and [`train_windows`]: the MSE loss with hand-written
+//!   backpropagation over faer matrix products (samples as columns), full-batch
+//!   gradient descent (the paper) or mini-batch Adam ([`Optimizer`]) with an
+//!   optional cosine schedule ([`Decay`]), stopping at an MSE threshold or a step
+//!   budget ([`TrainOptions`]), returning the loss curves ([`TrainHistory`]);
+//! * inference: [`Mlp::predict`], [`WindowNet::predict`] and [`Nim::predict`] for
+//!   one sample or window without allocation (through reusable workspaces),
+//!   [`Mlp::predict_batch`] for many, [`Mlp::evaluate`] for the MSE on a dataset;
+//! * JSON files: [`Mlp::to_json`], [`WindowNet::to_json`], [`Nim::to_json`] and their
+//!   `from_json`, `save`, `load`; numbers round-trip exactly, so a loaded net
 //!   predicts bit-identically.
 //!
-//! Everything is deterministic: initialisation and shuffling draw from
-//! [`SplitMix64`](crate::reference::SplitMix64) streams seeded by
-//! [`TrainOptions::seed`], and faer runs sequentially, so the same call gives the
-//! same bits on the same build and machine. Failures are [`NimError`]s naming the
-//! offending row, column, layer or field.
+//! Everything is deterministic: initialisation, draws and shuffling come from
+//! [`SplitMix64`](crate::reference::SplitMix64) streams seeded by the options, and
+//! faer runs sequentially, so the same call gives the same bits on the same build
+//! and machine (bodies train on parallel threads, each from its own seed).
+//! Failures are [`NimError`]s naming the offending row, column, layer or field.
 //!
 //! ```
 //! use dyngen::nim::{train, Dataset, Optimizer, TrainOptions};

@@ -45,9 +45,10 @@ pub struct WindowShape {
     pub decoder: Vec<usize>,
 }
 
-/// See the [module docs](self): encoder, mean over the window, decoder. The
-/// encoder's input standardiser holds the feature statistics, the decoder's output
-/// standardiser the target statistics; the two in between are the identity.
+/// A deep set over a window of samples: encoder, mean over the window, decoder
+/// (trained by [`train_windows`]). The encoder's input standardiser holds the
+/// feature statistics, the decoder's output standardiser the target statistics; the
+/// two in between are the identity.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WindowNet {
     encoder: Mlp,

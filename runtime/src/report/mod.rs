@@ -13,7 +13,7 @@ mod urdf;
 
 pub use error::ReportError;
 pub use json::{CombinationReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, Term, SCHEMA};
-pub use svg::{svg_lines, svg_report, svg_report_with, LineChart, SvgOptions};
+pub use svg::{svg_lines, svg_report, svg_report_with, Corner, LineChart, SvgOptions};
 pub use urdf::{rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;

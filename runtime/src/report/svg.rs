@@ -319,6 +319,16 @@ pub struct LineChart<'a> {
     pub curves: &'a [(String, Vec<(f64, f64)>)],
     /// A horizontal reference line: `(name, y)`.
     pub reference: Option<(&'a str, f64)>,
+    /// Where the legend goes (pick the corner the lines leave free).
+    pub legend: Corner,
+}
+
+/// A corner of a chart, for its legend.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Corner {
+    #[default]
+    UpperRight,
+    LowerRight,
 }
 
 /// Lines against a common x axis, e.g. the paper's Fig. 5 (MSE against training
@@ -411,7 +421,10 @@ where
         .label_font(("sans-serif", 12))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK.mix(0.3))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(match chart.legend {
+            Corner::UpperRight => SeriesLabelPosition::UpperRight,
+            Corner::LowerRight => SeriesLabelPosition::LowerRight,
+        })
         .draw()
         .map_err(plot_error)?;
     Ok(())

@@ -1,4 +1,4 @@
-//! Simulated experiments for identification (issue 4, item 1): the paper's ADAMS
+//! Simulated experiments for identification: the paper's ADAMS
 //! experiment ([`Experiment`], [`record`]), optimal Fourier excitation
 //! ([`FourierExcitation`], [`ExcitationDesign`]), forward simulation from torques
 //! ([`simulate_rk4`]) and seeded sensor noise ([`NoiseModel`]). Everything runs on a

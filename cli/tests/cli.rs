@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, run, stderr, stdout, temp_dir, ur5};
+use common::{assert_error, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
 
 #[test]
 fn help_has_examples() {
@@ -79,22 +79,7 @@ fn generate_writes_header_and_refuses_to_overwrite() {
 #[test]
 fn simulate_then_identify_recovers_the_torques() {
     let dir = temp_dir("dyngen-cli", "identify");
-    let csv = dir.join("ur5.csv");
-    // `--evaluations 0`: the optimiser's random feasible start, enough excitation
-    // for noise-free data and fast in a debug build.
-    let o = run!(
-        "simulate",
-        ur5(),
-        "-o",
-        csv,
-        "--experiment",
-        "fourier",
-        "--evaluations",
-        "0",
-        "--steps",
-        "120"
-    );
-    assert_ok(&o);
+    let csv = simulate_ur5(&dir, 120, &[]);
     let traj = dyngen::data::read_csv(&csv, None).unwrap();
     assert_eq!((traj.dof(), traj.len()), (6, 121));
     assert!(traj.velocities().is_some() && traj.accelerations().is_some());

@@ -3,7 +3,7 @@
 use dyngen::report::{ParamStatus, ParameterReport};
 mod common;
 
-use common::{assert_error, assert_ok, run, stdout, temp_dir, ur5};
+use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
 use std::path::{Path, PathBuf};
 
 const JOINTS: [&str; 6] = [
@@ -17,21 +17,7 @@ const JOINTS: [&str; 6] = [
 
 /// Noise-free fourier data for the UR5 in `dir`.
 fn simulate(dir: &Path) -> PathBuf {
-    let csv = dir.join("ur5.csv");
-    let o = run!(
-        "simulate",
-        ur5(),
-        "-o",
-        csv,
-        "--experiment",
-        "fourier",
-        "--evaluations",
-        "0",
-        "--steps",
-        "120"
-    );
-    assert_ok(&o);
-    csv
+    simulate_ur5(dir, 120, &[])
 }
 
 #[test]
@@ -153,15 +139,9 @@ fn identify_output_flags_are_checked() {
     let o = run!("identify", ur5(), csv, "--mode", "mim", "--method", "ols");
     assert_error(&o, "--method applies to --mode standard and principal");
 
-    // MIM needs the joint wrench columns: the same data without them (t, q, v, a,
-    // tau: the first 1 + 4·6 columns) is refused with a message naming them.
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let bare: String = text
-        .lines()
-        .map(|l| l.split(',').take(25).collect::<Vec<_>>().join(",") + "\n")
-        .collect();
-    let bare_csv = dir.join("bare.csv");
-    std::fs::write(&bare_csv, bare).unwrap();
+    // MIM needs the joint wrench columns: the same data without them is refused
+    // with a message naming them.
+    let bare_csv = without_wrenches(&csv, &dir);
     let o = run!("identify", ur5(), bare_csv, "--mode", "mim");
     assert_error(
         &o,

@@ -4,31 +4,13 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, run, stdout, temp_dir, ur5};
+use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
 use dyngen::report::{ParamStatus, ParameterReport};
 use std::path::{Path, PathBuf};
 
-/// Noise-free UR5 data along a 2 s Fourier motion.
+/// Noise-free UR5 data along a 2 s Fourier motion designed for the body model.
 fn simulate(dir: &Path) -> PathBuf {
-    let csv = dir.join("ur5.csv");
-    let o = run!(
-        "simulate",
-        ur5(),
-        "-o",
-        csv,
-        "--experiment",
-        "fourier",
-        "--criterion",
-        "body-model",
-        "--base-frequency",
-        "0.5",
-        "--evaluations",
-        "0",
-        "--steps",
-        "60"
-    );
-    assert_ok(&o);
-    csv
+    simulate_ur5(dir, 60, &["--criterion", "body-model", "--base-frequency", "0.5"])
 }
 
 fn train(dir: &Path, csv: &Path) -> PathBuf {
@@ -117,15 +99,8 @@ fn nim_predict_explains_bad_input() {
     let o = run!("nim", "predict", paper6, nim, csv);
     assert_error(&o, "was trained for ur5 with bodies [shoulder_link");
 
-    // Data without the joint wrench columns (t, q, v, a, tau: the first 25 columns).
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let bare: String = text
-        .lines()
-        .map(|l| l.split(',').take(25).collect::<Vec<_>>().join(",") + "\n")
-        .collect();
-    let bare_csv = dir.join("bare.csv");
-    std::fs::write(&bare_csv, bare).unwrap();
-    let o = run!("nim", "predict", ur5(), nim, bare_csv);
+    // Data without the joint wrench columns.
+    let o = run!("nim", "predict", ur5(), nim, without_wrenches(&csv, &dir));
     assert_error(&o, "joint wrench columns fx1, fy1, fz1, mx1, my1, mz1");
 
     // A damaged identifier file: the error names the file and the field.

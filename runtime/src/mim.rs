@@ -508,15 +508,8 @@ pub fn whole_robot(
             let block = recording.body_regressor(k, i);
             let wrench = recording.body_wrench(k, i);
             for r in 0..6 {
-                let lhs = if r < 3 {
-                    block.force.row(r)
-                } else {
-                    block.moment.row(r - 3)
-                };
                 row.fill(0.0);
-                for c in 0..4 {
-                    row[4 * i + c] = lhs[c];
-                }
+                row[4 * i..4 * i + 4].copy_from_slice(&block.row(r));
                 acc.push_row(&row, wrench[r])?;
             }
         }

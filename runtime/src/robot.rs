@@ -47,6 +47,15 @@ pub struct BodyRegressor<S: Scalar> {
     pub moment: SMatrix<S, 3, 4>,
 }
 
+impl<S: Scalar> BodyRegressor<S> {
+    /// Row `r` of `A_i` (`0..3` the force, `3..6` the moment). Panics when `r ≥ 6`.
+    pub fn row(&self, r: usize) -> [S; 4] {
+        let m = if r < 3 { &self.force } else { &self.moment };
+        let r = r % 3;
+        [m[(r, 0)], m[(r, 1)], m[(r, 2)], m[(r, 3)]]
+    }
+}
+
 impl<S: Scalar> Default for BodyRegressor<S> {
     fn default() -> Self {
         BodyRegressor {

@@ -103,12 +103,7 @@ fn inference(c: &mut Criterion) {
     c.bench_function("rls/sample", |b| {
         b.iter(|| {
             for r in 0..6 {
-                let row = if r < 3 {
-                    block.force.row(r)
-                } else {
-                    block.moment.row(r - 3)
-                };
-                rls.update(&[row[0], row[1], row[2], row[3]], wrench[r]).unwrap();
+                rls.update(&block.row(r), wrench[r]).unwrap();
             }
             black_box(rls.estimate()[0])
         })

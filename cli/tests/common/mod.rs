@@ -59,3 +59,35 @@ pub fn assert_error(o: &Output, needle: &str) {
     assert!(err.contains(needle), "expected `{needle}` in:\n{err}");
     assert!(!err.contains("panicked") && !err.contains("internal error"), "{err}");
 }
+
+/// Noise-free UR5 data from `dyngen simulate` along a Fourier motion with the random
+/// feasible start (`--evaluations 0`: excitation enough for exact data, and fast in a
+/// debug build), `steps` + 1 samples, in `dir/ur5.csv`; `extra` arguments are
+/// passed on.
+pub fn simulate_ur5(dir: &Path, steps: usize, extra: &[&str]) -> PathBuf {
+    let csv = dir.join("ur5.csv");
+    let steps = steps.to_string();
+    let mut args: Vec<std::ffi::OsString> = vec!["simulate".into(), ur5().into(), "-o".into(), csv.clone().into()];
+    for a in ["--experiment", "fourier", "--evaluations", "0", "--steps", &steps]
+        .into_iter()
+        .chain(extra.iter().copied())
+    {
+        args.push(a.into());
+    }
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    assert_ok(&dyngen(&args));
+    csv
+}
+
+/// `csv` without its joint wrench columns (keeps t, q, v, a, tau: the first
+/// 1 + 4·6 columns of a 6-joint file), as `dir/bare.csv`.
+pub fn without_wrenches(csv: &Path, dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let bare: String = text
+        .lines()
+        .map(|l| l.split(',').take(25).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    let path = dir.join("bare.csv");
+    std::fs::write(&path, bare).unwrap();
+    path
+}

@@ -652,9 +652,7 @@ impl Nim {
     }
 
     pub fn load(path: impl AsRef<Path>) -> Result<Nim, NimError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| NimError::io(path, e))?;
-        Nim::from_json(&text)
+        Nim::from_json(&super::mlp::read_json(path.as_ref())?)
     }
 }
 

@@ -535,10 +535,13 @@ impl Mlp {
 
     /// Reads a file written by [`Mlp::save`].
     pub fn load(path: impl AsRef<Path>) -> Result<Mlp, NimError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| NimError::io(path, e))?;
-        Mlp::from_json(&text)
+        Mlp::from_json(&read_json(path.as_ref())?)
     }
+}
+
+/// The text of a JSON file (its I/O errors name the path).
+pub(crate) fn read_json(path: &Path) -> Result<String, NimError> {
+    std::fs::read_to_string(path).map_err(|e| NimError::io(path, e))
 }
 
 /// Writes `json` and a newline to `path`; an existing file only with `overwrite`

@@ -101,13 +101,7 @@ pub fn track(nim: &Nim, recording: &Recording, tracking: &Tracking) -> Result<(T
         let block = recording.body_regressor(k, i);
         let y = recording.body_wrench(k, i);
         for r in 0..6 {
-            let row = if r < 3 {
-                block.force.row(r)
-            } else {
-                block.moment.row(r - 3)
-            };
-            let a = [row[0], row[1], row[2], row[3]];
-            rls.update(&a, y[r]).map_err(rls_error)?;
+            rls.update(&block.row(r), y[r]).map_err(rls_error)?;
         }
         rls_time += start.elapsed().as_secs_f64();
         out.t.push(recording.samples[k].t);

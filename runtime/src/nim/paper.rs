@@ -114,15 +114,7 @@ pub fn paper_nim(
             found: labels.len(),
         });
     }
-    if samples.end > recording.len() || samples.start >= samples.end {
-        return Err(NimError::InvalidOption {
-            field: "samples",
-            reason: format!(
-                "{samples:?} is not a non-empty range within the recording's {} samples",
-                recording.len()
-            ),
-        });
-    }
+    check_samples(recording, &samples)?;
     let options = TrainOptions {
         optimizer: Optimizer::GradientDescent {
             learning_rate: config.learning_rate,
@@ -179,6 +171,20 @@ pub fn paper_nim(
     })
 }
 
+/// Errors unless `samples` is a non-empty range of the recording's samples.
+fn check_samples(recording: &Recording, samples: &Range<usize>) -> Result<(), NimError> {
+    if samples.end > recording.len() || samples.start >= samples.end {
+        return Err(NimError::InvalidOption {
+            field: "samples",
+            reason: format!(
+                "{samples:?} is not a non-empty range within the recording's {} samples",
+                recording.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
 impl PaperNim {
     /// The result with the true θ attached (Table 5).
     pub fn with_truth(mut self, truth: &[f64]) -> PaperNim {
@@ -198,15 +204,7 @@ impl PaperNim {
                 found: recording.nv(),
             });
         }
-        if samples.end > recording.len() || samples.start >= samples.end {
-            return Err(NimError::InvalidOption {
-                field: "samples",
-                reason: format!(
-                    "{samples:?} is not a non-empty range within the recording's {} samples",
-                    recording.len()
-                ),
-            });
-        }
+        check_samples(recording, &samples)?;
         let mut workspace = self.nets[0].workspace();
         let mut out = [0.0; 4];
         let mut theta = vec![0.0; 4 * self.nets.len()];

@@ -195,9 +195,7 @@ impl WindowNet {
     }
 
     pub fn load(path: impl AsRef<Path>) -> Result<WindowNet, NimError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| NimError::io(path, e))?;
-        WindowNet::from_json(&text)
+        WindowNet::from_json(&super::mlp::read_json(path.as_ref())?)
     }
 }
 

@@ -319,12 +319,11 @@ fn generalising_nim(
     progress: &Progress,
     figure: Option<&Path>,
 ) -> Result<Trained> {
-    let config = NimConfig {
+    let mut config = NimConfig {
         draws: args.draws,
         threads: args.threads,
         ..NimConfig::default()
     };
-    let mut config = config;
     config.train.max_steps = args.steps;
     println!("\n== the generalising NIM ==");
     let two_periods = Experiment {

@@ -92,7 +92,7 @@ pub enum Verdict {
 }
 
 impl Verdict {
-    fn short(self) -> &'static str {
+    pub(crate) fn short(self) -> &'static str {
         match self {
             Verdict::Identified => "",
             Verdict::InCombination => "comb.",

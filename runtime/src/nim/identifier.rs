@@ -733,7 +733,7 @@ impl fmt::Display for NimEstimate {
             .theta
             .iter()
             .zip(&self.verdicts)
-            .map(|(v, verdict)| v.ok_or(if *verdict == Verdict::NoEffect { "n/i" } else { "n/s" }))
+            .map(|(v, verdict)| v.ok_or(verdict.short()))
             .collect();
         let table = ThetaTable {
             body_names: &self.body_names,

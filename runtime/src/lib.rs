@@ -15,6 +15,7 @@ pub mod nim;
 pub mod reference;
 pub mod report;
 mod robot;
+mod robot_model;
 mod scalar;
 pub mod simulate;
 
@@ -23,6 +24,7 @@ pub use dyngen_model as model;
 pub use nalgebra;
 pub use reference::Reference;
 pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
+pub use robot_model::{BodyModel, JointLimits, JointModel, JointType, RobotModel};
 pub use scalar::Scalar;
 
 /// Support for generated code; not a public API.

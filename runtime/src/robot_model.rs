@@ -1,0 +1,65 @@
+//! The robot description a generated type carries as Rust data (`Robot::MODEL`): the
+//! checked model it was generated from, in the generator's numbering, so that nothing
+//! at run time re-parses a file or renumbers a joint.
+
+/// What a joint allows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum JointType {
+    /// Rotation about the axis, with position limits.
+    Revolute,
+    /// Rotation about the axis without limits; its coordinate is the angle.
+    Continuous,
+    /// Translation along the axis.
+    Prismatic,
+}
+
+/// Joint position, velocity and effort limits (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointLimits {
+    pub lower: f64,
+    pub upper: f64,
+    pub velocity: f64,
+    pub effort: f64,
+}
+
+/// One joint: joint `j` (1-based) carries body `j`; its parent body is `< j`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointModel {
+    pub name: &'static str,
+    pub kind: JointType,
+    /// Parent body: 0 is the fixed base.
+    pub parent: usize,
+    /// Joint frame at `q = 0` in the parent body's frame:
+    /// `x_parent = rotation · x_joint + translation`.
+    pub rotation: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+    /// Unit axis in the joint (= child body) frame.
+    pub axis: [f64; 3],
+    pub limits: Option<JointLimits>,
+}
+
+/// One moving body; its frame is its joint's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyModel {
+    pub name: &'static str,
+    pub mass: f64,
+    /// Centre of mass in the body frame.
+    pub com: [f64; 3],
+    /// Inertia about the centre of mass, in the body frame's axes.
+    pub inertia: [[f64; 3]; 3],
+    /// Links rigidly attached through fixed joints whose inertia was lumped here.
+    pub merged: &'static [&'static str],
+}
+
+/// A fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
+/// `bodies[j - 1]` (body `j`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotModel {
+    pub name: &'static str,
+    /// Gravity in the base frame, m/s².
+    pub gravity: [f64; 3],
+    /// Name of the fixed base (body 0).
+    pub base: &'static str,
+    pub joints: &'static [JointModel],
+    pub bodies: &'static [BodyModel],
+}

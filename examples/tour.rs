@@ -5,9 +5,9 @@
 //!
 //!     cargo run --release -p dyngen-examples --example tour
 
-use dyngen::model::graph;
-use dyngen::reference::{sample_states, Reference};
 use dyngen::Robot;
+use dyngen_model::graph;
+use dyngen_reference::{sample_states, Reference};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;

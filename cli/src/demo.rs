@@ -7,14 +7,17 @@
 //! mid-motion, followed by NIM and by recursive least squares.
 
 use crate::common::{check_overwrite, with_spinner, Progress, Result};
+use crate::svg::{self, Corner, LineChart};
 use clap::Args;
-use dyngen::dynamics::{Dynamics, Generated};
-use dyngen::mim::{self, MimOptions, Verdict, THETA_NAMES};
-use dyngen::nim::online::{track, Tracking, TrackingSummary};
-use dyngen::nim::{draw_theta, paper_nim, Nim, NimConfig, PaperNim, PaperNimConfig};
-use dyngen::reference::{principal_params_to_standard, SplitMix64};
-use dyngen::report::{self, Corner, LineChart};
-use dyngen::simulate::{moment_sigma, record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
+use dyngen_identify::mim::{self, MimOptions, Verdict, THETA_NAMES};
+use dyngen_identify::report;
+use dyngen_identify::simulate::{
+    moment_sigma, record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording,
+};
+use dyngen_nim::online::{track, Tracking, TrackingSummary};
+use dyngen_nim::{draw_theta, paper_nim, Nim, NimConfig, PaperNim, PaperNimConfig};
+use dyngen_reference::{principal_params_to_standard, SplitMix64};
+use dyngen_reference::{Dynamics, Generated};
 use robot_paper6::Paper6;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -260,7 +263,7 @@ fn paper_faithful_nim(
         let curves = loss_curves(&paper.body_names, paper.histories.iter().map(Some), |h, k| {
             h.train_mse[k]
         });
-        report::svg_lines(&LineChart {
+        svg::svg_lines(&LineChart {
             title: "paper-faithful NIM: MSE against training step (cf. the paper's Fig. 5)",
             x_label: "training step (full-batch gradient descent)",
             y_label: "MSE (each target over its own size)",
@@ -276,8 +279,8 @@ fn paper_faithful_nim(
 /// Each body's training curve, `(step, value(history, record point))`.
 fn loss_curves<'a>(
     names: &[String],
-    histories: impl Iterator<Item = Option<&'a dyngen::nim::TrainHistory>>,
-    value: impl Fn(&dyngen::nim::TrainHistory, usize) -> f64,
+    histories: impl Iterator<Item = Option<&'a dyngen_nim::TrainHistory>>,
+    value: impl Fn(&dyngen_nim::TrainHistory, usize) -> f64,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
     names
         .iter()
@@ -383,7 +386,7 @@ fn generalising_nim(
             training.histories.iter().map(Option::as_ref),
             |h, k| h.validation_mse_original[k].sqrt(),
         );
-        report::svg_lines(&LineChart {
+        svg::svg_lines(&LineChart {
             title: "generalising NIM: RMS relative error of one window's θ, on validation draws",
             x_label: "Adam step (64 windows each)",
             y_label: "RMS relative error",
@@ -650,7 +653,7 @@ fn payload(
         }
     }
     write_figure(figure, args.force, || {
-        report::svg_lines(&LineChart {
+        svg::svg_lines(&LineChart {
             title: "flange mass while a payload is picked up: NIM and recursive least squares",
             x_label: "t (s)",
             y_label: "m (kg)",

@@ -3,15 +3,15 @@
 //! by MIM from joint wrenches.
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
-use dyngen::data::{read_csv, Trajectory};
-use dyngen::dynamics::Dynamics;
-use dyngen::identify::{Accumulation, Accumulator, Channels, Estimate, Options};
-use dyngen::mim::{self, MimEstimate, MimOptions};
-use dyngen::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
-use dyngen::simulate::Recording;
-use dyngen::Reference;
 use dyngen_codegen::standard_param_names;
+use dyngen_identify::data::{read_csv, Trajectory};
+use dyngen_identify::mim::{self, MimEstimate, MimOptions};
+use dyngen_identify::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
+use dyngen_identify::simulate::Recording;
+use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate, Options};
 use dyngen_model::{ErrorKind, Inertial, Model};
+use dyngen_reference::Dynamics;
+use dyngen_reference::Reference;
 use std::path::{Path, PathBuf};
 
 pub const EXAMPLES: &str = "\
@@ -59,7 +59,7 @@ pub enum Mode {
     Mim,
 }
 
-/// How the rows are compressed (dyngen::identify::Accumulation).
+/// How the rows are compressed (dyngen_identify::Accumulation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum AccumulationArg {
     Qr,
@@ -165,7 +165,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
     let n = model.dof();
-    let data_err = |e: dyngen::data::DataError| format!("{}: {e}", args.data.display());
+    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", args.data.display());
     let mut traj = read_csv(&args.data, Some(n)).map_err(data_err)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
         return Err(format!(
@@ -322,7 +322,7 @@ fn by_mim(args: &IdentifyArgs, model: &Model, traj: &Trajectory) -> Result<Ident
     Ok(Identified {
         report: ParameterReport::from_mim(&model.name, &estimate),
         per_body: 4,
-        prediction: Prediction::Parameters(dyngen::reference::principal_params_to_standard(model, &theta)),
+        prediction: Prediction::Parameters(dyngen_reference::principal_params_to_standard(model, &theta)),
     })
 }
 
@@ -473,7 +473,7 @@ fn write_svg(
             .map_or_else(|| args.data.display().to_string(), |f| f.to_string_lossy().into_owned())
     );
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    let svg = report::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
+    let svg = crate::svg::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
         .map_err(|e| report_error(path, e))?;
     report::write_report(path, &svg, args.force).map_err(|e| report_error(path, e))?;
     println!("wrote the SVG report to {}", path.display());
@@ -501,7 +501,7 @@ fn identified_inertial(identified: &Identified, model: &Model, body: usize) -> s
         // θ of this body, the URDF's θ elsewhere (only this body's 10 are used).
         let mut theta = mim::true_theta(model);
         theta[4 * body..4 * body + 4].copy_from_slice(&values);
-        let standard = dyngen::reference::principal_params_to_standard(model, &theta);
+        let standard = dyngen_reference::principal_params_to_standard(model, &theta);
         x.copy_from_slice(&standard[10 * body..10 * body + 10]);
     }
     let inertial = Inertial::from_standard_params(&x).ok_or("identified mass is not positive")?;

@@ -1,6 +1,6 @@
 //! `dyngen`: the command line of dyngen. Every subcommand works on any URDF given at
-//! run time, through the reference implementation (`dyngen::Reference`, behind the
-//! `dyngen::dynamics::Dynamics` trait).
+//! run time, through the reference implementation (`dyngen_reference::Reference`, behind the
+//! `dyngen_reference::Dynamics` trait).
 //!
 //! Errors are printed as `error: …` on stderr with exit code 1; bad input never
 //! panics.
@@ -12,6 +12,7 @@ mod identify;
 mod info;
 mod nim;
 mod simulate;
+mod svg;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

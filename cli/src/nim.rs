@@ -4,14 +4,14 @@
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
 use clap::{Args, Subcommand};
-use dyngen::data::{read_csv, Trajectory};
-use dyngen::mim;
-use dyngen::nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
-use dyngen::reference::{principal_params_to_standard, SplitMix64};
-use dyngen::report::{self, ParameterReport};
-use dyngen::simulate::{record_trajectory, Recording, SampledMotion};
-use dyngen::Reference;
+use dyngen_identify::data::{read_csv, Trajectory};
+use dyngen_identify::mim;
+use dyngen_identify::report;
+use dyngen_identify::simulate::{record_trajectory, Recording, SampledMotion};
 use dyngen_model::Model;
+use dyngen_nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
+use dyngen_reference::Reference;
+use dyngen_reference::{principal_params_to_standard, SplitMix64};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -126,7 +126,7 @@ pub fn run(args: &NimArgs, progress: &Progress) -> Result<()> {
 
 /// A CSV with v and a (estimated when missing, with a note on stderr).
 fn read_data(path: &Path, model: &Model, cutoff: f64) -> Result<Trajectory> {
-    let data_err = |e: dyngen::data::DataError| format!("{}: {e}", path.display());
+    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", path.display());
     let traj = read_csv(path, Some(model.dof())).map_err(data_err)?;
     if traj.velocities().is_some() && traj.accelerations().is_some() {
         return Ok(traj);
@@ -238,14 +238,14 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
             })
             .collect();
         let title = format!("{}: NIM training, RMS relative error of one window's θ", model.name);
-        let text = report::svg_lines(&report::LineChart {
+        let text = crate::svg::svg_lines(&crate::svg::LineChart {
             title: &title,
             x_label: "Adam step",
             y_label: "RMS relative error",
             log_y: true,
             curves: &curves,
             reference: None,
-            legend: report::Corner::UpperRight,
+            legend: crate::svg::Corner::UpperRight,
         })
         .map_err(|e| format!("{}: {e}", svg.display()))?;
         report::write_new(svg, &text, args.force).map_err(|e| format!("{}: {e}", svg.display()))?;
@@ -350,7 +350,8 @@ fn predict(args: &PredictArgs) -> Result<()> {
     );
     println!("{estimate}");
     if let Some(path) = &args.params_json {
-        ParameterReport::from_nim(&model.name, &estimate)
+        estimate
+            .report(&model.name)
             .write(path, args.force)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         println!("wrote the parameters to {}", path.display());

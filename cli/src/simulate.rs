@@ -1,9 +1,9 @@
 //! `dyngen simulate`: an identification experiment on the nominal parameters, as CSV.
 
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
-use dyngen::data::{overwrite_csv, write_csv};
-use dyngen::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
-use dyngen::Reference;
+use dyngen_identify::data::{overwrite_csv, write_csv};
+use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
+use dyngen_reference::Reference;
 use std::path::PathBuf;
 
 pub const EXAMPLES: &str = "\
@@ -14,7 +14,7 @@ Examples:
   dyngen simulate arm.urdf -o mim.csv --experiment fourier --criterion body-model --base-frequency 0.5
 
 The CSV has the columns t, q1..qn, v1..vn, a1..an, tau1..taun and the joint wrenches
-fx1, fy1, fz1, mx1, my1, mz1, … (SI units; see the dyngen::data module docs).";
+fx1, fy1, fz1, mx1, my1, mz1, … (SI units; see the dyngen_identify::data module docs).";
 
 /// Which motion drives the joints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

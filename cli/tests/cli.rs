@@ -80,7 +80,7 @@ fn generate_writes_header_and_refuses_to_overwrite() {
 fn simulate_then_identify_recovers_the_torques() {
     let dir = temp_dir("dyngen-cli", "identify");
     let csv = simulate_ur5(&dir, 120, &[]);
-    let traj = dyngen::data::read_csv(&csv, None).unwrap();
+    let traj = dyngen_identify::data::read_csv(&csv, None).unwrap();
     assert_eq!((traj.dof(), traj.len()), (6, 121));
     assert!(traj.velocities().is_some() && traj.accelerations().is_some());
     assert_eq!(traj.joint_wrenches().map(<[_]>::len), Some(6 * 121));
@@ -88,7 +88,7 @@ fn simulate_then_identify_recovers_the_torques() {
     // Not replaced without --force.
     let o = run!("simulate", ur5(), "-o", csv);
     assert_error(&o, "--force");
-    assert_eq!(dyngen::data::read_csv(&csv, None).unwrap(), traj);
+    assert_eq!(dyngen_identify::data::read_csv(&csv, None).unwrap(), traj);
 
     for (method, accumulation) in [("ols", "qr"), ("wls", "qr"), ("tls", "qr"), ("ols", "normal-equations")] {
         let o = run!(
@@ -123,7 +123,7 @@ fn paper_experiment_has_default_length() {
     let csv = dir.join("paper.csv");
     let o = run!("simulate", ur5(), "-o", csv, "--noise", "0.01", "--seed", "4");
     assert_ok(&o);
-    let traj = dyngen::data::read_csv(&csv, Some(6)).unwrap();
+    let traj = dyngen_identify::data::read_csv(&csv, Some(6)).unwrap();
     assert_eq!((traj.dof(), traj.len()), (6, 101));
     assert_eq!(traj.t()[100], 2.0);
 }

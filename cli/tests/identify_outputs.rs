@@ -1,6 +1,6 @@
 //! `dyngen identify` with --params-json, --svg and --urdf-out on robots/ur5/ur5.urdf.
 
-use dyngen::report::{ParamStatus, ParameterReport};
+use dyngen_identify::report::{ParamStatus, ParameterReport};
 mod common;
 
 use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
@@ -202,7 +202,7 @@ fn identify_by_mim_rewrites_the_identified_bodies() {
 
     let report = ParameterReport::read(&json).unwrap();
     assert_eq!(report.parameters.len(), 24);
-    let truth = dyngen::mim::true_theta(&dyngen_model::load_urdf(&ur5()).unwrap());
+    let truth = dyngen_identify::mim::true_theta(&dyngen_model::load_urdf(&ur5()).unwrap());
     for (j, (p, t)) in report.parameters.iter().zip(&truth).enumerate() {
         if j == 1 || j == 2 {
             assert_eq!(p.status, ParamStatus::NoEffect, "{p:?}");

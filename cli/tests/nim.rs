@@ -5,7 +5,7 @@
 mod common;
 
 use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
-use dyngen::report::{ParamStatus, ParameterReport};
+use dyngen_identify::report::{ParamStatus, ParameterReport};
 use std::path::{Path, PathBuf};
 
 /// Noise-free UR5 data along a 2 s Fourier motion designed for the body model.
@@ -79,7 +79,7 @@ fn nim_trains_predicts_and_writes_parameters() {
     assert_eq!(report.parameters[1].value, None);
     assert!(report.method.starts_with("NIM"), "{}", report.method);
     // A tiny budget, but the masses already come out within 30 % (the draws' spread).
-    let truth = dyngen::mim::true_theta(&dyngen_model::load_urdf(&ur5()).unwrap());
+    let truth = dyngen_identify::mim::true_theta(&dyngen_model::load_urdf(&ur5()).unwrap());
     for j in (0..24).step_by(4) {
         let p = &report.parameters[j];
         if let Some(v) = p.value {

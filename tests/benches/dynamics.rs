@@ -3,9 +3,9 @@
 //! Ratios against Pinocchio are measured in the same sitting; see docs/benchmarks.md.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use dyngen::reference::Reference;
-use dyngen::reference::{sample_states, State};
 use dyngen::{Pose, Robot, Wrench};
+use dyngen_reference::Reference;
+use dyngen_reference::{sample_states, State};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;

@@ -17,13 +17,13 @@
 //! `scripts/bench_identification_pinocchio.py` (Pinocchio's regressor plus numpy
 //! least squares), to be run in the same sitting; see docs/benchmarks.md.
 
-use dyngen::reference::Reference;
+use dyngen_reference::Reference;
 use std::time::{Duration, Instant};
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use dyngen::identify::faer::MatRef;
-use dyngen::identify::{Accumulation, Accumulator, Channels, Estimate};
-use dyngen::reference::{sample_states, SplitMix64};
+use dyngen_identify::faer::MatRef;
+use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate};
+use dyngen_reference::{sample_states, SplitMix64};
 use robot_panda::Panda;
 
 const N: usize = 100_000;

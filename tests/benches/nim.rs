@@ -16,11 +16,11 @@
 //! printed: `cargo bench -p dyngen-tests --bench nim`.
 
 use criterion::{black_box, criterion_group, Criterion};
-use dyngen::dynamics::{Dynamics, Generated};
-use dyngen::identify::Rls;
-use dyngen::mim::{self, MimOptions};
-use dyngen::nim::{paper_nim, BodySample, Nim, NimConfig, PaperNimConfig};
-use dyngen::simulate::{record, Criterion as Design, ExcitationDesign, Experiment, Motion, Recording};
+use dyngen_identify::mim::{self, MimOptions};
+use dyngen_identify::simulate::{record, Criterion as Design, ExcitationDesign, Experiment, Motion, Recording};
+use dyngen_identify::Rls;
+use dyngen_nim::{paper_nim, BodySample, Nim, NimConfig, PaperNimConfig};
+use dyngen_reference::{Dynamics, Generated};
 use robot_paper6::Paper6;
 use std::time::Instant;
 
@@ -82,7 +82,7 @@ fn inference(c: &mut Criterion) {
 
     let paper = paper_nim(&s.recording, 1..101, &s.nominal, &PaperNimConfig::default()).unwrap();
     let net = &paper.nets[body];
-    let inputs = dyngen::nim::paper_inputs(&s.recording, 50, body);
+    let inputs = dyngen_nim::paper_inputs(&s.recording, 50, body);
     let mut workspace = net.workspace();
     let mut y = [0.0; 4];
     c.bench_function("paper_nim/sample", |b| {

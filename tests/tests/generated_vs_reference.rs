@@ -1,9 +1,9 @@
 //! Generated code against the reference implementation on 1,000 random states per
 //! robot (fixed seeds), with nominal and with perturbed parameters.
 
-use dyngen::reference::Reference;
-use dyngen::reference::{perturbed_params, sample_states};
 use dyngen::{BodyRegressor, Pose, Robot, Wrench};
+use dyngen_reference::Reference;
+use dyngen_reference::{perturbed_params, sample_states};
 use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{pose_vec, rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;

@@ -5,9 +5,9 @@
 //! `aba(q, v, rnea(q, v, a)) = a`, `nle = rnea(q, v, 0)`, `g = rnea(q, 0, 0)`, and the
 //! paper's decoupling `A_i θ_i` = body resultants.
 
-use dyngen::reference::Reference;
-use dyngen::reference::{perturbed_params, sample_states};
 use dyngen::{BodyRegressor, Robot, Wrench};
+use dyngen_reference::Reference;
+use dyngen_reference::{perturbed_params, sample_states};
 use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{rel_err, wrench_vec};
 use robot_gripper_arm::GripperArm;

@@ -2,14 +2,14 @@
 //! noise-free and with 1 % noise, and joint-torque identification on ur5 and the
 //! 7-DOF panda validated on a separate trajectory.
 
-use dyngen::dynamics::{Dynamics, Generated};
-use dyngen::identify::Options;
-use dyngen::mim::{self, MimEstimate, MimOptions, Verdict, Weighting};
-use dyngen::simulate::{
+use dyngen::Robot;
+use dyngen_identify::mim::{self, MimEstimate, MimOptions, Verdict, Weighting};
+use dyngen_identify::simulate::{
     moment_sigma, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording,
     Sigma,
 };
-use dyngen::Robot;
+use dyngen_identify::Options;
+use dyngen_reference::{Dynamics, Generated};
 use robot_panda::Panda;
 use robot_paper6::Paper6;
 use robot_ur5::Ur5;
@@ -221,11 +221,11 @@ fn paper6_from_joint_torques_says_what_is_identifiable() {
     assert_eq!(est.estimate.rank, Paper6::NBASE_PRINCIPAL);
     // Never a number for a parameter that is not identifiable alone.
     for p in &est.estimate.params {
-        assert_eq!(p.value.is_some(), p.status == dyngen::identify::Status::Identified);
+        assert_eq!(p.value.is_some(), p.status == dyngen_identify::Status::Identified);
     }
     // The turret's transverse moments have no effect on the joint torques.
-    assert_eq!(est.estimate.params[1].status, dyngen::identify::Status::NoEffect);
-    assert_eq!(est.estimate.params[2].status, dyngen::identify::Status::NoEffect);
+    assert_eq!(est.estimate.params[1].status, dyngen_identify::Status::NoEffect);
+    assert_eq!(est.estimate.params[2].status, dyngen_identify::Status::NoEffect);
     for c in est.combination_errors().unwrap() {
         // Relative to the terms' size: J2 − J3 of a cylinder is 0.
         let scale = c.terms.iter().map(|&(j, k)| (k * truth[j]).abs()).fold(0.0, f64::max);
@@ -294,7 +294,7 @@ fn torque_identification<R: Robot>(evaluations: usize) {
     .unwrap();
     assert_eq!(est.estimate.rank, R::NBASE, "{}: rank", R::NAME);
     for p in &est.estimate.params {
-        assert!(p.value.is_none() || p.status == dyngen::identify::Status::Identified);
+        assert!(p.value.is_none() || p.status == dyngen_identify::Status::Identified);
     }
 
     let floor: Vec<f64> = (0..n)

@@ -4,13 +4,13 @@
 //! the full dynamics; then a payload followed online against recursive least
 //! squares. Times are measured by the benchmarks and the demo, not here.
 
-use dyngen::dynamics::{Dynamics, Generated};
-use dyngen::mim::{self, Verdict};
-use dyngen::nim::online::{track, Tracking};
-use dyngen::nim::{draw_theta, Nim, NimConfig};
-use dyngen::reference::{principal_params_to_standard, SplitMix64};
-use dyngen::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
 use dyngen::Robot;
+use dyngen_identify::mim::{self, Verdict};
+use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
+use dyngen_nim::online::{track, Tracking};
+use dyngen_nim::{draw_theta, Nim, NimConfig};
+use dyngen_reference::{principal_params_to_standard, SplitMix64};
+use dyngen_reference::{Dynamics, Generated};
 use robot_paper6::Paper6;
 
 /// The demo's experiment: a Fourier excitation over the paper's 2 s and 100 steps,

@@ -1,6 +1,6 @@
 //! Property tests on random kinematic trees: the symbolic algorithms of
 //! `dyngen_codegen::algo`, evaluated straight from the expression graph (nothing is
-//! compiled), against the Featherstone reference of `dyngen::reference`.
+//! compiled), against the Featherstone reference of `dyngen_reference`.
 //!
 //! A seeded generator builds valid trees of 1 to 8 moving bodies: random topology,
 //! revolute, continuous and prismatic joints, axis-aligned and skew axes, quarter-turn
@@ -11,13 +11,13 @@
 //! and every algorithm against the reference on a few random states with perturbed
 //! parameters.
 
-use dyngen::reference::{perturbed_params, sample_states, Reference, SplitMix64, State};
 use dyngen_codegen::algo::{self, Force, Inputs, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
 use dyngen_codegen::sym::{Expr, Graph, NodeId};
 use dyngen_model::math::{self, Mat3, Vec3};
 use dyngen_model::{
     DeclaredJointType, Description, Inertial, JointDesc, JointKind, Limits, LinkDesc, Model, Placement, DEFAULT_GRAVITY,
 };
+use dyngen_reference::{perturbed_params, sample_states, Reference, SplitMix64, State};
 use dyngen_tests::{pose_vec, rel_err, wrench_vec};
 use std::f64::consts::{FRAC_PI_2, PI};
 

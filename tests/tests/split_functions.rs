@@ -1,8 +1,8 @@
 //! Functions split into `#[inline(never)]` parts compute exactly what the unsplit
 //! ones do: the same operations in the same order, only passed through an array.
 
-use dyngen::reference::sample_states;
-use dyngen::reference::Reference;
+use dyngen_reference::sample_states;
+use dyngen_reference::Reference;
 use dyngen_tests::split::Ur5Split;
 use robot_ur5::Ur5;
 

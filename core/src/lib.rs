@@ -1,0 +1,70 @@
+//! # dyngen
+//!
+//! What generated robot code needs, and nothing more: the [`Robot`] trait, the
+//! [`Scalar`] trait, the small spatial value types of the API ([`Pose`], [`Wrench`],
+//! [`BodyRegressor`]), the model a generated robot carries ([`RobotModel`]), and the
+//! [`robot!`] macro. `no_std`: maths come from the standard library (feature `std`,
+//! the default) or from `libm` (feature `libm`).
+//!
+//! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a
+//! URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
+//! a type implementing [`Robot`]. The layers above (reference dynamics, identification,
+//! neural-network identification, the command line) are separate crates, so a crate
+//! that runs a robot in a control loop links only this one.
+
+#![no_std]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+#[cfg(not(any(feature = "std", feature = "libm")))]
+compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos and sqrt");
+
+mod robot;
+mod robot_model;
+mod scalar;
+
+pub use dyngen_macros::robot;
+pub use nalgebra;
+pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
+pub use robot_model::{BodyModel, JointLimits, JointModel, JointType, RobotModel};
+pub use scalar::Scalar;
+
+/// Support for generated code; not a public API.
+#[doc(hidden)]
+pub mod __private {
+    /// A slice as a fixed-size array, with a message naming the argument when the
+    /// length is wrong.
+    #[inline(always)]
+    #[track_caller]
+    pub fn as_array<'a, S, const N: usize>(x: &'a [S], what: &str) -> &'a [S; N] {
+        match x.try_into() {
+            Ok(a) => a,
+            Err(_) => panic!("dyngen: `{what}` has length {}, expected {N}", x.len()),
+        }
+    }
+
+    /// A row-major slice as a fixed-size matrix `[[S; C]; R]`, with a message naming
+    /// the argument when the length is wrong.
+    #[inline(always)]
+    #[track_caller]
+    pub fn as_rows_mut<'a, S, const C: usize, const R: usize>(x: &'a mut [S], what: &str) -> &'a mut [[S; C]; R] {
+        let len = x.len();
+        let (rows, rest) = x.as_chunks_mut::<C>();
+        match (rest.is_empty(), <&mut [[S; C]; R]>::try_from(rows)) {
+            (true, Ok(m)) => m,
+            _ => panic!("dyngen: `{what}` has length {len}, expected {} ({R} × {C})", R * C),
+        }
+    }
+
+    /// Mutable variant of [`as_array`].
+    #[inline(always)]
+    #[track_caller]
+    pub fn as_array_mut<'a, S, const N: usize>(x: &'a mut [S], what: &str) -> &'a mut [S; N] {
+        let len = x.len();
+        match x.try_into() {
+            Ok(a) => a,
+            Err(_) => panic!("dyngen: `{what}` has length {len}, expected {N}"),
+        }
+    }
+}

@@ -1,0 +1,74 @@
+//! The scalar type generated code computes in. Generated functions are generic over
+//! [`Scalar`]; `f64` is the reference, `f32` suits microcontrollers and SIMD-friendly
+//! control loops.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// A real number type: the arithmetic generated code uses, and nothing else.
+pub trait Scalar:
+    Copy
+    + PartialEq
+    + PartialOrd
+    + Debug
+    + Default
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + nalgebra::Scalar
+{
+    const ZERO: Self;
+    const ONE: Self;
+    /// Converts a constant of the generated code (rounding for narrower types).
+    fn from_f64(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    /// Both at once: one call where the platform computes them together.
+    fn sin_cos(self) -> (Self, Self);
+    fn sqrt(self) -> Self;
+}
+
+macro_rules! impl_scalar {
+    ($t:ty) => {
+        impl Scalar for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            #[inline(always)]
+            fn from_f64(x: f64) -> Self {
+                x as $t
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                num_traits::Float::sin(self)
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                num_traits::Float::cos(self)
+            }
+            #[inline(always)]
+            fn sin_cos(self) -> (Self, Self) {
+                num_traits::Float::sin_cos(self)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                num_traits::Float::sqrt(self)
+            }
+        }
+    };
+}
+
+impl_scalar!(f64);
+impl_scalar!(f32);

@@ -1,0 +1,472 @@
+//! Sufficient statistics of a linear least-squares problem in O(p²) memory.
+//!
+//! Per channel, a factor `R` of `[A y]` with `RᵀR = [A y]ᵀ[A y]`, so that
+//! `‖A x − y‖² = ‖R [x; −1]‖²` for every `x`: residuals per channel, weighted stacks
+//! and the total problem all follow from the factors without keeping a single data
+//! row. Two ways to get it ([`Accumulation`]): the upper-triangular factor of
+//! Householder QR (TSQR: stack the old `R` on a block of new rows and re-factor;
+//! backward stable, the default), or the Gram matrix `[A y]ᵀ[A y]` summed by one
+//! matrix product per block of rows and factored at the end (the normal equations:
+//! faster, but it squares the condition number).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::linalg::qr::no_pivoting::factor as qr;
+use faer::prelude::default;
+use faer::{Accum, Mat, MatRef, Par, Side};
+
+use super::error::{IdentifyError, Input};
+use super::Channels;
+
+/// Streaming accumulation of `y = A x + e`, the common entry point of every batch
+/// estimator.
+///
+/// Memory is `O(channels · p²)` whatever the number of rows: rows are buffered per
+/// channel and folded into a triangular factor `R` of `[A y]` by Householder QR
+/// (faer) every few hundred rows. Estimators ([`Accumulator::ols`],
+/// [`Accumulator::wls`], [`Accumulator::tls`], [`Accumulator::ridge`],
+/// [`Accumulator::principal_consistent`], [`Accumulator::log_cholesky`]) read the
+/// factors and give exactly what they would give on the stacked rows.
+///
+/// ```
+/// use dyngen_identify::{Accumulator, Options};
+/// use dyngen_identify::faer::Mat;
+/// let a = Mat::from_fn(6, 2, |i, j| if j == 0 { 1.0 } else { i as f64 });
+/// let y: Vec<f64> = (0..6).map(|i| 2.0 + 0.5 * i as f64).collect();
+/// let mut acc = Accumulator::new(2);
+/// acc.push_rows(a.as_ref(), &y).unwrap();
+/// let est = acc.finish().unwrap();
+/// assert!((est.params[1].value.unwrap() - 0.5).abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug)]
+pub struct Accumulator {
+    p: usize,
+    channels: Channels,
+    accumulation: Accumulation,
+    blocks: Vec<Block>,
+    rows: usize,
+}
+
+/// How an [`Accumulator`] compresses its rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Accumulation {
+    /// Householder QR of `[A y]` per channel, folded block by block: backward
+    /// stable at any condition number.
+    #[default]
+    Qr,
+    /// The normal equations: `[A y]ᵀ[A y]` per channel, one matrix product per
+    /// block of rows (no data reordering, about half the work of QR at a higher
+    /// rate), factored by an eigendecomposition when an estimate is asked for. It
+    /// squares the condition number, so it resolves fewer directions: the rank
+    /// tolerance is at least `max(10⁻⁶, √(max(m, p) ε)) σ₁`
+    /// ([`NORMAL_EQUATIONS_RESOLUTION`]), and a direction weaker than that is
+    /// reported as unidentifiable where `Qr` might still give it a value; residuals
+    /// are resolved only down to about `√ε` of the data (a noise-free fit shows
+    /// ~10⁻⁸ relative residuals rather than ~10⁻¹⁶). For well-conditioned, noisy
+    /// problems (a good excitation, real sensors) the estimates are QR's.
+    NormalEquations,
+}
+
+/// The weakest direction, relative to the strongest singular value, that
+/// [`Accumulation::NormalEquations`] resolves (unless `√(max(m, p) ε)` is larger):
+/// its squared condition number then costs at most 12 of the 16 digits of a double.
+pub const NORMAL_EQUATIONS_RESOLUTION: f64 = 1e-6;
+
+#[derive(Clone, Debug)]
+struct Block {
+    /// [`Accumulation::Qr`]: column-major, `(p + 1 + fold_rows(p)) × (p + 1)`: rows
+    /// `0..k` hold the upper-trapezoidal factor of the folded rows of `[A y]`
+    /// (`k ≤ p + 1`), the rows below are the room a fold factors the pending rows in.
+    /// [`Accumulation::NormalEquations`]: `(p + 1) × (p + 1)`, the upper triangle of
+    /// `[A y]ᵀ[A y]` over the folded rows.
+    work: Mat<f64>,
+    k: usize,
+    /// Rows not yet folded, row-major, `p+1` numbers each.
+    pending: Vec<f64>,
+    rows: usize,
+}
+
+impl Block {
+    /// The factor of the rows folded so far, `k × (p + 1)`.
+    fn r(&self) -> Mat<f64> {
+        self.work.as_ref().subrows(0, self.k).to_owned()
+    }
+}
+
+/// One channel's factor with all rows folded in.
+#[derive(Clone, Debug)]
+pub(crate) struct Factor {
+    pub r: Mat<f64>,
+    pub rows: usize,
+    /// Made from the normal equations ([`Accumulation::NormalEquations`]).
+    pub normal_equations: bool,
+}
+
+/// The total (possibly weighted) problem, compressed: `‖A x − y‖² = ‖R x − z‖² + ρ²`.
+#[derive(Clone, Debug)]
+pub(crate) struct Triangle {
+    /// `p × p`, upper triangular (zero rows padded when fewer than `p` rows were seen).
+    pub r: Mat<f64>,
+    pub z: Vec<f64>,
+    pub rho2: f64,
+    pub rows: usize,
+    /// Singular values below `floor · σ₁` are not resolved by the accumulation (0
+    /// for QR; see [`NORMAL_EQUATIONS_RESOLUTION`] for the normal equations).
+    pub floor: f64,
+}
+
+impl Accumulator {
+    /// An empty accumulator for `p` parameters, all rows in one channel.
+    pub fn new(p: usize) -> Self {
+        Self::build(p, Channels::Single)
+    }
+
+    /// An empty accumulator whose rows are grouped into channels (e.g. joints:
+    /// `Channels::Interleaved(n)` for regressors stacked sample by sample).
+    pub fn with_channels(p: usize, channels: Channels) -> Result<Self, IdentifyError> {
+        Self::with_accumulation(p, channels, Accumulation::Qr)
+    }
+
+    /// [`Accumulator::with_channels`] with the choice of [`Accumulation`].
+    pub fn with_accumulation(p: usize, channels: Channels, accumulation: Accumulation) -> Result<Self, IdentifyError> {
+        if let Channels::Interleaved(0) = channels {
+            return Err(IdentifyError::InvalidArgument {
+                what: "channels",
+                reason: "Interleaved(0): the channel count must be positive".into(),
+            });
+        }
+        let mut acc = Self::build(p, channels);
+        acc.accumulation = accumulation;
+        if accumulation == Accumulation::NormalEquations {
+            for b in &mut acc.blocks {
+                b.work = Mat::zeros(p + 1, p + 1);
+            }
+        }
+        Ok(acc)
+    }
+
+    /// How the rows are compressed.
+    pub fn accumulation(&self) -> Accumulation {
+        self.accumulation
+    }
+
+    /// An accumulator holding the rows of `a` (`m × p`) and `y` (`m`).
+    pub fn from_rows(a: MatRef<'_, f64>, y: &[f64], channels: Channels) -> Result<Self, IdentifyError> {
+        let mut acc = Self::with_channels(a.ncols(), channels)?;
+        acc.push_rows(a, y)?;
+        Ok(acc)
+    }
+
+    fn build(p: usize, channels: Channels) -> Self {
+        let blocks = (0..channels.count())
+            .map(|_| Block {
+                work: Mat::zeros(0, p + 1),
+                k: 0,
+                pending: Vec::new(),
+                rows: 0,
+            })
+            .collect();
+        Self {
+            p,
+            channels,
+            accumulation: Accumulation::Qr,
+            blocks,
+            rows: 0,
+        }
+    }
+
+    /// Number of parameters `p`.
+    pub fn n_params(&self) -> usize {
+        self.p
+    }
+
+    /// Rows pushed so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// The channel grouping.
+    pub fn channels(&self) -> &Channels {
+        &self.channels
+    }
+
+    /// Rows pushed so far per channel.
+    pub fn rows_per_channel(&self) -> Vec<usize> {
+        self.blocks.iter().map(|b| b.rows).collect()
+    }
+
+    /// Appends a block of rows: `a` is `k × p`, `y` has `k` entries. All rows are
+    /// checked before any is taken, so on error the accumulator is unchanged.
+    pub fn push_rows(&mut self, a: MatRef<'_, f64>, y: &[f64]) -> Result<(), IdentifyError> {
+        let p = self.p;
+        if a.ncols() != p {
+            return Err(IdentifyError::DimensionMismatch {
+                what: "regressor columns",
+                expected: p,
+                found: a.ncols(),
+            });
+        }
+        let k = a.nrows();
+        if y.len() != k {
+            return Err(IdentifyError::DimensionMismatch {
+                what: "observations",
+                expected: k,
+                found: y.len(),
+            });
+        }
+        for i in 0..k {
+            if let Some(j) = a.row(i).iter().position(|x| !x.is_finite()) {
+                return Err(IdentifyError::NonFinite {
+                    input: Input::Regressor,
+                    row: self.rows + i,
+                    column: j,
+                });
+            }
+            if !y[i].is_finite() {
+                return Err(IdentifyError::NonFinite {
+                    input: Input::Observation,
+                    row: self.rows + i,
+                    column: 0,
+                });
+            }
+        }
+        if let Channels::Labels(labels) = &self.channels {
+            if labels.len() < self.rows + k {
+                return Err(IdentifyError::DimensionMismatch {
+                    what: "channel labels",
+                    expected: self.rows + k,
+                    found: labels.len(),
+                });
+            }
+        }
+        let fold_at = fold_rows(p);
+        let mut i = 0;
+        while i < k {
+            // Buffer rows until some channel has a fold's worth, then fold every
+            // channel with at least half of one (in parallel: the channels are
+            // independent, and interleaved channels fill up together).
+            while i < k {
+                let ch = self.channels.channel_of(self.rows + i);
+                let block = &mut self.blocks[ch];
+                block.pending.extend(a.row(i).iter());
+                block.pending.push(y[i]);
+                block.rows += 1;
+                i += 1;
+                if block.pending.len() >= fold_at * (p + 1) {
+                    break;
+                }
+            }
+            let full: Vec<&mut Block> = self
+                .blocks
+                .iter_mut()
+                .filter(|b| 2 * b.pending.len() >= fold_at * (p + 1))
+                .collect();
+            fold_all(full, p, self.accumulation);
+        }
+        self.rows += k;
+        Ok(())
+    }
+
+    /// Appends one row `a` (`p` entries) with observation `y`.
+    pub fn push_row(&mut self, a: &[f64], y: f64) -> Result<(), IdentifyError> {
+        self.push_rows(MatRef::from_row_major_slice(a, 1, a.len()), &[y])
+    }
+
+    /// Ordinary least squares on everything pushed so far, with default [`super::Options`].
+    /// Equal to [`Accumulator::ols`] on the stacked rows.
+    pub fn finish(&self) -> Result<super::Estimate, IdentifyError> {
+        self.ols(&super::Options::default())
+    }
+
+    /// Every channel's factor with pending rows folded in (the accumulator is not
+    /// changed).
+    pub(crate) fn factors(&self) -> Result<Vec<Factor>, IdentifyError> {
+        if self.rows == 0 {
+            return Err(IdentifyError::Empty);
+        }
+        self.blocks
+            .iter()
+            .map(|b| {
+                let mut b = b.clone();
+                let r = match self.accumulation {
+                    Accumulation::Qr => {
+                        fold(&mut b, self.p);
+                        b.r()
+                    }
+                    Accumulation::NormalEquations => {
+                        add_gram(&mut b, self.p);
+                        gram_factor(b.work.as_ref())?
+                    }
+                };
+                Ok(Factor {
+                    r,
+                    rows: b.rows,
+                    normal_equations: self.accumulation == Accumulation::NormalEquations,
+                })
+            })
+            .collect()
+    }
+}
+
+/// Rows buffered per channel before a QR fold: large enough that the fold's cost
+/// is dominated by the new rows, small enough to keep memory O(p²).
+fn fold_rows(p: usize) -> usize {
+    (8 * (p + 1)).max(1024)
+}
+
+/// Folds the pending rows of every block, spreading the blocks over the machine's
+/// cores; each block's result does not depend on which thread folds it.
+fn fold_all(mut blocks: Vec<&mut Block>, p: usize, accumulation: Accumulation) {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(blocks.len());
+    let fold_block = |b: &mut Block| match accumulation {
+        Accumulation::Qr => fold(b, p),
+        Accumulation::NormalEquations => add_gram(b, p),
+    };
+    if threads <= 1 {
+        blocks.into_iter().for_each(fold_block);
+        return;
+    }
+    let per = blocks.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        for chunk in blocks.chunks_mut(per) {
+            scope.spawn(move || chunk.iter_mut().for_each(|b| fold_block(b)));
+        }
+    });
+}
+
+/// QR of `[R; pending rows]` in the block's work matrix, in place (faer's blocked
+/// Householder QR, no allocation of the matrix); `R` becomes the new factor and
+/// the pending rows are cleared.
+fn fold(block: &mut Block, p: usize) {
+    let n = p + 1;
+    let b = block.pending.len() / n;
+    if b == 0 {
+        return;
+    }
+    let m = block.k + b;
+    if block.work.nrows() < m {
+        // First fold (or an unusually large one): room for a fold's worth of rows.
+        let mut work = Mat::zeros(m.max(n + fold_rows(p)), n);
+        work.as_mut()
+            .subrows_mut(0, block.k)
+            .copy_from(block.work.as_ref().subrows(0, block.k));
+        block.work = work;
+    }
+    block
+        .work
+        .as_mut()
+        .subrows_mut(block.k, b)
+        .copy_from(MatRef::from_row_major_slice(&block.pending, b, n));
+    let size = m.min(n);
+    let blocksize = qr::recommended_block_size::<f64>(m, n);
+    let mut householder = Mat::<f64>::zeros(blocksize, size);
+    let mut scratch = MemBuffer::new(qr::qr_in_place_scratch::<f64>(m, n, blocksize, Par::Seq, default()));
+    qr::qr_in_place(
+        block.work.as_mut().subrows_mut(0, m),
+        householder.as_mut(),
+        Par::Seq,
+        MemStack::new(&mut scratch),
+        default(),
+    );
+    // Keep R: clear the Householder vectors stored below its diagonal.
+    for j in 0..n {
+        for i in (j + 1)..size {
+            block.work[(i, j)] = 0.0;
+        }
+    }
+    block.k = size;
+    block.pending.clear();
+}
+
+/// Adds the pending rows `P` (row-major, so `Pᵀ` column-major without a copy) to
+/// the upper triangle of the block's Gram matrix: `G += Pᵀ P`.
+fn add_gram(block: &mut Block, p: usize) {
+    let n = p + 1;
+    let b = block.pending.len() / n;
+    if b == 0 {
+        return;
+    }
+    let pt = MatRef::from_column_major_slice(&block.pending, n, b);
+    triangular::matmul(
+        block.work.as_mut(),
+        BlockStructure::TriangularUpper,
+        Accum::Add,
+        pt,
+        BlockStructure::Rectangular,
+        pt.transpose(),
+        BlockStructure::Rectangular,
+        1.0,
+        Par::Seq,
+    );
+    block.pending.clear();
+}
+
+/// A square factor `R` of a Gram matrix `G` (upper triangle given): `RᵀR = G`, from
+/// `G = V Λ Vᵀ` as `R = Λ^{1/2} Vᵀ` with the eigenvalues rounding made negative
+/// set to zero.
+fn gram_factor(upper: MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
+    let n = upper.nrows();
+    let g = Mat::from_fn(n, n, |i, j| if i <= j { upper[(i, j)] } else { upper[(j, i)] });
+    let eigen = g
+        .self_adjoint_eigen(Side::Upper)
+        .map_err(|_| IdentifyError::DecompositionFailed {
+            what: "eigendecomposition of the normal equations",
+        })?;
+    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    Ok(Mat::from_fn(n, n, |i, j| values[i].max(0.0).sqrt() * vectors[(j, i)]))
+}
+
+/// Stacks the channel factors, channel `c` scaled by `weights[c]` (all 1 when
+/// `None`), and reduces them to one triangle.
+pub(crate) fn combine(factors: &[Factor], weights: Option<&[f64]>, p: usize) -> Triangle {
+    let total: usize = factors.iter().map(|f| f.r.nrows()).sum();
+    let mut stacked = Mat::zeros(total, p + 1);
+    let mut row = 0;
+    for (c, f) in factors.iter().enumerate() {
+        let w = weights.map_or(1.0, |w| w[c]);
+        for i in 0..f.r.nrows() {
+            for j in 0..=p {
+                stacked[(row, j)] = w * f.r[(i, j)];
+            }
+            row += 1;
+        }
+    }
+    let r_aug = stacked.qr().thin_R().to_owned();
+    let k = r_aug.nrows();
+    let rows: usize = factors.iter().map(|f| f.rows).sum();
+    let r = Mat::from_fn(p, p, |i, j| if i < k && j >= i { r_aug[(i, j)] } else { 0.0 });
+    let z = (0..p).map(|i| if i < k { r_aug[(i, p)] } else { 0.0 }).collect();
+    let rho2 = if k == p + 1 { r_aug[(p, p)].powi(2) } else { 0.0 };
+    let floor = if factors.iter().any(|f| f.normal_equations) {
+        (rows.max(p) as f64 * f64::EPSILON)
+            .sqrt()
+            .max(NORMAL_EQUATIONS_RESOLUTION)
+    } else {
+        0.0
+    };
+    Triangle {
+        r,
+        z,
+        rho2,
+        rows,
+        floor,
+    }
+}
+
+/// `‖A_c x − y_c‖²` for every channel.
+pub(crate) fn channel_rss(factors: &[Factor], x: &[f64]) -> Vec<f64> {
+    factors
+        .iter()
+        .map(|f| {
+            let p = x.len();
+            (0..f.r.nrows())
+                .map(|i| {
+                    let e: f64 = (0..p).map(|j| f.r[(i, j)] * x[j]).sum::<f64>() - f.r[(i, p)];
+                    e * e
+                })
+                .sum()
+        })
+        .collect()
+}

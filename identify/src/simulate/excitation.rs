@@ -1,0 +1,600 @@
+//! Optimal excitation: Fourier coefficients that make the identification problem
+//! well conditioned (Swevers et al. 1997), within joint position and velocity limits.
+//! Two criteria ([`Criterion`]):
+//!
+//! * for identification from joint torques, the condition number `σ_max/σ_min` of
+//!   the stacked base regressor `W_b = [Y(q_k, v_k, a_k)]_{k}` restricted to the
+//!   identifiable columns of `Y`. Those columns are found once, numerically, by
+//!   [`base_columns`]: with them, `Y π = Y_b β` where `Y_b = Y[:, base]` and `β` the
+//!   base parameters built on those columns, so `cond(W_b)` is the condition number
+//!   of the base-parameter least squares problem the trajectory will feed;
+//! * for MIM on body measurements, the worst relative standard deviation of a
+//!   principal moment: per body `i`, with `B_i` stacked over the samples and
+//!   `M_i = B_i J_i` its moments at the nominal parameters,
+//!   `max_k √([(B_iᵀ B_i)⁻¹]_kk) · rms(M_i) / J_ik` over the bodies and the moments
+//!   that enter their equations. It is the relative σ of `Ĵ_ik` per unit of relative
+//!   noise on the moments (5.7 means 5.7 % at 1 % noise). Masses are left out: gravity
+//!   alone makes them well conditioned.
+
+use super::motion::{FourierExcitation, Trajectory};
+use super::nelder_mead;
+use dyngen::BodyRegressor;
+use dyngen_model::{JointKind, Model};
+use dyngen_reference::Dynamics;
+use dyngen_reference::{sample_states, SplitMix64};
+use nalgebra::{DMatrix, Matrix3, Vector3};
+use std::f64::consts::PI;
+
+/// Where one joint may go: positions in `[lower, upper]`, speeds up to `velocity`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointLimits {
+    pub lower: f64,
+    pub upper: f64,
+    pub velocity: f64,
+}
+
+impl JointLimits {
+    /// Each joint's limits from the model, with defaults where the description has
+    /// none: positions within `[−π, π]` rad (rotation) or `[−0.5, 0.5]` m
+    /// (translation), narrowed to the joint's limits when it has any; speed the
+    /// joint's velocity limit when it is positive and below `10⁵` (URDF writers put
+    /// `10⁶` for "none"), else 2 rad/s or 0.5 m/s.
+    pub fn from_model(model: &Model) -> Vec<JointLimits> {
+        model
+            .joints
+            .iter()
+            .map(|j| {
+                let (reach, speed) = if j.kind == JointKind::Prismatic {
+                    (0.5, 0.5)
+                } else {
+                    (PI, 2.0)
+                };
+                match j.limits {
+                    Some(l) if l.upper > l.lower => JointLimits {
+                        lower: l.lower.max(-reach),
+                        upper: l.upper.min(reach),
+                        velocity: if l.velocity > 0.0 && l.velocity < 1e5 {
+                            l.velocity
+                        } else {
+                            speed
+                        },
+                    },
+                    _ => JointLimits {
+                        lower: -reach,
+                        upper: reach,
+                        velocity: speed,
+                    },
+                }
+            })
+            .collect()
+    }
+}
+
+/// The identifiable columns of the joint torque regressor `Y` (indices into its
+/// `10 n` columns, ascending): the columns a QR factorisation with column pivoting
+/// (largest remaining column first, modified Gram–Schmidt) accepts before the
+/// largest remaining residual norm falls below `10⁻⁸` times the first pivot's, on
+/// `Y` stacked over 40 random states from
+/// [`sample_states`](dyngen_reference::sample_states) with `seed` (`40 n` rows for
+/// `10 n` columns).
+///
+/// Their number is the number of base parameters. The choice of columns may differ
+/// from the generator's (which groups into a preferred order); the span is the same.
+pub fn base_columns(dynamics: &dyn Dynamics, seed: u64) -> Vec<usize> {
+    let n = dynamics.nv();
+    let p = dynamics.nparams();
+    let states = sample_states(dynamics.model(), 40, seed);
+    let mut w = DMatrix::zeros(n * states.len(), p);
+    let mut y = vec![0.0; n * p];
+    for (k, s) in states.iter().enumerate() {
+        dynamics.joint_torque_regressor(&s.q, &s.v, &s.a, &mut y);
+        for r in 0..n {
+            for c in 0..p {
+                w[(k * n + r, c)] = y[r * p + c];
+            }
+        }
+    }
+    pivoted_columns(w, 1e-8)
+}
+
+/// Column indices chosen by pivoted modified Gram–Schmidt, ascending.
+fn pivoted_columns(mut w: DMatrix<f64>, tolerance: f64) -> Vec<usize> {
+    let p = w.ncols();
+    let mut chosen = Vec::new();
+    let mut remaining: Vec<usize> = (0..p).collect();
+    let mut first = 0.0;
+    while !remaining.is_empty() {
+        let (slot, &pivot) = remaining
+            .iter()
+            .enumerate()
+            .max_by(|a, b| w.column(*a.1).norm().total_cmp(&w.column(*b.1).norm()))
+            .expect("non-empty");
+        let norm = w.column(pivot).norm();
+        if chosen.is_empty() {
+            first = norm;
+        }
+        if norm <= tolerance * first || norm == 0.0 {
+            break;
+        }
+        remaining.swap_remove(slot);
+        chosen.push(pivot);
+        let unit = w.column(pivot) / norm;
+        for &c in &remaining {
+            let projection = unit.dot(&w.column(c));
+            let mut col = w.column_mut(c);
+            col.axpy(-projection, &unit, 1.0);
+        }
+    }
+    chosen.sort_unstable();
+    chosen
+}
+
+/// What [`ExcitationDesign::optimise`] minimises (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Criterion {
+    /// `cond(W_b)` of the stacked base torque regressor: for identification from
+    /// joint torques.
+    #[default]
+    JointTorques,
+    /// The worst relative σ of a principal moment per unit of relative noise: for
+    /// MIM (and NIM) on each body's measured motion and resultant.
+    BodyModel,
+}
+
+/// Settings of [`ExcitationDesign::optimise`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcitationDesign {
+    /// What to minimise.
+    pub criterion: Criterion,
+    /// Harmonics `L` per joint (Swevers: 5).
+    pub harmonics: usize,
+    /// Base frequency `f_f`, Hz; the trajectory repeats every `1/f_f` s.
+    pub base_frequency: f64,
+    /// Length of the experiment the criterion is evaluated over, s (default one
+    /// period).
+    pub duration: f64,
+    /// Samples `t_k = k · duration / samples`, `k = 0..samples`, stacked into the
+    /// regressor.
+    pub samples: usize,
+    /// Per joint; checked on a grid of `max(4 · samples, 64 L)` instants over the
+    /// duration.
+    pub limits: Vec<JointLimits>,
+    /// Objective evaluations allowed in total (each one evaluates `samples`
+    /// regressors and one SVD or a few 3 × 3 inverses).
+    pub max_evaluations: usize,
+    /// Nelder–Mead runs; each after the first restarts from the best point with a
+    /// fresh simplex.
+    pub restarts: usize,
+    /// Impose `v(0) = 0` and `a(0) = 0` (so also at every multiple of the period):
+    /// `a_i1 = −Σ_{l≥2} a_il`, `b_i1 = −Σ_{l≥2} l b_il`. Needs `L ≥ 2`.
+    pub start_at_rest: bool,
+    /// Seeds the random initial coefficients and the column selection.
+    pub seed: u64,
+}
+
+impl ExcitationDesign {
+    /// Defaults for `model`: the joint-torque criterion, `L = 5`, `f_f = 0.1` Hz, one
+    /// 10 s period sampled 100 times, the model's [`JointLimits`], 3000 evaluations
+    /// in 3 runs, free start, seed 1.
+    pub fn new(model: &Model) -> ExcitationDesign {
+        ExcitationDesign {
+            criterion: Criterion::JointTorques,
+            harmonics: 5,
+            base_frequency: 0.1,
+            duration: 10.0,
+            samples: 100,
+            limits: JointLimits::from_model(model),
+            max_evaluations: 3000,
+            restarts: 3,
+            start_at_rest: false,
+            seed: 1,
+        }
+    }
+
+    /// Optimises the Fourier coefficients and offsets for the smallest value of the
+    /// [`Criterion`] (see the module docs) within the limits.
+    ///
+    /// Variables: per joint `q0_i` and the free `a_il`, `b_il`. Objective:
+    /// `log10` of the criterion on feasible points, `10⁶ +` (total limit violation,
+    /// relative to each joint's range or speed) on infeasible ones, so infeasible
+    /// points always lose to feasible ones yet still point back to feasibility. The
+    /// start is random (seeded): `a_il, b_il ~ U(−1, 1)/l`, `q0` mid-range, scaled
+    /// per joint until the [`FourierExcitation::amplitude_bounds`] use half the
+    /// range and half the speed, hence feasible. Minimised by Nelder–Mead with
+    /// restarts ([`ExcitationDesign::restarts`]) within
+    /// [`ExcitationDesign::max_evaluations`].
+    ///
+    /// Panics if `limits` does not have one entry per joint, or `start_at_rest` with
+    /// fewer than 2 harmonics.
+    pub fn optimise(&self, dynamics: &dyn Dynamics) -> OptimisedExcitation {
+        let n = dynamics.nv();
+        let harmonics = self.harmonics;
+        assert_eq!(
+            self.limits.len(),
+            n,
+            "`limits` has {} entries for {n} joints",
+            self.limits.len()
+        );
+        assert!(harmonics >= 1, "need at least one harmonic");
+        assert!(
+            !self.start_at_rest || harmonics >= 2,
+            "`start_at_rest` needs at least 2 harmonics"
+        );
+        let base = base_columns(dynamics, self.seed);
+        let objective = Objective::new(self, dynamics, &base);
+        let layout = Layout {
+            n,
+            harmonics,
+            start_at_rest: self.start_at_rest,
+            omega: 2.0 * PI * self.base_frequency,
+        };
+
+        // Random start, scaled into the limits.
+        let mut rng = SplitMix64::new(self.seed ^ 0x5157_4552_5345_5331);
+        let mut x = vec![0.0; layout.len()];
+        for i in 0..n {
+            let l = &self.limits[i];
+            x[layout.q0(i)] = 0.5 * (l.lower + l.upper);
+            for k in 0..layout.free() {
+                let harmonic = (k + layout.first_free()) as f64;
+                x[layout.a(i, k)] = rng.uniform(-1.0, 1.0) / harmonic;
+                x[layout.b(i, k)] = rng.uniform(-1.0, 1.0) / harmonic;
+            }
+        }
+        let guess = layout.decode(&x);
+        for (i, (position, speed, _)) in guess.amplitude_bounds().into_iter().enumerate() {
+            let l = &self.limits[i];
+            let scale = (0.5 * 0.5 * (l.upper - l.lower) / position).min(0.5 * l.velocity / speed);
+            for k in 0..layout.free() {
+                x[layout.a(i, k)] *= scale;
+                x[layout.b(i, k)] *= scale;
+            }
+        }
+        let initial = layout.decode(&x);
+        let initial_value = objective.criterion(&initial);
+
+        // Simplex steps: a tenth of the half-range for offsets, a quarter of the
+        // speed share of one harmonic for coefficients.
+        let mut steps = vec![0.0; layout.len()];
+        for i in 0..n {
+            let l = &self.limits[i];
+            steps[layout.q0(i)] = 0.05 * (l.upper - l.lower);
+            for k in 0..layout.free() {
+                steps[layout.a(i, k)] = 0.25 * l.velocity / harmonics as f64;
+                steps[layout.b(i, k)] = 0.25 * l.velocity / harmonics as f64;
+            }
+        }
+
+        let mut evaluations = 0;
+        let mut f = |x: &[f64]| objective.value(&layout.decode(x));
+        let mut best = (x.clone(), f64::INFINITY);
+        let runs = self.restarts.max(1);
+        for run in 0..runs {
+            let budget = (self.max_evaluations.saturating_sub(evaluations)) / (runs - run);
+            if budget <= layout.len() + 1 {
+                break;
+            }
+            let start = best.0.clone();
+            let m = nelder_mead::minimise(&mut f, &start, &steps, budget, &mut evaluations);
+            if m.f <= best.1 {
+                best = (m.x, m.f);
+            }
+        }
+
+        let excitation = layout.decode(&best.0);
+        let value = objective.criterion(&excitation);
+        let worse = value.is_nan() || value > initial_value;
+        let (value, excitation) = if objective.violation(&excitation) > 0.0 || worse {
+            // Never happens from a feasible start, but never return worse than it.
+            (initial_value, initial)
+        } else {
+            (value, excitation)
+        };
+        OptimisedExcitation {
+            excitation,
+            criterion: self.criterion,
+            value,
+            initial_value,
+            evaluations,
+            base_columns: base,
+        }
+    }
+}
+
+/// What [`ExcitationDesign::optimise`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OptimisedExcitation {
+    pub excitation: FourierExcitation,
+    /// The criterion minimised.
+    pub criterion: Criterion,
+    /// Its value for the result over the design's samples: `cond(W_b)`, or the worst
+    /// relative σ of a principal moment per unit of relative noise.
+    pub value: f64,
+    /// Its value for the random feasible start.
+    pub initial_value: f64,
+    /// Objective evaluations spent.
+    pub evaluations: usize,
+    /// The identifiable columns of `Y` the criterion used ([`base_columns`]).
+    pub base_columns: Vec<usize>,
+}
+
+/// The optimisation vector: per joint `q0_i`, then the free `a_il` and `b_il`
+/// (all `L` of each, or `l = 2..L` when the first harmonic is fixed by the rest
+/// conditions).
+struct Layout {
+    n: usize,
+    harmonics: usize,
+    start_at_rest: bool,
+    omega: f64,
+}
+
+impl Layout {
+    fn free(&self) -> usize {
+        if self.start_at_rest {
+            self.harmonics - 1
+        } else {
+            self.harmonics
+        }
+    }
+
+    /// The harmonic number of free coefficient 0.
+    fn first_free(&self) -> usize {
+        if self.start_at_rest {
+            2
+        } else {
+            1
+        }
+    }
+
+    fn per_joint(&self) -> usize {
+        1 + 2 * self.free()
+    }
+
+    fn len(&self) -> usize {
+        self.n * self.per_joint()
+    }
+
+    fn q0(&self, i: usize) -> usize {
+        i * self.per_joint()
+    }
+
+    fn a(&self, i: usize, k: usize) -> usize {
+        i * self.per_joint() + 1 + k
+    }
+
+    fn b(&self, i: usize, k: usize) -> usize {
+        i * self.per_joint() + 1 + self.free() + k
+    }
+
+    fn decode(&self, x: &[f64]) -> FourierExcitation {
+        let (n, big_l) = (self.n, self.harmonics);
+        let mut a = vec![0.0; n * big_l];
+        let mut b = vec![0.0; n * big_l];
+        let offset = self.first_free() - 1;
+        for i in 0..n {
+            for k in 0..self.free() {
+                a[i * big_l + offset + k] = x[self.a(i, k)];
+                b[i * big_l + offset + k] = x[self.b(i, k)];
+            }
+            if self.start_at_rest {
+                a[i * big_l] = -(1..big_l).map(|l| a[i * big_l + l]).sum::<f64>();
+                b[i * big_l] = -(1..big_l).map(|l| (l + 1) as f64 * b[i * big_l + l]).sum::<f64>();
+            }
+        }
+        FourierExcitation {
+            omega: self.omega,
+            q0: (0..n).map(|i| x[self.q0(i)]).collect(),
+            a,
+            b,
+            harmonics: big_l,
+        }
+    }
+}
+
+/// The criterion with its sample times and base columns fixed.
+struct Objective<'a> {
+    dynamics: &'a dyn Dynamics,
+    criterion: Criterion,
+    base: &'a [usize],
+    samples: Vec<f64>,
+    grid: Vec<f64>,
+    limits: &'a [JointLimits],
+    /// [`Criterion::BodyModel`]: the nominal principal moments of each body and
+    /// whether each enters the body's equations at all.
+    moments: Vec<([f64; 3], [bool; 3])>,
+}
+
+impl<'a> Objective<'a> {
+    fn new(design: &'a ExcitationDesign, dynamics: &'a dyn Dynamics, base: &'a [usize]) -> Objective<'a> {
+        let times = |count: usize| (0..count).map(|k| k as f64 * design.duration / count as f64).collect();
+        let grid = (4 * design.samples).max(64 * design.harmonics);
+        let moments = match design.criterion {
+            Criterion::JointTorques => Vec::new(),
+            Criterion::BodyModel => body_moments(dynamics, design.seed),
+        };
+        Objective {
+            dynamics,
+            criterion: design.criterion,
+            base,
+            samples: times(design.samples),
+            grid: times(grid),
+            limits: &design.limits,
+            moments,
+        }
+    }
+
+    fn criterion(&self, e: &FourierExcitation) -> f64 {
+        match self.criterion {
+            Criterion::JointTorques => self.condition_number(e),
+            Criterion::BodyModel => self.worst_moment_sigma(e),
+        }
+    }
+
+    fn worst_moment_sigma(&self, e: &FourierExcitation) -> f64 {
+        worst_moment_sigma(self.dynamics, &self.moments, e, &self.samples)
+    }
+
+    /// Total relative violation of the position and velocity limits on the grid.
+    fn violation(&self, e: &FourierExcitation) -> f64 {
+        let n = e.nv();
+        let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut worst = vec![0.0f64; 2 * n];
+        for &t in &self.grid {
+            e.eval(t, &mut q, &mut v, &mut a);
+            for i in 0..n {
+                let l = &self.limits[i];
+                let range = l.upper - l.lower;
+                let out = (q[i] - l.upper).max(l.lower - q[i]).max(0.0) / range;
+                worst[2 * i] = worst[2 * i].max(out);
+                worst[2 * i + 1] = worst[2 * i + 1].max((v[i].abs() - l.velocity).max(0.0) / l.velocity);
+            }
+        }
+        worst.iter().sum()
+    }
+
+    /// `cond(W_b)` over the samples (∞ when rank-deficient).
+    fn condition_number(&self, e: &FourierExcitation) -> f64 {
+        let n = e.nv();
+        let p = self.dynamics.nparams();
+        let nb = self.base.len();
+        let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut y = vec![0.0; n * p];
+        let mut w = DMatrix::zeros(n * self.samples.len(), nb);
+        for (k, &t) in self.samples.iter().enumerate() {
+            e.eval(t, &mut q, &mut v, &mut a);
+            self.dynamics.joint_torque_regressor(&q, &v, &a, &mut y);
+            for r in 0..n {
+                for (c, &col) in self.base.iter().enumerate() {
+                    w[(k * n + r, c)] = y[r * p + col];
+                }
+            }
+        }
+        let s = w.singular_values();
+        let (max, min) = s
+            .iter()
+            .fold((0.0f64, f64::INFINITY), |(hi, lo), &x| (hi.max(x), lo.min(x)));
+        if min > 0.0 {
+            max / min
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    fn value(&self, e: &FourierExcitation) -> f64 {
+        let violation = self.violation(e);
+        if violation > 0.0 {
+            return 1e6 + violation;
+        }
+        let c = self.criterion(e);
+        if c.is_finite() {
+            c.log10()
+        } else {
+            1e5
+        }
+    }
+}
+
+/// [`Criterion::BodyModel`] of any trajectory sampled at `times`: the worst relative
+/// σ of a principal moment per unit of relative moment noise (see the module docs;
+/// ∞ when a moment that enters the equations is not determined). It says how well
+/// an experiment suits MIM before it is run:
+///
+/// ```
+/// use dyngen_reference::Dynamics;
+/// use dyngen_identify::simulate::{moment_sigma, Experiment};
+/// let model = dyngen_model::parse_urdf(include_str!("../../../tests/fixtures/paper6.urdf")).unwrap();
+/// let robot = dyngen_reference::Reference::new(&model);
+/// let paper = Experiment::paper(&model);
+/// let s = moment_sigma(&robot, &paper.motion, &paper.times());
+/// assert!(s > 1.0 && s.is_finite()); // > 1 % σ at 1 % noise: some moment is barely excited
+/// ```
+pub fn moment_sigma(dynamics: &dyn Dynamics, trajectory: &dyn Trajectory, times: &[f64]) -> f64 {
+    worst_moment_sigma(dynamics, &body_moments(dynamics, 1), trajectory, times)
+}
+
+fn worst_moment_sigma(
+    dynamics: &dyn Dynamics,
+    moments: &[([f64; 3], [bool; 3])],
+    trajectory: &dyn Trajectory,
+    times: &[f64],
+) -> f64 {
+    let n = trajectory.nv();
+    let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut blocks = vec![BodyRegressor::default(); n];
+    let mut grams = vec![Matrix3::<f64>::zeros(); n];
+    let mut squares = vec![0.0; n];
+    for &t in times {
+        trajectory.eval(t, &mut q, &mut v, &mut a);
+        dynamics.body_regressors(&q, &v, &a, &mut blocks);
+        for (i, block) in blocks.iter().enumerate() {
+            let b: Matrix3<f64> = block.moment.fixed_columns::<3>(1).into_owned();
+            grams[i] += b.transpose() * b;
+            squares[i] += (b * Vector3::from(moments[i].0)).norm_squared();
+        }
+    }
+    let mut worst = 0.0f64;
+    for (i, (j, enters)) in moments.iter().enumerate() {
+        let active: Vec<usize> = (0..3).filter(|&k| enters[k]).collect();
+        if active.is_empty() {
+            continue;
+        }
+        let g = DMatrix::from_fn(active.len(), active.len(), |r, c| grams[i][(active[r], active[c])]);
+        let Some(inverse) = g.cholesky().map(|c| c.inverse()) else {
+            return f64::INFINITY;
+        };
+        let rms = (squares[i] / (3 * times.len()) as f64).sqrt();
+        for (r, &k) in active.iter().enumerate() {
+            worst = worst.max(inverse[(r, r)].max(0.0).sqrt() * rms / j[k]);
+        }
+    }
+    worst
+}
+
+/// Per body, the nominal principal moments `(J1, J2, J3)` and which of them enter
+/// the body's equations: a column of `B(ω, ω̇)` that is zero (relative to the
+/// body's largest) on 40 random states from [`sample_states`] is zero for every
+/// motion (a turret turning about its own axis never feels its `J1`, `J2`).
+fn body_moments(dynamics: &dyn Dynamics, seed: u64) -> Vec<([f64; 3], [bool; 3])> {
+    let model = dynamics.model();
+    let n = dynamics.nv();
+    let theta = crate::mim::true_theta(model);
+    let mut norms = vec![[0.0f64; 3]; n];
+    let mut blocks = vec![BodyRegressor::default(); n];
+    for s in sample_states(model, 40, seed) {
+        dynamics.body_regressors(&s.q, &s.v, &s.a, &mut blocks);
+        for (i, block) in blocks.iter().enumerate() {
+            for k in 0..3 {
+                norms[i][k] += block.moment.column(k + 1).norm_squared();
+            }
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let largest = norms[i].iter().copied().fold(0.0, f64::max);
+            (
+                [theta[4 * i + 1], theta[4 * i + 2], theta[4 * i + 3]],
+                norms[i].map(|x| x > 1e-20 * largest && largest > 0.0),
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pivoted_columns_finds_the_independent_ones() {
+        // Column 2 = column 0 + column 1, column 3 = 0.
+        let w = DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 2.0, 1.0, 3.0, 0.0, 1.0, 3.0, 4.0, 0.0,
+            ],
+        );
+        let chosen = pivoted_columns(w, 1e-10);
+        assert_eq!(chosen.len(), 2);
+        assert!(!chosen.contains(&3));
+    }
+}

@@ -1,0 +1,52 @@
+//! The model a generated robot carries (`Robot::MODEL`, plain `'static` data in the
+//! core crate) as the runtime's [`Model`]: no file is parsed and no joint renumbered,
+//! so the reference, identification and NIM see exactly the generator's numbering.
+
+use dyngen::{JointType, RobotModel};
+use dyngen_model::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
+
+/// The runtime model of a generated robot's `MODEL`.
+pub fn model_from_static(m: &RobotModel) -> Model {
+    Model {
+        name: m.name.to_string(),
+        gravity: m.gravity,
+        base: m.base.to_string(),
+        joints: m
+            .joints
+            .iter()
+            .map(|j| Joint {
+                name: j.name.to_string(),
+                kind: match j.kind {
+                    JointType::Revolute => JointKind::Revolute,
+                    JointType::Continuous => JointKind::Continuous,
+                    JointType::Prismatic => JointKind::Prismatic,
+                },
+                parent: j.parent,
+                origin: Placement {
+                    rotation: j.rotation,
+                    translation: j.translation,
+                },
+                axis: j.axis,
+                limits: j.limits.map(|l| Limits {
+                    lower: l.lower,
+                    upper: l.upper,
+                    velocity: l.velocity,
+                    effort: l.effort,
+                }),
+            })
+            .collect(),
+        bodies: m
+            .bodies
+            .iter()
+            .map(|b| Body {
+                name: b.name.to_string(),
+                inertial: Inertial {
+                    mass: b.mass,
+                    com: b.com,
+                    inertia: b.inertia,
+                },
+                merged: b.merged.iter().map(|s| s.to_string()).collect(),
+            })
+            .collect(),
+    }
+}

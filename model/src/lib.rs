@@ -24,6 +24,7 @@ pub mod graph;
 mod ir;
 pub mod math;
 pub mod principal;
+pub mod regressor;
 pub mod sample;
 pub mod urdf;
 mod write;

@@ -18,11 +18,13 @@
 //! assert_eq!(dyngen_model::graph::incidence(&model), vec![vec![-1], vec![1]]);
 //! ```
 
+pub mod base;
 pub mod desc;
 pub mod error;
 pub mod graph;
 mod ir;
 pub mod math;
+pub mod names;
 pub mod principal;
 pub mod regressor;
 pub mod sample;
@@ -30,6 +32,7 @@ pub mod urdf;
 mod write;
 pub mod xml;
 
+pub use base::{BaseParams, Parameterisation};
 pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};

@@ -208,9 +208,10 @@ pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
         let mut rotated = false;
         for i in 0..p {
             for j in i + 1..p {
-                let (alpha, beta, gamma) = cols[i].iter().zip(&cols[j]).fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| {
-                    (a + x * x, b + y * y, g + x * y)
-                });
+                let (alpha, beta, gamma) = cols[i]
+                    .iter()
+                    .zip(&cols[j])
+                    .fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| (a + x * x, b + y * y, g + x * y));
                 if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
                     continue;
                 }
@@ -233,7 +234,10 @@ pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
             break;
         }
     }
-    let mut values: Vec<f64> = cols.iter().map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt()).collect();
+    let mut values: Vec<f64> = cols
+        .iter()
+        .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .collect();
     values.sort_by(|a, b| b.total_cmp(a));
     values
 }

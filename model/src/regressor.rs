@@ -109,8 +109,9 @@ pub(crate) fn principal_from_standard(model: &Model, y: &[Vec<f64>]) -> Vec<Vec<
             let mut out = vec![0.0; PRINCIPAL_PER_BODY * n];
             for (i, pi) in p.iter().enumerate() {
                 for c in 0..PRINCIPAL_PER_BODY {
-                    out[PRINCIPAL_PER_BODY * i + c] =
-                        (0..STANDARD_PER_BODY).map(|k| row[STANDARD_PER_BODY * i + k] * pi[k][c]).sum();
+                    out[PRINCIPAL_PER_BODY * i + c] = (0..STANDARD_PER_BODY)
+                        .map(|k| row[STANDARD_PER_BODY * i + k] * pi[k][c])
+                        .sum();
                 }
             }
             out
@@ -142,7 +143,10 @@ pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Bod
         let z = joint.axis;
         let origin = &joint.origin;
         let (rotation, translation) = if joint.kind.is_revolute() {
-            (math::mat_mul(&origin.rotation, &axis_rotation(&z, q[k])), origin.translation)
+            (
+                math::mat_mul(&origin.rotation, &axis_rotation(&z, q[k])),
+                origin.translation,
+            )
         } else {
             let slide = math::mat_vec(&origin.rotation, &math::scale(q[k], &z));
             (origin.rotation, math::add(&origin.translation, &slide))
@@ -225,7 +229,11 @@ pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -
 }
 
 fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Rotation by `angle` about the unit `axis` (Rodrigues): `E + sin S(u) + (1 − cos) S(u)²`.
@@ -265,7 +273,10 @@ mod tests {
         let mut tau = vec![0.0; n];
         for j in (1..=n).rev() {
             let joint = &model.joints[j - 1];
-            tau[j - 1] = math::dot(&joint.axis, if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] });
+            tau[j - 1] = math::dot(
+                &joint.axis,
+                if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] },
+            );
             if joint.parent != 0 {
                 let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
                 let fp = math::mat_vec(r, &f[j - 1]);

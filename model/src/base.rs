@@ -322,6 +322,42 @@ mod tests {
         }
     }
 
+    /// Every fixture robot: the count equals the rank of Pinocchio's own regressor
+    /// stacked over the fixture's 50 states (`σ > 10⁻⁸ σ₁`), as the Pinocchio
+    /// comparison of generated code checks it.
+    #[test]
+    fn counts_match_the_rank_of_pinocchios_stacked_regressor() {
+        for (name, path) in [
+            ("ur5", "robots/ur5/ur5.urdf"),
+            ("puma560", "robots/puma560/puma560.urdf"),
+            ("panda", "robots/panda/panda.urdf"),
+            ("gripper_arm", "robots/gripper_arm/gripper_arm.urdf"),
+            ("planar2", "tests/fixtures/planar2.urdf"),
+            ("paper6", "tests/fixtures/paper6.urdf"),
+            ("tree12", "tests/fixtures/tree12.urdf"),
+        ] {
+            let file = format!("{}/../tests/fixtures/{name}.json", env!("CARGO_MANIFEST_DIR"));
+            let fx: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+            let vec = |v: &serde_json::Value| -> Vec<f64> {
+                v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+            };
+            let rows: Vec<Vec<f64>> = fx["samples"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|s| s["Y"].as_array().unwrap().iter().map(vec).collect::<Vec<_>>())
+                .collect();
+            let sv = singular_values(&rows);
+            let pinocchio = sv.iter().filter(|&&x| x > RANK_TOLERANCE * sv[0]).count();
+            let mut model = robot(path);
+            let g = vec(&fx["gravity"]);
+            model.gravity = [g[0], g[1], g[2]];
+            let b = analyse(&model, Parameterisation::Standard);
+            assert_eq!(b.count(), pinocchio, "{name}\n{b}");
+            assert!(b.is_consistent(), "{name}\n{b}");
+        }
+    }
+
     /// `Y_b β = Y π` on states the analysis never saw, in both parameterisations.
     #[test]
     fn base_regressor_reproduces_the_torques() {

@@ -3,7 +3,9 @@
 //! The robot description every other dyngen crate builds on: a checked fixed-base
 //! kinematic tree ([`Model`]) in regular labelling, the front ends that produce it
 //! (URDF here; the `robot!` DSL lives in `dyngen-codegen`), the paper's graph theory
-//! ([`graph`]), and a URDF writer so any model can be opened in standard tools.
+//! ([`graph`]), a URDF writer so any model can be opened in standard tools, the
+//! numeric joint torque regressor ([`regressor`]) and the base-parameter analysis
+//! built on it ([`base`]), with the project's parameter names ([`names`]).
 //!
 //! ```
 //! let urdf = r#"<robot name="pendulum">

@@ -3,7 +3,9 @@
 //! The robot description every other dyngen crate builds on: a checked fixed-base
 //! kinematic tree ([`Model`]) in regular labelling, the front ends that produce it
 //! (URDF here; the `robot!` DSL lives in `dyngen-codegen`), the paper's graph theory
-//! ([`graph`]), and a URDF writer so any model can be opened in standard tools.
+//! ([`graph`]), a URDF writer so any model can be opened in standard tools, the
+//! numeric joint torque regressor ([`regressor`]) and the base-parameter analysis
+//! built on it ([`base`]), with the project's parameter names ([`names`]).
 //!
 //! ```
 //! let urdf = r#"<robot name="pendulum">
@@ -18,17 +20,21 @@
 //! assert_eq!(dyngen_model::graph::incidence(&model), vec![vec![-1], vec![1]]);
 //! ```
 
+pub mod base;
 pub mod desc;
 pub mod error;
 pub mod graph;
 mod ir;
 pub mod math;
+pub mod names;
 pub mod principal;
+pub mod regressor;
 pub mod sample;
 pub mod urdf;
 mod write;
 pub mod xml;
 
+pub use base::{BaseParams, Parameterisation};
 pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};

@@ -192,6 +192,56 @@ pub fn det(a: &Mat3) -> f64 {
         + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
 }
 
+/// Singular values of a dense matrix given as rows (`m × p`, any shape), descending,
+/// by one-sided Jacobi (Hestenes): plane rotations of column pairs until every pair
+/// is orthogonal to working precision; the singular values are then the column
+/// norms. Unlike the eigenvalues of `AᵀA`, which square the condition number, small
+/// singular values come out with relative accuracy, which a rank test at `10⁻⁸ σ₁`
+/// needs. Rows of unequal length are read as zero-padded to the longest.
+pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
+    let p = rows.iter().map(Vec::len).max().unwrap_or(0);
+    // Column-major copy: the rotations work on whole columns.
+    let mut cols: Vec<Vec<f64>> = (0..p)
+        .map(|c| rows.iter().map(|r| r.get(c).copied().unwrap_or(0.0)).collect())
+        .collect();
+    for _sweep in 0..80 {
+        let mut rotated = false;
+        for i in 0..p {
+            for j in i + 1..p {
+                let (alpha, beta, gamma) = cols[i]
+                    .iter()
+                    .zip(&cols[j])
+                    .fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| (a + x * x, b + y * y, g + x * y));
+                if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
+                    continue;
+                }
+                rotated = true;
+                // The rotation that diagonalises the 2×2 Gram matrix [[α, γ], [γ, β]].
+                let zeta = (beta - alpha) / (2.0 * gamma);
+                let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+                let t = if zeta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (1.0 + t * t).sqrt();
+                let s = c * t;
+                let (left, right) = cols.split_at_mut(j);
+                for (x, y) in left[i].iter_mut().zip(right[0].iter_mut()) {
+                    let (xi, yj) = (*x, *y);
+                    *x = c * xi - s * yj;
+                    *y = s * xi + c * yj;
+                }
+            }
+        }
+        if !rotated {
+            break;
+        }
+    }
+    let mut values: Vec<f64> = cols
+        .iter()
+        .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .collect();
+    values.sort_by(|a, b| b.total_cmp(a));
+    values
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,5 +278,29 @@ mod tests {
         }
         assert!(vals[0] <= vals[1] && vals[1] <= vals[2]);
         assert!((det(&vecs) - 1.0).abs() < 1e-12);
+    }
+    #[test]
+    fn singular_values_of_a_known_matrix() {
+        // A = U diag(3, 2, 0) Vᵀ built from two orthonormal columns: rank 2.
+        let u = [[0.6, 0.0], [0.8, 0.0], [0.0, 1.0], [0.0, 0.0]];
+        let v = [[1.0 / 2f64.sqrt(), 0.0], [1.0 / 2f64.sqrt(), 0.0], [0.0, 1.0]];
+        let s = [3.0, 2.0];
+        let rows: Vec<Vec<f64>> = (0..4)
+            .map(|r| (0..3).map(|c| (0..2).map(|k| u[r][k] * s[k] * v[c][k]).sum()).collect())
+            .collect();
+        let sv = singular_values(&rows);
+        assert_eq!(sv.len(), 3);
+        assert!((sv[0] - 3.0).abs() < 1e-14 && (sv[1] - 2.0).abs() < 1e-14, "{sv:?}");
+        assert!(sv[2] < 1e-14, "{sv:?}");
+    }
+
+    #[test]
+    fn singular_values_resolve_small_values() {
+        // diag(1, 1e-10) rotated: the small value survives with relative accuracy.
+        let (c, s) = (0.8, 0.6);
+        let rows = vec![vec![c, -s * 1e-10], vec![s, c * 1e-10]];
+        let sv = singular_values(&rows);
+        assert!((sv[0] - 1.0).abs() < 1e-15);
+        assert!((sv[1] / 1e-10 - 1.0).abs() < 1e-12, "{sv:?}");
     }
 }

@@ -1,7 +1,8 @@
 //! Deterministic sampling of joint states, from a tiny PRNG whose output is fixed
 //! forever (no dependency on `rand`, whose streams may change between versions).
-//! Shared by the generator (base-parameter analysis) and the runtime (tests,
-//! benchmarks, simulation).
+//! [`sample_states`] (within each joint's limits) serves the runtime (tests,
+//! benchmarks, simulation); [`structure_states`] (full ranges, limits ignored) serves
+//! the base-parameter analysis.
 
 use crate::{JointKind, Model};
 use std::f64::consts::PI;
@@ -69,6 +70,36 @@ pub fn sample_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
                         Some(l) => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
                         None => rng.uniform(-reach, reach),
                     }
+                })
+                .collect();
+            let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
+            let a = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
+            State { q, v, a }
+        })
+        .collect()
+}
+
+/// `count` states for analysing the structure of the dynamics (which columns of a
+/// regressor are independent), from [`SplitMix64`] seeded with `seed`: `q_i` uniform
+/// in `[−π, π]` for every revolute and continuous joint and in `[−0.5, 0.5]` m for
+/// every prismatic joint, whatever the limits say; `v_i` and `a_i` uniform in
+/// `[−2, 2]`. Same draw order as [`sample_states`].
+///
+/// The limits are ignored on purpose: the regressor is a trigonometric polynomial in
+/// the revolute angles and a polynomial in the prismatic displacements whatever the
+/// limits, so its rank over the full range is its rank anywhere generic, while
+/// placeholder limits (`lower = upper = 0`, or a narrow range) would pin a joint and
+/// hide parameters. A prismatic range wider than ±0.5 m would add nothing but scale.
+pub fn structure_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
+    let mut rng = SplitMix64::new(seed);
+    (0..count)
+        .map(|_| {
+            let q = model
+                .joints
+                .iter()
+                .map(|j| {
+                    let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
+                    rng.uniform(-reach, reach)
                 })
                 .collect();
             let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();

@@ -1,0 +1,408 @@
+//! The joint torque regressor in plain `f64`: `τ = Y(q, v, a) π`, by the classical
+//! (Luh–Walker–Paul) Newton–Euler recursion on a checked [`Model`].
+//!
+//! Forward pass, body frames, body 0 the base with `ω₀ = ω̇₀ = 0` and `a₀ = −g` (so
+//! gravity comes in as an acceleration of the base). Joint `i` maps body `i`'s frame
+//! into its parent's by the rotation `R_i` and the translation `p_i` (its origin, plus
+//! `R_i z_i q_i` for a prismatic joint), with `z_i` its unit axis in body `i`'s frame:
+//!
+//! ```text
+//! revolute:  ω_i = R_iᵀ ω_λ + z_i v_i
+//!            ω̇_i = R_iᵀ ω̇_λ + (R_iᵀ ω_λ) × z_i v_i + z_i a_i
+//!            a_i = R_iᵀ (a_λ + ω̇_λ × p_i + ω_λ × (ω_λ × p_i))
+//! prismatic: ω_i = R_iᵀ ω_λ,  ω̇_i = R_iᵀ ω̇_λ
+//!            a_i = R_iᵀ (a_λ + ω̇_λ × p_i + ω_λ × (ω_λ × p_i)) + 2 ω_i × z_i v_i + z_i a_i
+//! ```
+//!
+//! With `π_i = [m, h, I]` (`h = m c`, `I` about the body origin), the net wrench on
+//! body `i` about its origin is linear in `π_i`:
+//!
+//! ```text
+//! f_i = m a_i + ω̇_i × h + ω_i × (ω_i × h)
+//! n_i = I ω̇_i + ω_i × (I ω_i) + h × a_i
+//! ```
+//!
+//! Column `k` of body `i`'s wrench regressor is that wrench with `π_i = e_k`. Joint `j`
+//! carries the wrenches of every body it supports, moved towards the base one joint at
+//! a time (`f ← R f`, `n ← R n + p × R f`), and `τ_j = z_jᵀ n` (revolute) or `z_jᵀ f`
+//! (prismatic).
+
+use crate::math::{self, Mat3, Vec3};
+use crate::principal::PrincipalFrame;
+use crate::{JointKind, Model};
+use std::fmt;
+
+/// Standard parameters per body: `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
+pub const STANDARD_PER_BODY: usize = 10;
+/// Principal parameters per body: `θ = (m, J1, J2, J3)`.
+pub const PRINCIPAL_PER_BODY: usize = 4;
+
+/// A state that does not fit the model.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RegressorError {
+    /// `argument` (`"q"`, `"v"` or `"a"`) has `found` entries; the model has
+    /// `expected` joints.
+    Length {
+        argument: &'static str,
+        expected: usize,
+        found: usize,
+    },
+}
+
+impl fmt::Display for RegressorError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RegressorError::Length {
+                argument,
+                expected,
+                found,
+            } => write!(f, "`{argument}` has {found} entries; the model has {expected} joints"),
+        }
+    }
+}
+
+impl std::error::Error for RegressorError {}
+
+/// The joint torque regressor `Y(q, v, a)`: `n` rows of `10 n` numbers with
+/// `τ = Y π` for the standard parameters `π` of every body (body 1 first, each in
+/// Pinocchio's order `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`, inertia
+/// about the body-frame origin, as [`Model::standard_params`]), gravity from
+/// `model.gravity`. Entry `(j, 10(i−1)+k)` is zero unless joint `j` supports body `i`.
+/// The formulas are in the module docs.
+pub fn joint_torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Vec<f64>>, RegressorError> {
+    check_state(model, q, v, a)?;
+    Ok(torque_regressor(model, q, v, a))
+}
+
+/// The principal-parameter regressor `Y_θ(q, v, a) = Y(q, v, a) · blkdiag(P_1, …, P_n)`:
+/// `n` rows of `4 n` numbers with `τ = Y_θ θ`, `θ_i = (m, J1, J2, J3)` and `P_i` the
+/// constant 10 × 4 matrix of body `i`'s nominal [`PrincipalFrame`] (`π_i = P_i θ_i`).
+pub fn principal_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Vec<f64>>, RegressorError> {
+    check_state(model, q, v, a)?;
+    Ok(principal_from_standard(model, &torque_regressor(model, q, v, a)))
+}
+
+fn check_state(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<(), RegressorError> {
+    let expected = model.dof();
+    for (argument, x) in [("q", q), ("v", v), ("a", a)] {
+        if x.len() != expected {
+            return Err(RegressorError::Length {
+                argument,
+                expected,
+                found: x.len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `Y · blkdiag(P_i)`, skipping the blocks that are structurally zero.
+pub(crate) fn principal_from_standard(model: &Model, y: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = model.dof();
+    let p: Vec<[[f64; 4]; 10]> = model
+        .bodies
+        .iter()
+        .map(|b| PrincipalFrame::of(&b.inertial).p_matrix())
+        .collect();
+    y.iter()
+        .map(|row| {
+            let mut out = vec![0.0; PRINCIPAL_PER_BODY * n];
+            for (i, pi) in p.iter().enumerate() {
+                for c in 0..PRINCIPAL_PER_BODY {
+                    out[PRINCIPAL_PER_BODY * i + c] = (0..STANDARD_PER_BODY)
+                        .map(|k| row[STANDARD_PER_BODY * i + k] * pi[k][c])
+                        .sum();
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// Where a body is and how it moves: its joint's placement at `q` and the body's
+/// angular velocity, angular acceleration and origin acceleration (gravity included),
+/// in the body's own frame.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BodyMotion {
+    /// Body frame → parent frame.
+    pub rotation: Mat3,
+    pub translation: Vec3,
+    pub omega: Vec3,
+    pub omega_dot: Vec3,
+    pub accel: Vec3,
+}
+
+/// The forward pass of the module docs, body 1 first. Lengths are the caller's to check.
+pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<BodyMotion> {
+    let mut out: Vec<BodyMotion> = Vec::with_capacity(model.dof());
+    for (k, joint) in model.joints.iter().enumerate() {
+        let (w_p, wd_p, a_p) = match joint.parent {
+            0 => ([0.0; 3], [0.0; 3], math::scale(-1.0, &model.gravity)),
+            p => (out[p - 1].omega, out[p - 1].omega_dot, out[p - 1].accel),
+        };
+        let z = joint.axis;
+        let origin = &joint.origin;
+        let (rotation, translation) = if joint.kind.is_revolute() {
+            (
+                math::mat_mul(&origin.rotation, &axis_rotation(&z, q[k])),
+                origin.translation,
+            )
+        } else {
+            let slide = math::mat_vec(&origin.rotation, &math::scale(q[k], &z));
+            (origin.rotation, math::add(&origin.translation, &slide))
+        };
+        let rt = math::transpose(&rotation);
+        let p = translation;
+        let carried = math::add(&math::add(&a_p, &cross(&wd_p, &p)), &cross(&w_p, &cross(&w_p, &p)));
+        let w_in = math::mat_vec(&rt, &w_p);
+        let wd_in = math::mat_vec(&rt, &wd_p);
+        let accel_in = math::mat_vec(&rt, &carried);
+        let motion = match joint.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                let zv = math::scale(v[k], &z);
+                BodyMotion {
+                    rotation,
+                    translation,
+                    omega: math::add(&w_in, &zv),
+                    omega_dot: math::add(&math::add(&wd_in, &cross(&w_in, &zv)), &math::scale(a[k], &z)),
+                    accel: accel_in,
+                }
+            }
+            JointKind::Prismatic => {
+                let zv = math::scale(v[k], &z);
+                let coriolis = math::scale(2.0, &cross(&w_in, &zv));
+                BodyMotion {
+                    rotation,
+                    translation,
+                    omega: w_in,
+                    omega_dot: wd_in,
+                    accel: math::add(&math::add(&accel_in, &coriolis), &math::scale(a[k], &z)),
+                }
+            }
+        };
+        out.push(motion);
+    }
+    out
+}
+
+/// The net wrench `(f, n)` on a body about its origin for standard parameters `pi`
+/// (linear in `pi`; see the module docs).
+fn body_wrench(m: &BodyMotion, pi: &[f64; 10]) -> (Vec3, Vec3) {
+    let mass = pi[0];
+    let h = [pi[1], pi[2], pi[3]];
+    let inertia = [[pi[4], pi[5], pi[7]], [pi[5], pi[6], pi[8]], [pi[7], pi[8], pi[9]]];
+    let (w, wd) = (&m.omega, &m.omega_dot);
+    let f = math::add(
+        &math::add(&math::scale(mass, &m.accel), &cross(wd, &h)),
+        &cross(w, &cross(w, &h)),
+    );
+    let n = math::add(
+        &math::add(&math::mat_vec(&inertia, wd), &cross(w, &math::mat_vec(&inertia, w))),
+        &cross(&h, &m.accel),
+    );
+    (f, n)
+}
+
+/// The torque regressor of the module docs; lengths are the caller's to check.
+pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Vec<f64>> {
+    let n = model.dof();
+    let motion = forward(model, q, v, a);
+    let mut y = vec![vec![0.0; STANDARD_PER_BODY * n]; n];
+    for i in 1..=n {
+        for k in 0..STANDARD_PER_BODY {
+            let mut unit = [0.0; 10];
+            unit[k] = 1.0;
+            let (mut f, mut m) = body_wrench(&motion[i - 1], &unit);
+            let mut j = i;
+            while j != 0 {
+                let joint = &model.joints[j - 1];
+                let moved = if joint.kind.is_revolute() { &m } else { &f };
+                y[j - 1][STANDARD_PER_BODY * (i - 1) + k] = math::dot(&joint.axis, moved);
+                let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
+                f = math::mat_vec(r, &f);
+                m = math::add(&math::mat_vec(r, &m), &cross(p, &f));
+                j = joint.parent;
+            }
+        }
+    }
+    y
+}
+
+fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Rotation by `angle` about the unit `axis` (Rodrigues): `E + sin S(u) + (1 − cos) S(u)²`.
+fn axis_rotation(axis: &Vec3, angle: f64) -> Mat3 {
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    let [x, y, z] = *axis;
+    [
+        [c + t * x * x, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, c + t * y * y, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, c + t * z * z],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::sample_states;
+    use crate::Inertial;
+
+    /// Inverse dynamics written another way: each body's wrench about its centre of
+    /// mass from its mass properties, shifted to the origin, and the children's
+    /// wrenches summed into the parent leaf first.
+    fn rnea(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
+        let n = model.dof();
+        let motion = forward(model, q, v, a);
+        let mut f = vec![[0.0; 3]; n];
+        let mut m = vec![[0.0; 3]; n];
+        for (i, (body, mo)) in model.bodies.iter().zip(&motion).enumerate() {
+            let Inertial { mass, com: c, inertia } = body.inertial;
+            let (w, wd) = (&mo.omega, &mo.omega_dot);
+            let a_c = math::add(&math::add(&mo.accel, &cross(wd, &c)), &cross(w, &cross(w, &c)));
+            f[i] = math::scale(mass, &a_c);
+            let about_c = math::add(&math::mat_vec(&inertia, wd), &cross(w, &math::mat_vec(&inertia, w)));
+            m[i] = math::add(&about_c, &cross(&c, &f[i]));
+        }
+        let mut tau = vec![0.0; n];
+        for j in (1..=n).rev() {
+            let joint = &model.joints[j - 1];
+            tau[j - 1] = math::dot(
+                &joint.axis,
+                if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] },
+            );
+            if joint.parent != 0 {
+                let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
+                let fp = math::mat_vec(r, &f[j - 1]);
+                let mp = math::add(&math::mat_vec(r, &m[j - 1]), &cross(p, &fp));
+                let k = joint.parent - 1;
+                f[k] = math::add(&f[k], &fp);
+                m[k] = math::add(&m[k], &mp);
+            }
+        }
+        tau
+    }
+
+    fn robot(path: &str) -> Model {
+        let file = format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{file}: {e}"));
+        crate::parse_urdf(&text).unwrap_or_else(|e| panic!("{file}: {e}"))
+    }
+
+    const URDFS: [&str; 7] = [
+        "robots/ur5/ur5.urdf",
+        "robots/puma560/puma560.urdf",
+        "robots/panda/panda.urdf",
+        "robots/gripper_arm/gripper_arm.urdf",
+        "tests/fixtures/planar2.urdf",
+        "tests/fixtures/paper6.urdf",
+        "tests/fixtures/tree12.urdf",
+    ];
+
+    fn mat_vec_rows(y: &[Vec<f64>], x: &[f64]) -> Vec<f64> {
+        y.iter().map(|r| r.iter().zip(x).map(|(a, b)| a * b).sum()).collect()
+    }
+
+    fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+        assert_eq!(a.len(), b.len(), "{what}");
+        let scale = b.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= tol * scale, "{what}: {a:?} vs {b:?}");
+        }
+    }
+
+    #[test]
+    fn regressor_times_params_is_inverse_dynamics() {
+        for path in URDFS {
+            let model = robot(path);
+            let pi = model.standard_params();
+            for s in sample_states(&model, 25, 11) {
+                let y = joint_torque_regressor(&model, &s.q, &s.v, &s.a).unwrap();
+                assert_close(&mat_vec_rows(&y, &pi), &rnea(&model, &s.q, &s.v, &s.a), 1e-12, path);
+            }
+        }
+    }
+
+    #[test]
+    fn principal_regressor_times_theta_is_inverse_dynamics() {
+        for path in URDFS {
+            let model = robot(path);
+            let theta = crate::principal_params(&model);
+            for s in sample_states(&model, 10, 12) {
+                let y = principal_regressor(&model, &s.q, &s.v, &s.a).unwrap();
+                assert_eq!(y[0].len(), 4 * model.dof());
+                assert_close(&mat_vec_rows(&y, &theta), &rnea(&model, &s.q, &s.v, &s.a), 1e-12, path);
+            }
+        }
+    }
+
+    #[test]
+    fn wrong_lengths_are_errors() {
+        let model = robot("robots/ur5/ur5.urdf");
+        let ok = vec![0.0; 6];
+        assert_eq!(
+            joint_torque_regressor(&model, &ok, &[0.0; 5], &ok),
+            Err(RegressorError::Length {
+                argument: "v",
+                expected: 6,
+                found: 5
+            })
+        );
+        let e = principal_regressor(&model, &ok, &ok, &[0.0; 7]).unwrap_err();
+        assert_eq!(e.to_string(), "`a` has 7 entries; the model has 6 joints");
+    }
+
+    /// Pinocchio's `tau` and `Y` for each fixture sample, with the fixture's gravity.
+    #[test]
+    fn matches_pinocchio_fixtures() {
+        for (name, path) in [
+            ("ur5", "robots/ur5/ur5.urdf"),
+            ("puma560", "robots/puma560/puma560.urdf"),
+            ("panda", "robots/panda/panda.urdf"),
+            ("gripper_arm", "robots/gripper_arm/gripper_arm.urdf"),
+            ("planar2", "tests/fixtures/planar2.urdf"),
+            ("paper6", "tests/fixtures/paper6.urdf"),
+            ("tree12", "tests/fixtures/tree12.urdf"),
+        ] {
+            let mut model = robot(path);
+            let file = format!("{}/../tests/fixtures/{name}.json", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(&file).unwrap();
+            let fx: serde_json::Value = serde_json::from_str(&text).unwrap();
+            let vec = |v: &serde_json::Value| -> Vec<f64> {
+                v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+            };
+            let g = vec(&fx["gravity"]);
+            model.gravity = [g[0], g[1], g[2]];
+            let names: Vec<&str> = fx["model"]["joint_names"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_str().unwrap())
+                .collect();
+            let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+            assert_eq!(ours, names, "{name}: joint order");
+            let samples = fx["samples"].as_array().unwrap();
+            assert!(!samples.is_empty());
+            for s in samples {
+                let (q, v, a) = (vec(&s["q"]), vec(&s["v"]), vec(&s["a"]));
+                let y = joint_torque_regressor(&model, &q, &v, &a).unwrap();
+                let y_pin: Vec<Vec<f64>> = s["Y"].as_array().unwrap().iter().map(vec).collect();
+                for (r, (ours, theirs)) in y.iter().zip(&y_pin).enumerate() {
+                    assert_close(ours, theirs, 1e-10, &format!("{name}: Y row {r}"));
+                }
+                assert_close(
+                    &mat_vec_rows(&y, &model.standard_params()),
+                    &vec(&s["tau"]),
+                    1e-10,
+                    name,
+                );
+            }
+        }
+    }
+}

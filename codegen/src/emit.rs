@@ -320,9 +320,10 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let width = usize_lit(spill.len().max(1));
     let mut parts = Vec::new();
     let mut calls = Vec::new();
-    let mut current = None;
     for (c, chunk) in chunks.iter().enumerate() {
         let part = format_ident!("__{}_part{}", spec.name, c);
+        // Each part says which section it starts in.
+        let mut current = None;
         let local: HashMap<NodeId, usize> = HashMap::new();
         let names = Names {
             spill: &local,

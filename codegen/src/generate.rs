@@ -672,7 +672,7 @@ impl Algorithm {
 }
 
 /// Generates the robot type `name` for `model`, with the base parameters `bases`
-/// found by [`base::analyse_model`] for the same model. `name` must be a Rust
+/// found by [`crate::base::analyse_model`] for the same model. `name` must be a Rust
 /// identifier (see [`is_type_name`]).
 pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> Generated {
     let sizes = Sizes {

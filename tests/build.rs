@@ -4,7 +4,7 @@
 fn main() -> Result<(), dyngen_codegen::Error> {
     dyngen_codegen::Config::new()
         .file_name("ur5_split.rs")
-        .max_statements(100)
+        .max_statements(40)
         .compile_urdf("../robots/ur5/ur5.urdf", "Ur5Split")?;
     Ok(())
 }

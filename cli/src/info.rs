@@ -1,7 +1,7 @@
 //! `dyngen info`: what dyngen sees in a URDF.
 
 use crate::common::{load_model, with_spinner, GravityArg, Progress, Result};
-use dyngen_codegen::{generate, Options};
+use dyngen_codegen::{analyse_model, generate, Options};
 use dyngen_model::graph::{incidence, path_matrix};
 use dyngen_model::Model;
 use std::fmt::Write as _;
@@ -49,13 +49,17 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         print!("{out}");
         return Ok(());
     }
-    let generated = with_spinner(
+    let (bases, generated) = with_spinner(
         progress,
         "generating code for the base parameters and op counts",
-        || generate(&model, "Robot", &Options::default()),
+        || {
+            let bases = analyse_model(&model);
+            let generated = generate(&model, "Robot", &bases, &Options::default());
+            (bases, generated)
+        },
     );
-    let base = &generated.base;
-    let pbase = &generated.principal_base;
+    let base = &bases.standard;
+    let pbase = &bases.principal;
     writeln!(
         out,
         "  base (identifiable from joint torques):                    {}",

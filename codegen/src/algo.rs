@@ -200,10 +200,17 @@ pub fn rotation_about<'g>(g: &'g Graph, a: [f64; 3], q: Expr<'g>) -> M3<'g> {
     }))
 }
 
+/// Starts the section of emitted code where body `j`'s step of a pass is computed
+/// (see [`Graph::mark`]), so the code says where each body's recursion starts.
+fn mark_body(g: &Graph, model: &Model, j: usize, step: &str) {
+    g.mark(format!("body {j} ({}): {step}", model.bodies[j - 1].name));
+}
+
 /// Every body's pose in the base frame: `(rotation, translation)`, body 1 first.
 pub fn forward_kinematics<'g>(g: &'g Graph, model: &Model) -> Vec<(M3<'g>, V3<'g>)> {
     let mut poses: Vec<(M3<'g>, V3<'g>)> = Vec::with_capacity(model.dof());
     for j in 1..=model.dof() {
+        mark_body(g, model, j, "pose");
         let x = JointTransform::new(g, model, j);
         let pose = match model.parent(j) {
             0 => (x.rotation(), x.translation),
@@ -414,13 +421,15 @@ pub struct Kinematics<'g> {
 /// The forward Newton–Euler pass.
 pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics<'g> {
     let n = model.dof();
-    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let mut x: Vec<JointTransform<'g>> = Vec::with_capacity(n);
     let mut motion = vec![BodyMotion {
         w: V3::zero(g),
         wd: V3::zero(g),
         acc: V3::constant(g, model.gravity.map(|c| -c)),
     }];
     for j in 1..=n {
+        mark_body(g, model, j, "joint transform, velocities and accelerations");
+        x.push(JointTransform::new(g, model, j));
         let joint = &model.joints[j - 1];
         let p = joint.parent;
         let xj = &x[j - 1];
@@ -477,14 +486,21 @@ pub struct Rnea<'g> {
 pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
     let n = model.dof();
     let k = kinematics(g, model, inputs);
-    let mut f: Vec<Force<'g>> = (1..=n).map(|j| BodyParams::input(g, j).wrench(&k.motion[j])).collect();
+    let mut f: Vec<Force<'g>> = (1..=n)
+        .map(|j| {
+            mark_body(g, model, j, "Newton–Euler wrench");
+            BodyParams::input(g, j).wrench(&k.motion[j])
+        })
+        .collect();
     // Backward pass: children first (regular labelling: higher index first).
     for j in (1..=n).rev() {
         let p = model.parent(j);
         if p > 0 {
+            mark_body(g, model, j, "wrench carried to the parent");
             f[p - 1] = f[p - 1] + k.x[j - 1].force_to_parent(f[j - 1]);
         }
     }
+    g.mark("joint torques");
     let tau = (1..=n).map(|j| f[j - 1].dot(subspace(g, model, j))).collect();
     Rnea { tau, wrenches: f }
 }
@@ -507,6 +523,7 @@ pub fn torque_regressor<'g>(
     let mut s: Vec<Vec<Option<Motion<'g>>>> = vec![vec![None; n + 1]; n + 1];
     let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![Vec::new(); n];
     for i in 1..=n {
+        mark_body(g, model, i, "regressor columns");
         let p = model.parent(i);
         for j in 1..i {
             s[i][j] = s[p][j].map(|sj| k.x[i - 1].motion_to_child(sj));
@@ -547,6 +564,7 @@ pub fn wrench_regressor<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Option<Expr<
     let k = kinematics(g, model, Inputs::Full);
     let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![vec![None; 10 * n]; 6 * n];
     for i in 1..=n {
+        mark_body(g, model, i, "regressor columns");
         for c in 0..10 {
             let mut w = BodyParams::unit(g, c).wrench(&k.motion[i]);
             let mut j = i;
@@ -570,11 +588,13 @@ pub fn wrench_regressor<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Option<Expr<
 /// symmetric; entries for joints on different branches are exact zeros).
 pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
     let n = model.dof();
+    g.mark("joint transforms");
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
     let mut composite: Vec<BodyParams<'g>> = (1..=n).map(|j| BodyParams::input(g, j)).collect();
     for i in (1..=n).rev() {
         let p = model.parent(i);
         if p > 0 {
+            mark_body(g, model, i, "composite inertia carried to the parent");
             let moved = composite_to_parent(&x[i - 1], &composite[i - 1]);
             let c = &mut composite[p - 1];
             *c = BodyParams {
@@ -586,6 +606,7 @@ pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
     }
     let mut m = vec![vec![g.zero(); n]; n];
     for i in 1..=n {
+        mark_body(g, model, i, "row and column of M");
         let si = subspace(g, model, i);
         let c = &composite[i - 1];
         // F = I_c S_i: the momentum of the composite body moving along S_i.
@@ -709,6 +730,7 @@ impl<'g> Inertia6<'g> {
 /// `tau` read from the `a` argument slot. One division per joint.
 pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     let n = model.dof();
+    g.mark("joint transforms");
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
     let s: Vec<Motion<'g>> = (1..=n).map(|j| subspace(g, model, j)).collect();
     // Pass 1: velocities, velocity-product accelerations, bias forces.
@@ -721,6 +743,7 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     }];
     let mut pa = vec![Force::zero(g)];
     for i in 1..=n {
+        mark_body(g, model, i, "velocity and bias force");
         let p = model.parent(i);
         let vj = s[i - 1].scale(g.input(ARG_V, (i - 1) as u32));
         let vi = x[i - 1].motion_to_child(v[p]) + vj;
@@ -735,6 +758,7 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     let mut inv_d = vec![g.zero(); n + 1];
     let mut u = vec![g.zero(); n + 1];
     for i in (1..=n).rev() {
+        mark_body(g, model, i, "articulated inertia");
         let ui = ia[i].apply(s[i - 1]);
         let d = ui.dot(s[i - 1]);
         let id = g.one() / d;
@@ -763,6 +787,7 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     }];
     let mut qdd = Vec::with_capacity(n);
     for i in 1..=n {
+        mark_body(g, model, i, "acceleration");
         let p = model.parent(i);
         let a_prime = x[i - 1].motion_to_child(acc[p]) + c[i];
         let qi = (u[i] - u_vec[i].dot(a_prime)) * inv_d[i];
@@ -772,7 +797,7 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     qdd
 }
 
-/// The paper's per-body model (DESIGN §5): for each body, `A_i` (6 × 4, row-major)
+/// The paper's per-body model (`docs/design.md`, "The generated algorithms"): for each body, `A_i` (6 × 4, row-major)
 /// with `[F; M] = A_i θ_i` in the body's centroidal principal frame:
 /// `A = blkdiag(a_c − g, B(ω, ω̇))`.
 pub fn body_regressors<'g>(g: &'g Graph, model: &Model) -> Vec<[[Expr<'g>; 4]; 6]> {
@@ -780,6 +805,7 @@ pub fn body_regressors<'g>(g: &'g Graph, model: &Model) -> Vec<[[Expr<'g>; 4]; 6
     let frames = dyngen_model::principal_frames(model);
     (1..=model.dof())
         .map(|i| {
+            mark_body(g, model, i, "regressor");
             let f = &frames[i - 1];
             let r = M3::constant(g, f.rotation);
             let c = V3::constant(g, f.com);
@@ -808,12 +834,14 @@ pub fn body_regressors<'g>(g: &'g Graph, model: &Model) -> Vec<[[Expr<'g>; 4]; 6
 pub fn body_resultants<'g>(g: &'g Graph, model: &Model) -> Vec<Force<'g>> {
     let n = model.dof();
     let r = rnea(g, model, Inputs::Full);
+    g.mark("joint transforms");
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
     let s = dyngen_model::graph::incidence(model);
     let c = dyngen_model::graph::body_joint_vectors(model);
     let frames = dyngen_model::principal_frames(model);
     (1..=n)
         .map(|i| {
+            mark_body(g, model, i, "resultant");
             let mut total = Force::zero(g);
             for a in 1..=n {
                 let sign = s[i][a - 1];

@@ -31,8 +31,10 @@ pub enum Output<'a> {
     Return(Assemble<'a>),
     /// Written through a final `out: &mut` argument, each output stored right after
     /// the statement that computes it, so large matrices neither tie up registers
-    /// until the end nor are copied.
-    InPlace(Place<'a>),
+    /// until the end nor are copied. `clear` sets all of `out` to zero in one
+    /// statement, after which only the outputs that are not structural zeros are
+    /// stored.
+    InPlace { place: Place<'a>, clear: TokenStream },
 }
 
 /// A function to emit: its signature pieces and symbolic outputs.
@@ -62,14 +64,90 @@ struct Stmt {
     node: Node,
 }
 
+/// Longest expression, in estimated characters, that a statement takes by writing
+/// operands inside it: it keeps each statement on one formatted line.
+const MAX_EXPR_CHARS: usize = 64;
+
+/// Which computed nodes are written inside the one expression that uses them rather
+/// than as a `let` of their own. Only single-use nodes are, so nothing is computed
+/// twice and the operations and their order are exactly those of one `let` per node
+/// (Rust does not contract `a * b + c` into a fused multiply-add): the values are
+/// bit-identical, the code is shorter.
+struct Inlined(std::collections::HashSet<NodeId>);
+
+impl Inlined {
+    fn new(graph: &Graph, stmts: &[Stmt], outputs: &[NodeId]) -> Inlined {
+        let mut uses: HashMap<NodeId, usize> = HashMap::new();
+        for s in stmts {
+            for op in operands(&s.node) {
+                *uses.entry(op).or_default() += 1;
+            }
+        }
+        for &o in outputs {
+            *uses.entry(o).or_default() += 2;
+        }
+        let mut chars: HashMap<NodeId, usize> = HashMap::new();
+        let mut inlined = std::collections::HashSet::new();
+        let atom = |id: NodeId| match graph.node(id) {
+            Node::Const(_) => 45,
+            Node::Input { .. } => 10,
+            _ => 6,
+        };
+        for s in stmts {
+            if s.defines.len() != 1 || matches!(s.node, Node::Sin(_) | Node::Cos(_)) {
+                continue;
+            }
+            let mut len = 3 * operands(&s.node).len();
+            for op in operands(&s.node) {
+                let own = atom(op);
+                match chars.get(&op) {
+                    Some(&inner) if uses.get(&op) == Some(&1) && len + inner + 2 <= MAX_EXPR_CHARS => {
+                        inlined.insert(op);
+                        len += inner + 2;
+                    }
+                    _ => len += own,
+                }
+            }
+            chars.insert(s.defines[0], len);
+        }
+        Inlined(inlined)
+    }
+
+    fn contains(&self, id: NodeId) -> bool {
+        self.0.contains(&id)
+    }
+
+    /// The operands `id`'s statement reads from other statements, inputs and
+    /// constants, through the nodes written inside it.
+    fn leaves(&self, graph: &Graph, node: &Node, out: &mut Vec<NodeId>) {
+        for op in operands(node) {
+            if self.contains(op) {
+                self.leaves(graph, &graph.node(op), out);
+            } else {
+                out.push(op);
+            }
+        }
+    }
+}
+
 /// Emits `spec` as an associated function (plus its parts, if split).
 pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (TokenStream, FnReport) {
-    let stmts = schedule(graph, &spec.outputs);
+    let scheduled = schedule(graph, &spec.outputs);
+    let inlined = Inlined::new(graph, &scheduled, &spec.outputs);
+    let stmts: Vec<Stmt> = scheduled
+        .into_iter()
+        .filter(|s| !(s.defines.len() == 1 && inlined.contains(s.defines[0])))
+        .collect();
     let ops = OpCount::of(graph, &spec.outputs);
     let fname = format_ident!("{}", spec.name);
-    let doc = spec.doc.lines();
+    // One attribute per line, so that prettyplease prints `///` lines.
+    let doc: Vec<String> = spec
+        .doc
+        .lines()
+        .map(|l| if l.is_empty() { String::new() } else { format!(" {l}") })
+        .collect();
     let ret = &spec.ret;
-    let in_place = matches!(spec.output, Output::InPlace(_));
+    let in_place = matches!(spec.output, Output::InPlace { .. });
     let (out_param, out_arg, ret_ty) = if in_place {
         (Some(quote!(out: &mut #ret)), Some(quote!(out)), quote!())
     } else {
@@ -107,29 +185,57 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     };
 
     // In place: the output slots of each computed node, and the stores of outputs
-    // that are constants or inputs (made up front).
+    // that are constants or inputs (made up front). A computed output stored in one
+    // place and used nowhere else is written straight there, without a `let`.
     let mut slots: HashMap<NodeId, Vec<usize>> = HashMap::new();
     let mut early_stores = Vec::new();
-    if let Output::InPlace(place) = &spec.output {
+    let mut direct: HashMap<NodeId, usize> = HashMap::new();
+    if let Output::InPlace { place, clear } = &spec.output {
         let computed: std::collections::HashSet<NodeId> =
             stmts.iter().flat_map(|s| s.defines.iter().copied()).collect();
         let names = Names {
             spill: &HashMap::new(),
             args: &spec.args,
+            inlined: &inlined,
         };
+        let is_zero = |o: NodeId| graph.node(o) == Node::Const(0.0f64.to_bits());
+        if spec.outputs.iter().any(|&o| is_zero(o)) {
+            early_stores.push(clear.clone());
+        }
         for (k, &o) in spec.outputs.iter().enumerate() {
             if computed.contains(&o) {
                 slots.entry(o).or_default().push(k);
-            } else {
+            } else if !is_zero(o) {
                 let (p, x) = (place(k), names.operand(graph, o));
                 early_stores.push(quote!(#p = #x;));
             }
         }
+        let mut used = std::collections::HashSet::new();
+        for s in &stmts {
+            let mut leaves = Vec::new();
+            inlined.leaves(graph, &s.node, &mut leaves);
+            used.extend(leaves);
+        }
+        for s in &stmts {
+            let d = s.defines[0];
+            if s.defines.len() == 1 && !used.contains(&d) {
+                if let Some([k]) = slots.get(&d).map(Vec::as_slice) {
+                    direct.insert(d, *k);
+                }
+            }
+        }
     }
-    let stores_after = |s: &Stmt| -> TokenStream {
-        let Output::InPlace(place) = &spec.output else {
-            return TokenStream::new();
+    let sections = Sections::new(graph);
+    let write = |s: &Stmt, names: &Names<'_>| -> TokenStream {
+        let Output::InPlace { place, .. } = &spec.output else {
+            return emit_stmt(graph, s, names);
         };
+        if let Some(&k) = direct.get(&s.defines[0]) {
+            let p = place(k);
+            let x = names.node_expr(graph, s.node).0;
+            return quote!(#p = #x;);
+        }
+        let st = emit_stmt(graph, s, names);
         let stores = s.defines.iter().flat_map(|d| {
             let x = var(*d);
             slots.get(d).into_iter().flatten().map(move |&k| {
@@ -137,25 +243,30 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
                 quote!(#p = #x;)
             })
         });
-        quote!(#(#stores)*)
+        quote!(#st #(#stores)*)
     };
 
     if chunks.len() == 1 {
         let names = Names {
             spill: &HashMap::new(),
             args: &spec.args,
+            inlined: &inlined,
         };
-        let body = chunks[0].iter().map(|s| {
-            let st = emit_stmt(graph, s, &names);
-            let stores = stores_after(s);
-            quote!(#st #stores)
-        });
+        let mut current = None;
+        let body: Vec<TokenStream> = chunks[0]
+            .iter()
+            .map(|s| {
+                let marker = sections.marker(s, &mut current);
+                let st = write(s, &names);
+                quote!(#marker #st)
+            })
+            .collect();
         let value = match &spec.output {
             Output::Return(assemble) => {
                 let outs: Vec<TokenStream> = spec.outputs.iter().map(|&o| names.operand(graph, o)).collect();
                 assemble(&outs)
             }
-            Output::InPlace(_) => TokenStream::new(),
+            Output::InPlace { .. } => TokenStream::new(),
         };
         let tokens = quote! {
             #(#[doc = #doc])*
@@ -180,6 +291,11 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             }
         }
     }
+    let reads = |s: &Stmt| {
+        let mut leaves = Vec::new();
+        inlined.leaves(graph, &s.node, &mut leaves);
+        leaves
+    };
     let mut spill: HashMap<NodeId, usize> = HashMap::new();
     let mark = |id: NodeId, spill: &mut HashMap<NodeId, usize>| {
         let next = spill.len();
@@ -187,7 +303,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     };
     for (c, chunk) in chunks.iter().enumerate() {
         for s in chunk.iter() {
-            for op in operands(&s.node) {
+            for op in reads(s) {
                 if defined_in.get(&op).is_some_and(|&d| d != c) {
                     mark(op, &mut spill);
                 }
@@ -206,15 +322,18 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let mut calls = Vec::new();
     for (c, chunk) in chunks.iter().enumerate() {
         let part = format_ident!("__{}_part{}", spec.name, c);
+        // Each part says which section it starts in.
+        let mut current = None;
         let local: HashMap<NodeId, usize> = HashMap::new();
         let names = Names {
             spill: &local,
             args: &spec.args,
+            inlined: &inlined,
         };
         // Loads of values defined in earlier parts.
         let mut loads: Vec<NodeId> = chunk
             .iter()
-            .flat_map(|s| operands(&s.node))
+            .flat_map(reads)
             .filter(|op| defined_in.get(op).is_some_and(|&d| d < c))
             .collect();
         loads.sort_unstable();
@@ -224,11 +343,14 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             let k = usize_lit(spill[&id]);
             quote!(let #x = w[#k];)
         });
-        let body = chunk.iter().map(|s| {
-            let st = emit_stmt(graph, s, &names);
-            let stores = stores_after(s);
-            quote!(#st #stores)
-        });
+        let body: Vec<TokenStream> = chunk
+            .iter()
+            .map(|s| {
+                let marker = sections.marker(s, &mut current);
+                let st = write(s, &names);
+                quote!(#marker #st)
+            })
+            .collect();
         let spills = chunk.iter().flat_map(|s| s.defines.iter()).filter_map(|id| {
             spill.get(id).map(|&k| {
                 let k = usize_lit(k);
@@ -253,6 +375,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             let names = Names {
                 spill: &spill,
                 args: &spec.args,
+                inlined: &inlined,
             };
             let outs: Vec<TokenStream> = spec
                 .outputs
@@ -267,7 +390,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
                 .collect();
             assemble(&outs)
         }
-        Output::InPlace(_) => TokenStream::new(),
+        Output::InPlace { .. } => TokenStream::new(),
     };
     let tokens = quote! {
         #(#[doc = #doc])*
@@ -282,6 +405,63 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         #(#parts)*
     };
     (tokens, report)
+}
+
+/// The graph's sections ([`Graph::mark`]), to say in the code where each starts.
+struct Sections {
+    marks: Vec<(NodeId, String)>,
+}
+
+impl Sections {
+    fn new(graph: &Graph) -> Sections {
+        Sections {
+            marks: graph.sections(),
+        }
+    }
+
+    /// A marker statement before `s` when `s` opens a section other than `current`.
+    /// The marker is a string-literal statement: it compiles to nothing, survives
+    /// prettyplease (which drops comments), and [`comment_markers`] turns it into a
+    /// `//` comment in the written file.
+    fn marker(&self, s: &Stmt, current: &mut Option<usize>) -> TokenStream {
+        let k = self.marks.partition_point(|(start, _)| *start <= s.defines[0]);
+        let Some(k) = k.checked_sub(1) else {
+            return TokenStream::new();
+        };
+        if *current == Some(k) {
+            return TokenStream::new();
+        }
+        *current = Some(k);
+        let label = &self.marks[k].1;
+        quote!(#label;)
+    }
+}
+
+/// Turns the section markers of emitted code (`"label";` alone on a line, as
+/// prettyplease prints them) into `// label` comments after a blank line.
+pub fn comment_markers(pretty: &str) -> String {
+    let mut out = String::with_capacity(pretty.len());
+    for line in pretty.lines() {
+        let body = line.trim_start();
+        let label = body
+            .strip_prefix('"')
+            .and_then(|b| b.strip_suffix("\";"))
+            .filter(|l| !l.contains(['"', '\\']));
+        match label {
+            Some(label) => {
+                let indent = &line[..line.len() - body.len()];
+                if !out.ends_with("{\n") {
+                    out.push('\n');
+                }
+                out.push_str(&format!("{indent}// {label}\n"));
+            }
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    out
 }
 
 fn operands(node: &Node) -> Vec<NodeId> {
@@ -342,9 +522,73 @@ fn var(id: NodeId) -> Ident {
 struct Names<'a> {
     spill: &'a HashMap<NodeId, usize>,
     args: &'a [Arg],
+    inlined: &'a Inlined,
 }
 
+/// Binding strength of an emitted expression: sums, products, negations, atoms.
+const SUM: u8 = 1;
+const PRODUCT: u8 = 2;
+const UNARY: u8 = 3;
+const ATOM: u8 = 4;
+
 impl Names<'_> {
+    /// The expression computing `node`, with the operands written inside it in
+    /// parentheses where Rust's precedence and left-to-right grouping would otherwise
+    /// change the order of operations; and how strongly it binds.
+    fn node_expr(&self, graph: &Graph, node: Node) -> (TokenStream, u8) {
+        let op = |id: NodeId, min: u8| {
+            let (e, p) = self.inner(graph, id);
+            if p < min {
+                quote!((#e))
+            } else {
+                e
+            }
+        };
+        match node {
+            // The right operand of `-` and `/` (and, to keep the graph's grouping
+            // exactly, of `+` and `*`) must bind more strongly than the operator.
+            Node::Add(a, b) => {
+                let (a, b) = (op(a, SUM), op(b, PRODUCT));
+                (quote!(#a + #b), SUM)
+            }
+            Node::Sub(a, b) => {
+                let (a, b) = (op(a, SUM), op(b, PRODUCT));
+                (quote!(#a - #b), SUM)
+            }
+            Node::Mul(a, b) => {
+                let (a, b) = (op(a, PRODUCT), op(b, UNARY));
+                (quote!(#a * #b), PRODUCT)
+            }
+            Node::Div(a, b) => {
+                let (a, b) = (op(a, PRODUCT), op(b, UNARY));
+                (quote!(#a / #b), PRODUCT)
+            }
+            Node::Neg(a) => {
+                let a = op(a, ATOM);
+                (quote!(-#a), UNARY)
+            }
+            Node::Sin(a) => {
+                let a = op(a, SUM);
+                (quote!(::dyngen::Scalar::sin(#a)), ATOM)
+            }
+            Node::Cos(a) => {
+                let a = op(a, SUM);
+                (quote!(::dyngen::Scalar::cos(#a)), ATOM)
+            }
+            Node::Const(_) | Node::Input { .. } => (TokenStream::new(), ATOM),
+        }
+    }
+
+    /// An operand: written out if it is inlined, else by name.
+    fn inner(&self, graph: &Graph, id: NodeId) -> (TokenStream, u8) {
+        if self.inlined.contains(id) {
+            return self.node_expr(graph, graph.node(id));
+        }
+        let e = self.operand(graph, id);
+        // A negative constant is `from_f64(-x)`, a call: an atom.
+        (e, ATOM)
+    }
+
     fn operand(&self, graph: &Graph, id: NodeId) -> TokenStream {
         match graph.node(id) {
             Node::Const(bits) => constant(f64::from_bits(bits)),
@@ -377,7 +621,7 @@ pub fn constant(x: f64) -> TokenStream {
     if x == 0.0 {
         return quote!(<S as ::dyngen::Scalar>::ZERO);
     }
-    let lit = Literal::f64_unsuffixed(x.abs());
+    let lit = float_literal(x.abs());
     if x.is_sign_negative() && x != 0.0 {
         quote!(<S as ::dyngen::Scalar>::from_f64(-#lit))
     } else {
@@ -386,43 +630,18 @@ pub fn constant(x: f64) -> TokenStream {
 }
 
 fn emit_stmt(graph: &Graph, s: &Stmt, names: &Names<'_>) -> TokenStream {
-    let op = |id: NodeId| names.operand(graph, id);
     let x = var(s.defines[0]);
     match s.node {
-        Node::Add(a, b) => {
-            let (a, b) = (op(a), op(b));
-            quote!(let #x = #a + #b;)
-        }
-        Node::Sub(a, b) => {
-            let (a, b) = (op(a), op(b));
-            quote!(let #x = #a - #b;)
-        }
-        Node::Mul(a, b) => {
-            let (a, b) = (op(a), op(b));
-            quote!(let #x = #a * #b;)
-        }
-        Node::Div(a, b) => {
-            let (a, b) = (op(a), op(b));
-            quote!(let #x = #a / #b;)
-        }
-        Node::Neg(a) => {
-            let a = op(a);
-            quote!(let #x = -#a;)
-        }
         Node::Sin(a) if s.defines.len() == 2 => {
             let c = var(s.defines[1]);
-            let a = op(a);
+            let a = names.operand(graph, a);
             quote!(let (#x, #c) = ::dyngen::Scalar::sin_cos(#a);)
         }
-        Node::Sin(a) => {
-            let a = op(a);
-            quote!(let #x = ::dyngen::Scalar::sin(#a);)
-        }
-        Node::Cos(a) => {
-            let a = op(a);
-            quote!(let #x = ::dyngen::Scalar::cos(#a);)
-        }
         Node::Const(_) | Node::Input { .. } => TokenStream::new(),
+        node => {
+            let e = names.node_expr(graph, node).0;
+            quote!(let #x = #e;)
+        }
     }
 }
 
@@ -431,9 +650,20 @@ pub fn usize_lit(n: usize) -> Literal {
     Literal::usize_unsuffixed(n)
 }
 
+/// An unsuffixed float literal spelling `x` (finite, not negative) with the fewest
+/// digits that read back as exactly `x` (`{:?}`, with an exponent for very large or
+/// small magnitudes). Nothing is rounded here to look nicer: a constant such as
+/// `0.0018913546875000001` is the value the description wrote or the model's own
+/// arithmetic produced, and printing a shorter neighbour would change the results.
+/// The one place where rounding noise is removed is the base-parameter analysis,
+/// whose factorisation error is far larger than the snap (`base::clean`).
+fn float_literal(x: f64) -> Literal {
+    format!("{x:?}").parse().unwrap_or_else(|_| Literal::f64_unsuffixed(x))
+}
+
 /// An `f64` literal for constant tables (no scalar conversion).
 pub fn f64_lit(x: f64) -> TokenStream {
-    let lit = Literal::f64_unsuffixed(x.abs());
+    let lit = float_literal(x.abs());
     if x.is_sign_negative() && x != 0.0 {
         quote!(-#lit)
     } else {

@@ -2,7 +2,9 @@
 //!
 //! Turns a robot description into specialised, unrolled Rust. One pipeline, three
 //! front doors (the `robot!` macro, `build.rs`, the command line):
-//! **front end → checked model → symbolic graph → emitted code**.
+//! **front end → checked model → base-parameter analysis → symbolic graph → emitted
+//! code**. Each front door checks the model, calls [`analyse_model`] and hands both
+//! to [`generate`].
 //!
 //! In `build.rs`:
 //! ```no_run
@@ -18,6 +20,7 @@ pub mod emit;
 mod generate;
 pub mod sym;
 
+pub use base::{analyse_model, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
 pub use generate::{generate, is_type_name, principal_param_names, standard_param_names, Generated, Options};
 
@@ -57,7 +60,8 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
             (model, Some(path))
         }
     };
-    let generated = generate(&model, &name, &Options::default());
+    let bases = base::analyse_model(&model);
+    let generated = generate(&model, &name, &bases, &Options::default());
     let tokens = generated.tokens;
     // Make the crate rebuild when the URDF changes.
     let watch = rebuild_on.map(|p| {

@@ -33,6 +33,8 @@ pub enum Node {
 pub struct Graph {
     nodes: RefCell<Vec<Node>>,
     index: RefCell<HashMap<Node, NodeId>>,
+    /// Section labels by the first node built after them (see [`Graph::mark`]).
+    marks: RefCell<Vec<(NodeId, String)>>,
 }
 
 /// A handle to a node: cheap to copy, with arithmetic operators that fold as they
@@ -97,6 +99,25 @@ impl Graph {
 
     pub fn expr(&self, id: NodeId) -> Expr<'_> {
         Expr { graph: self, id }
+    }
+
+    /// Starts a labelled section: nodes built from now on belong to it, so emitted
+    /// code can say where, e.g., a body's recursion starts. Since ids are evaluation
+    /// order, sections are contiguous runs of statements; a node built earlier and
+    /// only reused here stays in its own section.
+    pub fn mark(&self, label: impl Into<String>) {
+        let at = NodeId::try_from(self.len()).unwrap_or(NodeId::MAX);
+        let mut marks = self.marks.borrow_mut();
+        // A section in which nothing was built is replaced, not kept empty.
+        if marks.last().is_some_and(|(start, _)| *start == at) {
+            marks.pop();
+        }
+        marks.push((at, label.into()));
+    }
+
+    /// The sections in order: each label with the first node id built in it.
+    pub fn sections(&self) -> Vec<(NodeId, String)> {
+        self.marks.borrow().clone()
     }
 
     /// Evaluates every node reachable from `outputs`, reading inputs through `input`.

@@ -1,7 +1,7 @@
 //! The [`Robot`] trait every generated robot type implements, and the small spatial
 //! types of its API.
 
-use crate::Scalar;
+use crate::{RobotModel, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// A body's pose in the base frame: `x_base = rotation · x_body + translation`.
@@ -88,6 +88,9 @@ pub trait Robot {
     const NBASE: usize;
     /// Base parameters of the principal parameterisation.
     const NBASE_PRINCIPAL: usize;
+    /// The checked model the code was generated from (fixed joints merged), in the
+    /// generated numbering: `MODEL.joints[j - 1]` carries `MODEL.bodies[j - 1]`.
+    const MODEL: RobotModel;
 
     /// Joint names, joint 1 first.
     fn joint_names() -> &'static [&'static str];

@@ -1,7 +1,7 @@
 //! Shared helpers of dyngen's cross-crate tests: the reference model of a generated
 //! robot, Pinocchio fixtures, and error measures.
 
-/// UR5 generated with every function split into parts of at most 100 statements
+/// UR5 generated with every function split into parts of at most 40 statements
 /// (see `build.rs`).
 pub mod split {
     include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
@@ -98,6 +98,35 @@ impl FixturePose {
 }
 
 /// The workspace root.
+/// The checked model of the robot a robot crate's source declares, with its type
+/// name: the `robot!` invocation in `robots/<dir>/src/lib.rs` (inline description or
+/// `urdf: "path"`), or, for a crate generated in `build.rs`, the URDF `urdf`.
+pub fn robot_crate_model(dir: &str) -> (String, dyngen_model::Model) {
+    let crate_dir = workspace_root().join("robots").join(dir);
+    let path = crate_dir.join("src/lib.rs");
+    let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let file = syn::parse_file(&source).expect("robot crate parses");
+    let tokens = file.items.iter().find_map(|item| match item {
+        syn::Item::Macro(m) if m.mac.path.segments.last().is_some_and(|s| s.ident == "robot") => {
+            Some(m.mac.tokens.clone())
+        }
+        _ => None,
+    });
+    let Some(tokens) = tokens else {
+        let urdf = crate_dir.join(format!("{dir}.urdf"));
+        let model = dyngen_model::load_urdf(&urdf).unwrap_or_else(|e| panic!("{e}"));
+        return (String::new(), model);
+    };
+    let input = dyngen_codegen::dsl::parse(tokens).expect("description parses");
+    let model = match input.source {
+        dyngen_codegen::RobotSource::Dsl(d) => d.build().expect("description is valid"),
+        dyngen_codegen::RobotSource::Urdf(lit) => {
+            dyngen_model::load_urdf(&crate_dir.join(lit.value())).unwrap_or_else(|e| panic!("{e}"))
+        }
+    };
+    (input.name.to_string(), model)
+}
+
 pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()

@@ -199,15 +199,15 @@ fn base_parameters_are_confirmed_by_a_second_seed() {
     fn confirm<R: Robot>() {
         let mut model = dyngen_model::parse_urdf(R::urdf()).expect("URDF parses");
         model.gravity = R::gravity();
-        let g = dyngen_codegen::generate(&model, "Check", &dyngen_codegen::Options::default());
+        let g = dyngen_codegen::analyse_model(&model);
         assert!(
-            g.base.confirmed && g.principal_base.confirmed,
+            g.standard.confirmed && g.principal.confirmed,
             "{}: the second seed disagrees",
             R::NAME
         );
-        assert_eq!(g.base.independent, R::base_index(), "{}", R::NAME);
-        assert_eq!(g.principal_base.independent, R::principal_base_index(), "{}", R::NAME);
-        assert_eq!(g.base.groupings, R::base_groupings(), "{}", R::NAME);
+        assert_eq!(g.standard.independent, R::base_index(), "{}", R::NAME);
+        assert_eq!(g.principal.independent, R::principal_base_index(), "{}", R::NAME);
+        assert_eq!(g.standard.groupings, R::base_groupings(), "{}", R::NAME);
     }
     confirm::<Planar2>();
     confirm::<Paper6>();

@@ -20,7 +20,7 @@ fn the_functions_compared_are_split() {
         .contains(&name)
         {
             assert!(
-                ops.statements > 100,
+                ops.statements > 40,
                 "{name} has only {} statements: not split",
                 ops.statements
             );

@@ -414,7 +414,7 @@ impl Trajectory {
     }
 
     /// [`Trajectory::with_derivatives`] for time stamps that are not uniform (a
-    /// jittered logger): the signal to differentiate is interpolated ([`hermite`])
+    /// jittered logger): the signal to differentiate is interpolated (cubic Hermite)
     /// onto a uniform grid of as many samples from `t[0]` to `t[n−1]`, filtered and
     /// differentiated there exactly as by [`Trajectory::with_derivatives`], and the
     /// derivatives are interpolated back to the log's own time stamps. (Filtering

@@ -3,6 +3,13 @@
 //! by MIM from joint wrenches.
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use dyngen_identify::data::{Recipe, Trajectory};
+use dyngen_reference::Dynamics;
+use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate, Options};
+use dyngen_identify::mim::{self, MimEstimate, MimOptions};
+use dyngen_identify::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
+use dyngen_identify::simulate::Recording;
+use dyngen_reference::Reference;
 use dyngen_codegen::standard_param_names;
 use dyngen_identify::data::{read_csv, Trajectory};
 use dyngen_identify::mim::{self, MimEstimate, MimOptions};
@@ -27,6 +34,14 @@ Examples:
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them.
+Other layouts (no header, other names and order, semicolons, degrees, motor
+currents, sign flips, time in ms) are read through a recipe file (--recipe) or the
+flags for the common cases; duplicate time stamps are dropped and counted, irregular
+ones used as they are or resampled (--resample), and a summary says what was
+measured and what estimated:
+  dyngen identify robots/ur5/ur5.urdf robot.log --recipe docs/example.recipe
+  dyngen identify robots/ur5/ur5.urdf log.csv --no-header --delimiter semicolon \\
+      --degrees --gains 0.11,0.11,0.11,0.05,0.05,0.05 --window 5:65 --resample 0.01
 --mode mim also needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, … (what
 `dyngen simulate` writes).
 
@@ -114,6 +129,9 @@ pub struct IdentifyArgs {
     #[command(flatten)]
     pub gravity: GravityArg,
 
+    #[command(flatten)]
+    pub recipe: RecipeArgs,
+
     /// Write the estimate as JSON (schema dyngen-parameters/1) to this file.
     #[arg(long, value_name = "FILE")]
     pub params_json: Option<PathBuf>,
@@ -143,6 +161,83 @@ pub struct IdentifyArgs {
     pub force: bool,
 }
 
+/// How to read a recording that is not in dyngen's own CSV schema: a recipe file,
+/// and flags for the common cases (they override the file's settings).
+#[derive(Debug, Default, clap::Args)]
+pub struct RecipeArgs {
+    /// Read the recording through this recipe: `key = value` lines giving the
+    /// delimiter, header, columns, units, gains, signs, windows, … (see the README).
+    #[arg(long, value_name = "FILE")]
+    pub recipe: Option<PathBuf>,
+
+    /// The recording has no header line: columns in the order dyngen writes them
+    /// (t, q…, [v…, a…,] tau…), or as the recipe's `time`, `q`, `tau` say.
+    #[arg(long)]
+    pub no_header: bool,
+
+    /// Field separator: comma, semicolon, tab or whitespace.
+    #[arg(long, value_name = "SEP")]
+    pub delimiter: Option<String>,
+
+    /// Joint positions (and velocities) are in degrees.
+    #[arg(long)]
+    pub degrees: bool,
+
+    /// The torque columns hold motor currents: torque = k·current with these
+    /// torque constants (N·m/A), one for all joints or one per joint.
+    #[arg(long, value_name = "K1,K2,…", allow_hyphen_values = true)]
+    pub gains: Option<String>,
+
+    /// Interpolate onto a uniform grid of this step (s) instead of using irregular
+    /// time stamps as they are.
+    #[arg(long, value_name = "DT")]
+    pub resample: Option<String>,
+
+    /// Use only the samples with t0 ≤ t ≤ t1 (s); either end may be left out.
+    #[arg(long, value_name = "T0:T1", allow_hyphen_values = true)]
+    pub window: Option<String>,
+
+    /// Keep every N-th sample.
+    #[arg(long, value_name = "N")]
+    pub decimate: Option<String>,
+}
+
+impl RecipeArgs {
+    /// The recipe: the file's (or the default), then the flags.
+    pub fn recipe(&self) -> Result<Recipe> {
+        let mut recipe = match &self.recipe {
+            Some(path) => Recipe::from_file(path).map_err(|e| format!("{}: {e}", path.display()))?,
+            None => Recipe::default(),
+        };
+        let flags = [
+            ("--no-header", "header", self.no_header.then_some("false")),
+            ("--delimiter", "delimiter", self.delimiter.as_deref()),
+            ("--degrees", "units", self.degrees.then_some("deg")),
+            ("--gains", "gains", self.gains.as_deref()),
+            ("--resample", "resample", self.resample.as_deref()),
+            ("--window", "window", self.window.as_deref()),
+            ("--decimate", "decimate", self.decimate.as_deref()),
+        ];
+        for (flag, key, value) in flags {
+            if let Some(value) = value {
+                recipe.set(key, value).map_err(|e| format!("{flag}: {e}"))?;
+            }
+        }
+        recipe.check().map_err(|e| format!("recipe: {e}"))?;
+        Ok(recipe)
+    }
+}
+
+/// Reads a recording through the recipe the flags describe, estimates what it does
+/// not measure, and prints what was done.
+pub fn load_recording(path: &Path, recipe: &RecipeArgs, dof: usize, cutoff: f64) -> Result<Trajectory> {
+    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", path.display());
+    let loaded = recipe.recipe()?.read(path, Some(dof)).map_err(data_err)?;
+    let loaded = loaded.with_derivatives(cutoff).map_err(data_err)?;
+    println!("{}: {}", path.display(), loaded.report);
+    Ok(loaded.trajectory)
+}
+
 pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if !(args.cutoff.is_finite() && args.cutoff > 0.0) {
         return Err(format!(
@@ -165,22 +260,13 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
     let n = model.dof();
-    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", args.data.display());
-    let mut traj = read_csv(&args.data, Some(n)).map_err(data_err)?;
+    let traj = load_recording(&args.data, &args.recipe, n, args.cutoff)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
         return Err(format!(
             "{}: --mode mim needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, mz{n}, which the file \
              does not have; identify from the joint torques with --mode standard or principal instead",
             args.data.display()
         ));
-    }
-    if traj.velocities().is_none() || traj.accelerations().is_none() {
-        eprintln!(
-            "{} has no velocities or accelerations: estimating them from positions (low-pass at {} Hz)",
-            args.data.display(),
-            args.cutoff
-        );
-        traj = traj.with_derivatives(args.cutoff).map_err(data_err)?;
     }
     println!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
     let identified = match args.mode {

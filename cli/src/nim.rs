@@ -4,10 +4,13 @@
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
 use clap::{Args, Subcommand};
-use dyngen_identify::data::{read_csv, Trajectory};
+use dyngen_identify::data::Trajectory;
 use dyngen_identify::mim;
-use dyngen_identify::report;
+use dyngen_nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
+use dyngen_reference::{principal_params_to_standard, SplitMix64};
+use dyngen_identify::report::{self, ParameterReport};
 use dyngen_identify::simulate::{record_trajectory, Recording, SampledMotion};
+use dyngen_reference::Reference;
 use dyngen_model::Model;
 use dyngen_nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
 use dyngen_reference::Reference;
@@ -84,6 +87,9 @@ pub struct TrainArgs {
     /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
     #[arg(long, default_value_t = 10.0)]
     pub cutoff: f64,
+    /// Read the recording through this recipe (layout, units, windows; see the README).
+    #[arg(long, value_name = "FILE")]
+    pub recipe: Option<PathBuf>,
     /// Also write the training curves (MSE against step, per body) as SVG.
     #[arg(long, value_name = "FILE")]
     pub loss_svg: Option<PathBuf>,
@@ -113,6 +119,9 @@ pub struct PredictArgs {
     /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
     #[arg(long, default_value_t = 10.0)]
     pub cutoff: f64,
+    /// Read the recording through this recipe (layout, units, windows; see the README).
+    #[arg(long, value_name = "FILE")]
+    pub recipe: Option<PathBuf>,
     #[command(flatten)]
     pub gravity: GravityArg,
 }
@@ -124,18 +133,13 @@ pub fn run(args: &NimArgs, progress: &Progress) -> Result<()> {
     }
 }
 
-/// A CSV with v and a (estimated when missing, with a note on stderr).
-fn read_data(path: &Path, model: &Model, cutoff: f64) -> Result<Trajectory> {
-    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", path.display());
-    let traj = read_csv(path, Some(model.dof())).map_err(data_err)?;
-    if traj.velocities().is_some() && traj.accelerations().is_some() {
-        return Ok(traj);
-    }
-    eprintln!(
-        "{} has no velocities or accelerations: estimating them from positions (low-pass at {cutoff} Hz)",
-        path.display()
-    );
-    traj.with_derivatives(cutoff).map_err(data_err)
+/// A recording with v and a (estimated when missing), read through `recipe` if given.
+fn read_data(path: &Path, model: &Model, cutoff: f64, recipe: Option<&Path>) -> Result<Trajectory> {
+    let recipe = crate::identify::RecipeArgs {
+        recipe: recipe.map(Path::to_path_buf),
+        ..Default::default()
+    };
+    crate::identify::load_recording(path, &recipe, model.dof(), cutoff)
 }
 
 fn nim_error(path: &Path, e: NimError) -> String {
@@ -154,7 +158,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         check_overwrite(svg, args.force)?;
     }
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
-    let traj = read_data(&args.motion, &model, args.cutoff)?;
+    let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
     let motion = SampledMotion::from_data(&traj).ok_or("the motion has no velocities or accelerations")?;
     let robot = Reference::new(&model);
     let nominal = mim::true_theta(&model);
@@ -313,7 +317,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
             body_names.join(", ")
         ));
     }
-    let traj = read_data(&args.data, &model, args.cutoff)?;
+    let traj = read_data(&args.data, &model, args.cutoff, args.recipe.as_deref())?;
     if traj.joint_wrenches().is_none() {
         return Err(format!(
             "{}: NIM reads each body's resultant from the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, \

@@ -9,6 +9,8 @@
 //! matrix product per block of rows and factored at the end (the normal equations:
 //! faster, but it squares the condition number).
 
+use std::sync::OnceLock;
+
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::qr::no_pivoting::factor as qr;
@@ -256,12 +258,13 @@ impl Accumulator {
                     break;
                 }
             }
-            let full: Vec<&mut Block> = self
-                .blocks
-                .iter_mut()
-                .filter(|b| 2 * b.pending.len() >= fold_at * (p + 1))
-                .collect();
-            fold_all(full, p, self.accumulation);
+            let ready = |b: &Block| 2 * b.pending.len() >= fold_at * (p + 1);
+            // Rows pushed one at a time reach this point once per row: only build
+            // the list (and go to the thread pool) when there is something to fold.
+            if self.blocks.iter().any(ready) {
+                let full: Vec<&mut Block> = self.blocks.iter_mut().filter(|b| ready(b)).collect();
+                fold_all(full, p, self.accumulation);
+            }
         }
         self.rows += k;
         Ok(())
@@ -314,12 +317,17 @@ fn fold_rows(p: usize) -> usize {
     (8 * (p + 1)).max(1024)
 }
 
+/// The machine's core count, asked once: `available_parallelism` reads cgroup files
+/// on every call, far too slow for a path taken once per pushed row.
+fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |t| t.get()))
+}
+
 /// Folds the pending rows of every block, spreading the blocks over the machine's
 /// cores; each block's result does not depend on which thread folds it.
 fn fold_all(mut blocks: Vec<&mut Block>, p: usize, accumulation: Accumulation) {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(blocks.len());
+    let threads = cores().min(blocks.len());
     let fold_block = |b: &mut Block| match accumulation {
         Accumulation::Qr => fold(b, p),
         Accumulation::NormalEquations => add_gram(b, p),

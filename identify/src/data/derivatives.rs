@@ -235,6 +235,147 @@ pub fn second_difference(x: &[f64], dt: f64) -> Result<Vec<f64>, DataError> {
     Ok(d)
 }
 
+/// Finite-difference weights at `z` for the nodes `x` (at most 4), derivatives 0..=2:
+/// `w[k][j]` multiplies the value at `x[j]` in the `k`-th derivative (Fornberg's
+/// recursion, exact for polynomials of degree < `x.len()`). On a uniform grid it
+/// gives the classical stencils of [`central_difference`] and [`second_difference`].
+fn stencil(z: f64, x: &[f64]) -> [[f64; 4]; 3] {
+    let mut c = [[0.0; 4]; 3];
+    c[0][0] = 1.0;
+    let mut c1 = 1.0;
+    let mut c4 = x[0] - z;
+    for i in 1..x.len() {
+        let mn = i.min(2);
+        let mut c2 = 1.0;
+        let c5 = c4;
+        c4 = x[i] - z;
+        for j in 0..i {
+            let c3 = x[i] - x[j];
+            c2 *= c3;
+            if j == i - 1 {
+                for k in (1..=mn).rev() {
+                    c[k][i] = c1 * (k as f64 * c[k - 1][i - 1] - c5 * c[k][i - 1]) / c2;
+                }
+                c[0][i] = -c1 * c5 * c[0][i - 1] / c2;
+            }
+            for k in (1..=mn).rev() {
+                c[k][j] = (c4 * c[k][j] - k as f64 * c[k - 1][j]) / c3;
+            }
+            c[0][j] = c4 * c[0][j] / c3;
+        }
+        c1 = c2;
+    }
+    c
+}
+
+fn check_grid(t: &[f64], x: &[f64], needed: usize) -> Result<(), DataError> {
+    if t.len() != x.len() {
+        return Err(DataError::LengthMismatch {
+            what: "x",
+            expected: t.len(),
+            found: x.len(),
+        });
+    }
+    check_finite(t)?;
+    check_finite(x)?;
+    if x.len() < needed {
+        return Err(DataError::TooFewSamples { found: x.len(), needed });
+    }
+    match t.windows(2).position(|w| w[1] <= w[0]) {
+        None => Ok(()),
+        Some(k) => Err(DataError::NonMonotonicTime {
+            at: Location::Sample(k + 1),
+            t: t[k + 1],
+            previous: t[k],
+        }),
+    }
+}
+
+/// The derivative of `x` sampled at strictly increasing times `t` (any spacing), by
+/// three-point finite differences: at `t[k]` from `t[k−1], t[k], t[k+1]` inside,
+/// from the first or last three samples at the ends. Second-order accurate (exact on
+/// quadratics); on a uniform grid the same stencils as [`central_difference`]. With
+/// exactly 2 samples both values are the forward difference.
+///
+/// Errors: lengths differ, fewer than 2 samples, `t` not strictly increasing, a
+/// non-finite value.
+pub fn nonuniform_difference(t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
+    check_grid(t, x, 2)?;
+    let n = x.len();
+    if n == 2 {
+        let d = (x[1] - x[0]) / (t[1] - t[0]);
+        return Ok(vec![d, d]);
+    }
+    Ok((0..n)
+        .map(|k| {
+            let s = k.clamp(1, n - 2) - 1;
+            let w = stencil(t[k], &t[s..s + 3]);
+            (0..3).map(|j| w[1][j] * x[s + j]).sum()
+        })
+        .collect())
+}
+
+/// The second derivative of `x` sampled at strictly increasing times `t` (any
+/// spacing): three points `t[k−1], t[k], t[k+1]` inside, the first or last four at
+/// the ends (so that the ends are as accurate as the inside on a uniform grid, where
+/// these are the stencils of [`second_difference`]). With exactly 3 samples all
+/// values are the three-point one at the middle sample.
+///
+/// Errors: lengths differ, fewer than 3 samples, `t` not strictly increasing, a
+/// non-finite value.
+pub fn nonuniform_second_difference(t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
+    check_grid(t, x, 3)?;
+    let n = x.len();
+    let apply = |k: usize, s: usize, len: usize| -> f64 {
+        let w = stencil(t[k], &t[s..s + len]);
+        (0..len).map(|j| w[2][j] * x[s + j]).sum()
+    };
+    if n == 3 {
+        return Ok(vec![apply(1, 0, 3); 3]);
+    }
+    Ok((0..n)
+        .map(|k| match k {
+            0 => apply(0, 0, 4),
+            k if k == n - 1 => apply(k, n - 4, 4),
+            k => apply(k, k - 1, 3),
+        })
+        .collect())
+}
+
+/// For each time of `grid` (increasing), the interval `[t[k], t[k+1]]` of `t` holding
+/// it and the position in it, `0..=1` (clamped outside `t`).
+pub(super) fn intervals(t: &[f64], grid: &[f64]) -> Vec<(usize, f64)> {
+    let mut k = 0;
+    grid.iter()
+        .map(|&g| {
+            while k + 2 < t.len() && t[k + 1] <= g {
+                k += 1;
+            }
+            let s = ((g - t[k]) / (t[k + 1] - t[k])).clamp(0.0, 1.0);
+            (k, s)
+        })
+        .collect()
+}
+
+/// Cubic Hermite interpolation of `y` (sampled at `t`) at the points `at`
+/// ([`intervals`]), slopes from [`nonuniform_difference`]: exact on quadratics and
+/// continuous in value and slope, so that derivatives taken afterwards do not see
+/// the kinks linear interpolation would put at every sample.
+pub(super) fn hermite(t: &[f64], y: &[f64], at: &[(usize, f64)]) -> Result<Vec<f64>, DataError> {
+    let m = nonuniform_difference(t, y)?;
+    Ok(at
+        .iter()
+        .map(|&(k, s)| {
+            let h = t[k + 1] - t[k];
+            let (s2, s3) = (s * s, s * s * s);
+            (2.0 * s3 - 3.0 * s2 + 1.0) * y[k]
+                + (s3 - 2.0 * s2 + s) * h * m[k]
+                + (-2.0 * s3 + 3.0 * s2) * y[k + 1]
+                + (s3 - s2) * h * m[k + 1]
+        })
+        .collect())
+}
+
 /// Per joint column of a row-major `len × dof` array: `f(F(column))`, `F` the filter.
 fn filtered(
     values: &[f64],
@@ -270,6 +411,68 @@ impl Trajectory {
             }
         }
         Ok(nominal)
+    }
+
+    /// [`Trajectory::with_derivatives`] for time stamps that are not uniform (a
+    /// jittered logger): the signal to differentiate is interpolated (cubic Hermite)
+    /// onto a uniform grid of as many samples from `t[0]` to `t[n−1]`, filtered and
+    /// differentiated there exactly as by [`Trajectory::with_derivatives`], and the
+    /// derivatives are interpolated back to the log's own time stamps. (Filtering
+    /// the samples as if they were uniform would instead read the jitter as motion.)
+    /// `q` and `tau` are kept as they are.
+    ///
+    /// Errors: `cutoff_hz` not in `(0, 1 / (2 Δt̄))` for the mean step `Δt̄`, fewer
+    /// than 3 samples when `a` is computed from `q`.
+    pub fn with_derivatives_nonuniform(&self, cutoff_hz: f64) -> Result<Trajectory, DataError> {
+        let t = self.t();
+        let n = t.len();
+        let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+        check_cutoff(dt, cutoff_hz)?;
+        let dof = self.dof();
+        let grid: Vec<f64> = (0..n)
+            .map(|k| if k + 1 == n { t[n - 1] } else { t[0] + k as f64 * dt })
+            .collect();
+        let to_grid = intervals(t, &grid);
+        let back = intervals(&grid, t);
+        // Column `j` of `values`, on the grid, filtered; then `d` of it, back on `t`.
+        let derive = |values: &[f64], j: usize, d: fn(&[f64], f64) -> Result<Vec<f64>, DataError>| {
+            let uniform = hermite(t, &column(values, dof, j), &to_grid)?;
+            let smooth = butterworth_filtfilt(&uniform, dt, cutoff_hz)?;
+            hermite(&grid, &d(&smooth, dt)?, &back)
+        };
+        let mut v = self.velocities().map(<[f64]>::to_vec);
+        let mut a = self.accelerations().map(<[f64]>::to_vec);
+        let (source, first, second) = match (&v, &a) {
+            (Some(_), Some(_)) => return Ok(self.clone()),
+            (Some(v), None) => (v.clone(), None, Some(central_difference as fn(&[f64], f64) -> _)),
+            (None, Some(_)) => (
+                self.positions().to_vec(),
+                Some(central_difference as fn(&[f64], f64) -> _),
+                None,
+            ),
+            (None, None) => (
+                self.positions().to_vec(),
+                Some(central_difference as fn(&[f64], f64) -> _),
+                Some(second_difference as fn(&[f64], f64) -> _),
+            ),
+        };
+        if let Some(d) = first {
+            let mut out = vec![0.0; source.len()];
+            for j in 0..dof {
+                set_column(&mut out, dof, j, &derive(&source, j, d)?);
+            }
+            v = Some(out);
+        }
+        if let Some(d) = second {
+            let mut out = vec![0.0; source.len()];
+            for j in 0..dof {
+                set_column(&mut out, dof, j, &derive(&source, j, d)?);
+            }
+            a = Some(out);
+        }
+        let mut out = self.clone();
+        out.set_derivatives(v, a)?;
+        Ok(out)
     }
 
     /// The same trajectory with the missing velocities and accelerations computed
@@ -314,5 +517,74 @@ impl Trajectory {
         let mut out = self.clone();
         out.set_derivatives(Some(v), Some(a))?;
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn jittered_grid(seed: u64, n: usize) -> Vec<f64> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut t = vec![0.3];
+        for _ in 1..n {
+            let last = t[t.len() - 1];
+            t.push(last + rng.gen_range(0.008..0.013));
+        }
+        t
+    }
+
+    #[test]
+    fn nonuniform_differences_are_exact_on_quadratics() {
+        let t = jittered_grid(1, 30);
+        let x: Vec<f64> = t.iter().map(|t| 2.0 - 3.0 * t + 1.5 * t * t).collect();
+        let d = nonuniform_difference(&t, &x).unwrap();
+        let d2 = nonuniform_second_difference(&t, &x).unwrap();
+        for k in 0..t.len() {
+            assert!((d[k] - (-3.0 + 3.0 * t[k])).abs() < 1e-9, "{k}: {}", d[k]);
+            assert!((d2[k] - 3.0).abs() < 1e-6, "{k}: {}", d2[k]);
+        }
+    }
+
+    #[test]
+    fn nonuniform_differences_on_a_uniform_grid_are_the_classical_ones() {
+        let t: Vec<f64> = (0..20).map(|k| k as f64 * 0.01).collect();
+        let x: Vec<f64> = t.iter().map(|t| (3.0 * t).sin() + t * t * t).collect();
+        let a = nonuniform_difference(&t, &x).unwrap();
+        let b = central_difference(&x, 0.01).unwrap();
+        let a2 = nonuniform_second_difference(&t, &x).unwrap();
+        let b2 = second_difference(&x, 0.01).unwrap();
+        for k in 0..t.len() {
+            assert!((a[k] - b[k]).abs() < 1e-9 && (a2[k] - b2[k]).abs() < 1e-6, "{k}");
+        }
+    }
+
+    #[test]
+    fn nonuniform_differences_errors() {
+        let e = nonuniform_difference(&[0.0], &[1.0]).unwrap_err();
+        assert_eq!(e.to_string(), "1 sample(s); at least 2 are needed");
+        let e = nonuniform_second_difference(&[0.0, 1.0], &[1.0, 2.0]).unwrap_err();
+        assert_eq!(e.to_string(), "2 sample(s); at least 3 are needed");
+        let e = nonuniform_difference(&[0.0, 1.0, 1.0], &[1.0, 2.0, 3.0]).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("sample 2 (0-based): time t = 1 s does not increase"),
+            "{e}"
+        );
+        let e = nonuniform_difference(&[0.0, 1.0], &[1.0]).unwrap_err();
+        assert_eq!(e.to_string(), "`x` has 1 values, expected 2");
+    }
+
+    #[test]
+    fn hermite_reproduces_quadratics_between_samples() {
+        let t = jittered_grid(2, 12);
+        let y: Vec<f64> = t.iter().map(|t| 1.0 + t - 4.0 * t * t).collect();
+        let grid: Vec<f64> = (0..40).map(|k| t[0] + k as f64 * 0.0025).collect();
+        let out = hermite(&t, &y, &intervals(&t, &grid)).unwrap();
+        for (g, o) in grid.iter().zip(&out) {
+            assert!((o - (1.0 + g - 4.0 * g * g)).abs() < 1e-12, "{g}");
+        }
     }
 }

@@ -22,6 +22,31 @@ impl fmt::Display for Location {
     }
 }
 
+/// A column of a log read through a [`Recipe`](super::Recipe), as errors name it:
+/// its 1-based position, its header name when the file has one, and what the
+/// recipe reads from it (`t`, `q3`, `tau2`, `current2`, …).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Field {
+    pub index: usize,
+    pub name: Option<String>,
+    pub role: String,
+}
+
+impl fmt::Display for Field {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.name {
+            // The schema's own names: the name says it all, as the plain reader does.
+            Some(name) if *name == self.role => write!(f, "column `{name}`"),
+            Some(name) => write!(f, "column {} `{name}` ({})", self.index, self.role),
+            None => write!(f, "column {} ({})", self.index, self.role),
+        }
+    }
+}
+
+/// Largest magnitude a value may have in SI units, after the recipe's scaling: a
+/// larger one is a unit or column mistake (or a sensor fault), not a measurement.
+pub const MAX_ABS_VALUE: f64 = 1e6;
+
 /// Bad data or a failed read/write. Messages name the line (1-based file line) and
 /// the column, and say what would be valid.
 ///
@@ -100,6 +125,78 @@ pub enum DataError {
     },
     /// The CSV layer itself failed (for example invalid UTF-8).
     Malformed { line: Option<u64>, message: String },
+    /// A recipe that cannot be applied to this input (see [`RecipeError`](super::RecipeError)).
+    Recipe(super::RecipeError),
+    /// A recipe column given by name that the header does not have.
+    ColumnNotInHeader {
+        line: u64,
+        key: &'static str,
+        name: String,
+        header: Vec<String>,
+    },
+    /// A recipe column given by position beyond the fields of the line.
+    ColumnOutOfRange {
+        line: u64,
+        key: &'static str,
+        index: usize,
+        width: usize,
+    },
+    /// One column given for two roles.
+    ColumnTwice {
+        index: usize,
+        first: String,
+        second: String,
+    },
+    /// A recipe list (`gains`, `units`, `sign`) whose length fits neither all joints
+    /// at once (1) nor one per joint (`dof`).
+    RecipeLength {
+        key: &'static str,
+        found: usize,
+        dof: usize,
+    },
+    /// A recipe column list (`q`, `v`, `a`, `tau`) with other than one column per joint.
+    RecipeColumns {
+        key: &'static str,
+        found: usize,
+        dof: usize,
+    },
+    /// Without a header or column settings, a row whose field count matches no
+    /// layout of the writer's column order.
+    NoLayout {
+        line: u64,
+        found: usize,
+        dof: Option<usize>,
+    },
+    /// A row with a different field count from the row that set the width.
+    RowWidth {
+        line: u64,
+        expected: usize,
+        found: usize,
+        reference: u64,
+    },
+    /// A field of a log read through a recipe that does not parse as a number.
+    NotANumberIn { line: u64, field: Field, text: String },
+    /// A NaN or infinite field of a log read through a recipe.
+    NonFiniteIn { line: u64, field: Field, value: f64 },
+    /// A finite field whose magnitude in SI units, after scaling, exceeds
+    /// [`MAX_ABS_VALUE`].
+    OutOfRange { line: u64, field: Field, value: f64 },
+    /// A time stamp below the previous one (an equal one is a duplicate, dropped).
+    TimeNotIncreasing {
+        line: u64,
+        field: Field,
+        t: f64,
+        previous: f64,
+        previous_line: u64,
+    },
+    /// Too few samples left after windows, duplicates and decimation for `purpose`.
+    TooFewSamplesLeft {
+        found: usize,
+        needed: usize,
+        purpose: &'static str,
+        rows: usize,
+        dropped: usize,
+    },
     /// Several errors found in one pass (at most [`MAX_ERRORS`](super::MAX_ERRORS));
     /// `truncated` when reading stopped there.
     Multiple { errors: Vec<DataError>, truncated: bool },
@@ -124,7 +221,16 @@ impl DataError {
             | DataError::IncompleteGroup { line, .. }
             | DataError::DofMismatch { line, .. }
             | DataError::FieldCount { line, .. }
-            | DataError::NotANumber { line, .. } => Some(*line),
+            | DataError::NotANumber { line, .. }
+            | DataError::ColumnNotInHeader { line, .. }
+            | DataError::ColumnOutOfRange { line, .. }
+            | DataError::NoLayout { line, .. }
+            | DataError::RowWidth { line, .. }
+            | DataError::NotANumberIn { line, .. }
+            | DataError::NonFiniteIn { line, .. }
+            | DataError::OutOfRange { line, .. }
+            | DataError::TimeNotIncreasing { line, .. } => Some(*line),
+            DataError::Recipe(e) => e.line(),
             DataError::NonFinite { at, .. }
             | DataError::NonMonotonicTime { at, .. }
             | DataError::NonUniformSampling { at, .. } => match at {
@@ -218,6 +324,84 @@ impl fmt::Display for DataError {
             }
             DataError::Malformed { line: Some(line), message } => write!(f, "line {line}: malformed CSV: {message}"),
             DataError::Malformed { line: None, message } => write!(f, "malformed CSV: {message}"),
+            DataError::Recipe(e) => write!(f, "recipe: {e}"),
+            DataError::ColumnNotInHeader { line, key, name, header } => write!(
+                f,
+                "line {line}: recipe `{key}` names column `{name}`, which the header does not have; its columns are {}",
+                header.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ")
+            ),
+            DataError::ColumnOutOfRange { line, key, index, width } => write!(
+                f,
+                "line {line}: recipe `{key}` names column {index}, but the line has {width} field(s); \
+                 columns are numbered 1 to {width}"
+            ),
+            DataError::ColumnTwice { index, first, second } => write!(
+                f,
+                "column {index} is given both as {first} and as {second}; each column holds one quantity"
+            ),
+            DataError::RecipeLength { key, found, dof } => write!(
+                f,
+                "recipe `{key}` has {found} value(s); give 1 (for every joint) or {dof} (one per joint)"
+            ),
+            DataError::RecipeColumns { key, found, dof } => write!(
+                f,
+                "recipe `{key}` names {found} column(s); give one per joint ({dof}, the number of `q` columns or \
+                 of the robot's joints)"
+            ),
+            DataError::NoLayout { line, found, dof } => {
+                write!(f, "line {line}: {found} fields and no header or column settings; ")?;
+                match dof {
+                    Some(n) => write!(
+                        f,
+                        "for {n} joints the columns must be t, q1..q{n}, tau1..tau{n} ({} fields), with v1..v{n} \
+                         before tau ({}), or v and a ({}), optionally followed by the 6·{n} joint wrench columns; \
+                         otherwise name the columns in a recipe (`time`, `q`, `tau`, …)",
+                        1 + 2 * n,
+                        1 + 3 * n,
+                        1 + 4 * n
+                    ),
+                    None => write!(
+                        f,
+                        "without the number of joints the columns must be t, q1..qn, tau1..taun (an odd number \
+                         of fields); otherwise name the columns in a recipe (`time`, `q`, `tau`, …)"
+                    ),
+                }
+            }
+            DataError::RowWidth { line, expected, found, reference } => write!(
+                f,
+                "line {line}: {found} fields, expected {expected} like line {reference}; every row needs the same \
+                 columns"
+            ),
+            DataError::NotANumberIn { line, field, text } if text.is_empty() => {
+                write!(f, "line {line}, {field}: empty field; expected a number")
+            }
+            DataError::NotANumberIn { line, field, text } => {
+                write!(f, "line {line}, {field}: `{text}` is not a number")
+            }
+            DataError::NonFiniteIn { line, field, value } => {
+                write!(f, "line {line}, {field}: {value} is not a finite number")
+            }
+            DataError::OutOfRange { line, field, value } => {
+                write!(
+                    f,
+                    "line {line}, {field}: {value:e} after scaling to SI units; values must lie within ±{MAX_ABS_VALUE:e}"
+                )?;
+                if field.role == "t" {
+                    write!(f, " (check `time_unit`; for clock time stamps set `time_origin = first`)")
+                } else {
+                    write!(f, " (check the column and its unit, gain or scale)")
+                }
+            }
+            DataError::TimeNotIncreasing { line, field, t, previous, previous_line } => write!(
+                f,
+                "line {line}, {field}: time t = {t} s is before t = {previous} s on line {previous_line}; \
+                 time must increase (rows with an equal time stamp are dropped as duplicates)"
+            ),
+            DataError::TooFewSamplesLeft { found, needed, purpose, rows, dropped } => write!(
+                f,
+                "{found} sample(s) left of {rows} row(s) read ({dropped} dropped as duplicates, outside the \
+                 windows or by decimation); {purpose} needs at least {needed}"
+            ),
             DataError::Multiple { errors, truncated } => {
                 write!(f, "{} errors", errors.len())?;
                 if *truncated {

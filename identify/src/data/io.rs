@@ -17,11 +17,11 @@ use dyngen::Wrench;
 pub const MAX_ERRORS: usize = 20;
 
 /// The joint wrench components, in the order of [`Wrench`]'s `force` then `torque`.
-const WRENCH_PREFIXES: [&str; 6] = ["fx", "fy", "fz", "mx", "my", "mz"];
+pub(super) const WRENCH_PREFIXES: [&str; 6] = ["fx", "fy", "fz", "mx", "my", "mz"];
 
 /// What a header column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
+pub(super) enum Kind {
     T,
     Q,
     V,
@@ -33,9 +33,9 @@ enum Kind {
 
 /// One parsed header column: its kind and 1-based joint (0 for `t`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Column {
-    kind: Kind,
-    joint: usize,
+pub(super) struct Column {
+    pub(super) kind: Kind,
+    pub(super) joint: usize,
 }
 
 impl Column {
@@ -63,7 +63,7 @@ impl Column {
         Some(Column { kind, joint })
     }
 
-    fn name(self) -> String {
+    pub(super) fn name(self) -> String {
         let j = self.joint;
         match self.kind {
             Kind::T => "t".into(),
@@ -101,13 +101,13 @@ fn valid_columns(n: usize) -> String {
 }
 
 /// Collects errors up to [`MAX_ERRORS`].
-struct Errors {
+pub(super) struct Errors {
     list: Vec<DataError>,
-    truncated: bool,
+    pub(super) truncated: bool,
 }
 
 impl Errors {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Errors {
             list: Vec::new(),
             truncated: false,
@@ -115,7 +115,7 @@ impl Errors {
     }
 
     /// Records `e`; `false` when the list is full and reading should stop.
-    fn push(&mut self, e: DataError) -> bool {
+    pub(super) fn push(&mut self, e: DataError) -> bool {
         if self.list.len() < MAX_ERRORS {
             self.list.push(e);
             true
@@ -125,11 +125,11 @@ impl Errors {
         }
     }
 
-    fn full(&self) -> bool {
+    pub(super) fn full(&self) -> bool {
         self.list.len() >= MAX_ERRORS
     }
 
-    fn into_result(mut self) -> Result<(), DataError> {
+    pub(super) fn into_result(mut self) -> Result<(), DataError> {
         match self.list.len() {
             0 => Ok(()),
             1 if !self.truncated => Err(self.list.pop().expect("one error")),
@@ -143,16 +143,16 @@ impl Errors {
 
 /// The checked header: each field's column, the number of joints, which optional
 /// groups are present.
-struct Header {
-    columns: Vec<Column>,
-    dof: usize,
-    has_v: bool,
-    has_a: bool,
-    has_wrenches: bool,
+pub(super) struct Header {
+    pub(super) columns: Vec<Column>,
+    pub(super) dof: usize,
+    pub(super) has_v: bool,
+    pub(super) has_a: bool,
+    pub(super) has_wrenches: bool,
 }
 
 /// Checks the header row (on `line`) against the schema, collecting every problem.
-fn parse_header(names: &csv::StringRecord, line: u64, dof: Option<usize>) -> Result<Header, DataError> {
+pub(super) fn parse_header(names: &csv::StringRecord, line: u64, dof: Option<usize>) -> Result<Header, DataError> {
     if names.iter().all(|f| f.is_empty() || f.parse::<f64>().is_ok()) {
         return Err(DataError::MissingHeader {
             line,
@@ -464,7 +464,7 @@ fn read(reader: impl Read, dof: Option<usize>, path: Option<&Path>) -> Result<Tr
         header.has_a.then_some(a),
         tau,
         header.has_wrenches.then_some(wrenches),
-        lines,
+        Some(lines),
     )
 }
 

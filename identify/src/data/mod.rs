@@ -54,6 +54,115 @@
 //! the cutoff above the motion's bandwidth and below the noise: for a trajectory of a
 //! few Hz sampled at 100 Hz–1 kHz, 10–20 Hz is typical.
 //!
+//! On a non-uniform grid (a jittered logger read as it is),
+//! [`Trajectory::with_derivatives_nonuniform`] interpolates onto a uniform grid of
+//! as many samples (cubic Hermite), filters and differentiates there, and
+//! interpolates the derivatives back to the log's time stamps. Finite differences
+//! on any grid: [`nonuniform_difference`] and [`nonuniform_second_difference`]
+//! (three-point stencils, exact on quadratics).
+//!
+//! # Recipes
+//!
+//! Real loggers write files the schema above does not describe: no header, their
+//! own column names and order, semicolons or spaces, degrees, motor currents,
+//! jittered and repeated time stamps, hours of data. A [`Recipe`] says how to read
+//! one logger's files; [`Recipe::read`] reads a log through it into a [`Loaded`]
+//! trajectory with a [`LoadReport`] of what was done (rows dropped and why, the
+//! time steps, which quantities were measured and which estimated), and
+//! [`Loaded::with_derivatives`] estimates what was not measured.
+//!
+//! A recipe file is plain text, one `key = value` per line; `#` starts a comment
+//! (to the end of the line), blank lines are ignored, each key at most once, keys
+//! not given keep their defaults. Errors name the recipe line. The same keys can be
+//! set one at a time with [`Recipe::set`] (how `dyngen identify`'s flags override a
+//! file).
+//!
+//! | key | values | default |
+//! |---|---|---|
+//! | `delimiter` | `comma`, `semicolon`, `tab`, `whitespace` (runs of spaces and tabs) | `comma` |
+//! | `header` | `true`, `false`: whether the first line (after `skip`) names the columns | `true` |
+//! | `skip` | lines to skip before the header or first row (a preamble) | `0` |
+//! | `time` | the time column: its number (from 1) or header name | `1` when `q` is given |
+//! | `q` | one column per joint: numbers, names, ranges `2-7`, comma-separated | |
+//! | `v` | measured velocities, one column per joint (optional) | |
+//! | `a` | measured accelerations, one column per joint (optional) | |
+//! | `tau` | torques (forces), or motor currents when `gains` is given, one per joint | |
+//! | `time_unit` | `s`, `ms`, `us` (`µs`), `ns` | `s` |
+//! | `time_origin` | `file` (time stamps as they are) or `first` (the first row read is t = 0) | `file` |
+//! | `units` | `rad`, `deg`, `m`, `mm`: once for all joints or once per joint; applies to q, v, a | `rad` |
+//! | `gains` | torque constants k (N·m/A): τ = k·i; once for all joints or once per joint | none: `tau` is torque |
+//! | `sign` | `1` or `-1`, once for all joints or per joint: multiplies q, v, a and τ | all `1` |
+//! | `window` | `t0:t1`, seconds after `time_unit` and `time_origin`, inclusive; either end may be left out | all |
+//! | `rows` | `first:last`, data rows counted from 1 (blank lines not counted), inclusive | all |
+//! | `decimate` | `N`: keep every N-th sample (no anti-alias filter: for logs sampled far above the motion) | `1` |
+//! | `resample` | `DT` in s: interpolate onto a uniform grid; `off`: time stamps as they are | `off` |
+//! | `stale` | `keep` or `drop` rows repeating every value of the previous row under a new time stamp | `keep` |
+//!
+//! Columns: without `q` and `tau`, a file with a header is read by the schema above
+//! (names `t`, `q1`, …), and a file without one in the writer's order — `t`, the
+//! `q`s, the `v`s (if any), the `a`s (if any), the `tau`s, the 6 wrench components
+//! per joint (if any) — recognised by the number of fields. With `q` and `tau`,
+//! exactly the named columns are read and every other column is ignored (joint
+//! wrenches only come through the schema). Fields may be wrapped in double quotes.
+//!
+//! Each row is handled in this order: outside `rows` → skipped unread; its time
+//! stamp converted (`time_unit`, `time_origin`); outside `window` → skipped, the
+//! rest of the row unread (a window can cut away a damaged part); every read field
+//! parsed and scaled (`units`, `gains`, `sign`) and checked: not a number, NaN or
+//! infinite, or beyond ±[`MAX_ABS_VALUE`] in SI units is an error naming the line and
+//! the column. Then against the previous kept row: the same time stamp is a
+//! duplicate, dropped and counted (`repeated` when every value is equal too,
+//! `same_time` when not: the first row of a time stamp wins); an earlier time stamp
+//! is an error ([`DataError::TimeNotIncreasing`]); with `stale = drop` a row with a
+//! new time stamp but every value equal is dropped. Then decimation. Errors are
+//! collected over the whole file, as for the schema reader.
+//!
+//! Time stamps that are not uniform are accepted. `resample` off (the default): they
+//! are used as they are; [`Loaded::with_derivatives`] then estimates derivatives at
+//! those time stamps ([`Trajectory::with_derivatives_nonuniform`]; on a uniform
+//! grid, within 1 %, it is exactly [`Trajectory::with_derivatives`]). `resample = DT`: every column is interpolated
+//! (cubic Hermite, slopes from three-point differences, so value and slope are
+//! continuous) onto `t₀, t₀ + DT, …` up to the last time stamp, and derivatives are
+//! then taken on that uniform grid; resampled samples have no file line. The report
+//! gives the smallest, median and largest step either way.
+//!
+//! [`Recipe::default`] reads the schema exactly as [`read_csv`] does; it differs
+//! only in dropping duplicate time stamps, which [`read_csv`] rejects.
+//!
+//! An example recipe for a headerless 10 ms logger of a 6-joint arm writing
+//! semicolon-separated degrees and motor currents:
+//!
+//! ```
+//! use dyngen_identify::data::Recipe;
+//!
+//! let recipe = Recipe::parse("
+//! ## robot controller log, 100 Hz
+//! delimiter = semicolon
+//! header = false
+//! time = 1
+//! time_unit = ms
+//! q = 2-7
+//! v = 8-13          ## measured by the drives
+//! tau = 14-19       ## motor currents, A
+//! units = deg
+//! gains = 0.11, 0.11, 0.11, 0.05, 0.05, 0.05
+//! sign = 1, -1, 1, 1, 1, 1
+//! window = 5:65     ## s, after time_unit
+//! ")?;
+//! let row = |ms: f64| format!("{ms};90;90;0;0;0;0;0;0;0;0;0;0;2;2;2;2;2;2\n");
+//! let log: String = [4990.0, 5000.0, 5011.0, 5011.0, 5019.0].map(row).concat();
+//! let loaded = recipe.read_from(log.as_bytes(), Some(6))?;
+//! let traj = &loaded.trajectory;
+//! assert_eq!(traj.t(), &[5.0, 5.011, 5.019]); // one row before the window, one repeated
+//! assert_eq!(traj.q(0)[..2], [std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_2]);
+//! assert_eq!(traj.tau(0)[..2], [0.22, -0.22]);
+//! assert_eq!((loaded.report.outside_window, loaded.report.repeated), (1, 1));
+//! // Accelerations from the measured velocities, at the log's own time stamps.
+//! let full = loaded.with_derivatives(20.0)?;
+//! assert!(full.report.to_string().contains("velocity: measured (columns 8–13); acceleration: estimated"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! # Example
 //!
 //! ```
@@ -88,9 +197,19 @@ mod derivatives;
 mod error;
 mod io;
 mod lines;
+mod log;
+mod recipe;
 mod trajectory;
 
-pub use derivatives::{butterworth_filtfilt, central_difference, second_difference, SAMPLING_TOLERANCE};
-pub use error::{DataError, Location};
+pub use derivatives::{
+    butterworth_filtfilt, central_difference, nonuniform_difference, nonuniform_second_difference, second_difference,
+    SAMPLING_TOLERANCE,
+};
+pub use error::{DataError, Field, Location, MAX_ABS_VALUE};
 pub use io::{csv_header, from_reader, overwrite_csv, read_csv, to_writer, write_csv, MAX_ERRORS};
+pub use log::{LoadReport, Loaded, Provenance, TimeSteps, MAX_RESAMPLE_FACTOR};
+pub use recipe::{
+    ColumnRef, Columns, Delimiter, JointUnit, Recipe, RecipeError, RowWindow, Sampling, Stale, TimeOrigin, TimeUnit,
+    TimeWindow, RECIPE_KEYS,
+};
 pub use trajectory::{Sample, Trajectory};

@@ -110,8 +110,8 @@ impl Trajectory {
         Ok(self)
     }
 
-    /// Used by the reader, which has already checked every value and knows each
-    /// sample's line.
+    /// Used by the readers, which have already checked every value and know each
+    /// sample's line (none for resampled data).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn from_checked_parts(
         dof: usize,
@@ -121,7 +121,7 @@ impl Trajectory {
         a: Option<Vec<f64>>,
         tau: Vec<f64>,
         wrenches: Option<Vec<Wrench<f64>>>,
-        lines: Vec<u64>,
+        lines: Option<Vec<u64>>,
     ) -> Result<Self, DataError> {
         let traj = Trajectory {
             dof,
@@ -131,7 +131,7 @@ impl Trajectory {
             a,
             tau,
             wrenches,
-            lines: Some(lines),
+            lines,
         };
         traj.check()?;
         Ok(traj)

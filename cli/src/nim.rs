@@ -6,11 +6,8 @@ use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Re
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::mim;
-use dyngen_nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
-use dyngen_reference::{principal_params_to_standard, SplitMix64};
-use dyngen_identify::report::{self, ParameterReport};
+use dyngen_identify::report;
 use dyngen_identify::simulate::{record_trajectory, Recording, SampledMotion};
-use dyngen_reference::Reference;
 use dyngen_model::Model;
 use dyngen_nim::{draw_theta, Nim, NimConfig, NimError, Optimizer};
 use dyngen_reference::Reference;

@@ -15,7 +15,7 @@ use super::error::{DataError, Field, MAX_ABS_VALUE};
 use super::io::{parse_header, Errors, Kind, WRENCH_PREFIXES};
 use super::recipe::{ColumnRef, Delimiter, Recipe, RecipeError, Sampling, Stale, TimeOrigin};
 use super::trajectory::{column, set_column, Trajectory};
-use crate::Wrench;
+use dyngen::Wrench;
 
 /// A resampled log may have at most this many times the samples it was read with: a
 /// step far below the logger's only invents data (and memory).

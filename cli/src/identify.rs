@@ -3,12 +3,12 @@
 //! by MIM from joint wrenches.
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
-use dyngen_codegen::standard_param_names;
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::mim::{self, MimEstimate, MimOptions};
 use dyngen_identify::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
 use dyngen_identify::simulate::Recording;
 use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate, Options};
+use dyngen_model::names::standard_param_names;
 use dyngen_model::{ErrorKind, Inertial, Model};
 use dyngen_reference::Dynamics;
 use dyngen_reference::Reference;

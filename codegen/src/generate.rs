@@ -91,21 +91,6 @@ pub fn is_type_name(name: &str) -> bool {
     syn::parse_str::<syn::Ident>(name).is_ok()
 }
 
-/// Names of the standard parameters, `m1, mx1, …, Izz1, m2, …`.
-pub fn standard_param_names(n: usize) -> Vec<String> {
-    const NAMES: [&str; 10] = ["m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"];
-    (1..=n)
-        .flat_map(|i| NAMES.iter().map(move |s| format!("{s}{i}")))
-        .collect()
-}
-
-/// Names of the principal parameters, `m1, J1_1, J2_1, J3_1, m2, …`.
-pub fn principal_param_names(n: usize) -> Vec<String> {
-    (1..=n)
-        .flat_map(|i| [format!("m{i}"), format!("J1_{i}"), format!("J2_{i}"), format!("J3_{i}")])
-        .collect()
-}
-
 /// A regressor as output nodes, structural zeros as the constant 0.
 fn matrix_ids<'g>(g: &'g Graph, y: &[Vec<Option<Expr<'g>>>]) -> Vec<NodeId> {
     y.iter()
@@ -822,7 +807,6 @@ fn robot_type(
     let nominal = f64_array(&model.standard_params());
     let theta = f64_array(&dyngen_model::principal_params(model));
     let gravity = f64_array(&model.gravity);
-    let urdf = dyngen_model::to_urdf(model);
     let robot_model = model_expr(model);
     let op_counts = functions.iter().map(|f| {
         let name = &f.name;
@@ -910,8 +894,6 @@ fn robot_type(
             /// the generated numbering: joint and body `j` are `joints[j - 1]` and
             /// `bodies[j - 1]`.
             pub const MODEL: ::dyngen::RobotModel = #robot_model;
-            /// The model as URDF (fixed joints merged).
-            pub const URDF: &'static str = #urdf;
             /// Operation counts of the generated functions.
             pub const OP_COUNTS: [(&'static str, ::dyngen::OpCount); #nf] = [#(#op_counts),*];
 
@@ -941,7 +923,6 @@ fn robot_type(
             fn principal_base_groupings() -> &'static [&'static str] { &Self::PRINCIPAL_BASE_GROUPINGS }
             fn principal_base_index() -> &'static [usize] { &Self::PRINCIPAL_BASE_INDEX }
             fn principal_base_k() -> &'static [f64] { &Self::PRINCIPAL_BASE_K }
-            fn urdf() -> &'static str { Self::URDF }
             fn gravity() -> [f64; 3] { Self::GRAVITY }
             fn op_counts() -> &'static [(&'static str, ::dyngen::OpCount)] { &Self::OP_COUNTS }
 

@@ -114,9 +114,6 @@ pub trait Robot {
     fn principal_base_index() -> &'static [usize];
     /// `K_θ` (`NBASE_PRINCIPAL × NTHETA`, row-major): `β_θ = K_θ θ`.
     fn principal_base_k() -> &'static [f64];
-    /// The robot as URDF text (fixed joints already merged), from which the
-    /// reference model is rebuilt: `dyngen_model::parse_urdf(R::urdf())`.
-    fn urdf() -> &'static str;
     /// Gravity in the base frame the generated code was specialised for, m/s².
     fn gravity() -> [f64; 3];
     /// Operation counts of each generated function, by function name.

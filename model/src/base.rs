@@ -201,15 +201,34 @@ fn from_stacked(mut rows: Vec<Vec<f64>>, names: &[String]) -> BaseParams {
 }
 
 /// Rounds away the noise of the factorisation: |x| < 1e-10 → 0, and values within
-/// 1e-10 of ±1 → ±1, so exact groupings print exactly.
+/// 1e-10 of ±1 → ±1, so exact groupings print exactly. Other values are snapped to a
+/// short decimal when one lies within [`SNAP_RELATIVE`] (see [`snap_decimal`]).
 fn clean(x: f64) -> f64 {
     if x.abs() < 1e-10 {
         0.0
     } else if (x.abs() - 1.0).abs() < 1e-10 {
         x.signum()
     } else {
-        x
+        snap_decimal(x)
     }
+}
+
+/// How close, relative to its magnitude, a coefficient of `K` must be to a decimal of
+/// at most [`SNAP_DIGITS`] significant digits to be replaced by it. The entries of `K`
+/// are exact sums of products of the model's numbers (`0.425² = 0.180625`), which are
+/// short decimals when the description's numbers are; the factorisation returns them
+/// with its own rounding, some hundred ulps (`0.18062499999999998`). The snap is far
+/// below what the factorisation resolves, so it changes nothing a test can see.
+const SNAP_RELATIVE: f64 = 1e-13;
+const SNAP_DIGITS: usize = 10;
+
+/// `x`, or the decimal with the fewest significant digits (at most [`SNAP_DIGITS`])
+/// within [`SNAP_RELATIVE`] of it.
+fn snap_decimal(x: f64) -> f64 {
+    (0..SNAP_DIGITS)
+        .filter_map(|p| format!("{x:.p$e}").parse::<f64>().ok())
+        .find(|y| (y - x).abs() <= SNAP_RELATIVE * x.abs())
+        .unwrap_or(x)
 }
 
 fn grouping(kr: &[f64], names: &[String]) -> String {
@@ -285,6 +304,16 @@ fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coefficients_snap_to_short_decimals_only_when_within_rounding() {
+        assert_eq!(clean(0.18062499999999998), 0.180625);
+        assert_eq!(clean(-0.42500000000000004), -0.425);
+        let irrational = std::f64::consts::PI / 10.0;
+        assert_eq!(clean(irrational), irrational);
+        assert_eq!(clean(3e-11), 0.0);
+        assert_eq!(clean(-1.0 + 1e-12), -1.0);
+    }
     use crate::regressor::{joint_torque_regressor, principal_regressor};
     use crate::sample::sample_states;
 

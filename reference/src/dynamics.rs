@@ -166,18 +166,17 @@ impl Dynamics for Reference {
 
 /// A generated robot `R` as [`Dynamics`]: every algorithm runs `R`'s generated code,
 /// except [`Dynamics::body_motions`], which generated robots do not provide and which
-/// runs the reference implementation on the model rebuilt from `R::urdf()`.
+/// runs the reference implementation on the model `R` carries (`R::MODEL`).
 ///
-/// Not zero-sized: it keeps that model (parsed once, in [`Generated::new`], with
-/// gravity set to `R::gravity()`), because a generic type cannot own a static.
+/// Not zero-sized: it keeps that model as the runtime's [`Model`] (converted once, in
+/// [`Generated::new`]), because a generic type cannot own a static.
 pub struct Generated<R> {
     reference: Reference,
     robot: PhantomData<fn() -> R>,
 }
 
 impl<R: Robot> Generated<R> {
-    /// Parses `R::urdf()` and sets the gravity `R` was generated for. Panics if the
-    /// URDF does not parse, which would be a bug of the generator.
+    /// The generated robot `R` with the reference on its own model.
     pub fn new() -> Generated<R> {
         Generated {
             reference: Reference::of::<R>(),

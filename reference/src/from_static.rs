@@ -2,7 +2,7 @@
 //! core crate) as the runtime's [`Model`]: no file is parsed and no joint renumbered,
 //! so the reference, identification and NIM see exactly the generator's numbering.
 
-use dyngen::{JointType, RobotModel};
+use dyngen::{JointType, Robot, RobotModel};
 use dyngen_model::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
 
 /// The runtime model of a generated robot's `MODEL`.
@@ -49,4 +49,10 @@ pub fn model_from_static(m: &RobotModel) -> Model {
             })
             .collect(),
     }
+}
+
+/// A generated robot's model as URDF text (fixed joints merged), for tools that read
+/// URDF: `dyngen_model::to_urdf` of [`model_from_static`] of `R::MODEL`.
+pub fn urdf_of<R: Robot>() -> String {
+    dyngen_model::to_urdf(&model_from_static(&R::MODEL))
 }

@@ -33,7 +33,7 @@ mod sample;
 pub mod spatial;
 
 pub use dynamics::{Dynamics, Generated};
-pub use from_static::model_from_static;
+pub use from_static::{model_from_static, urdf_of};
 pub use mim::euler_matrix;
 pub use regressor::{principal_matrix, principal_params_to_standard};
 pub use sample::{perturbed_params, sample_states, SplitMix64, State};
@@ -109,14 +109,10 @@ struct Kinematics {
 }
 
 impl Reference {
-    /// The reference implementation of a generated robot, rebuilt from the URDF it was
-    /// generated from, with the gravity it was specialised for. Panics if that URDF does
-    /// not parse, which would be a bug of the generator.
+    /// The reference implementation of a generated robot, on the model it carries
+    /// (`R::MODEL`: the generator's numbering, the gravity it was specialised for).
     pub fn of<R: dyngen::Robot>() -> Reference {
-        let mut model = dyngen_model::parse_urdf(R::urdf())
-            .unwrap_or_else(|e| panic!("dyngen: the URDF generated for `{}` does not parse: {e}", R::NAME));
-        model.gravity = R::gravity();
-        Reference::new(&model)
+        Reference::new(&model_from_static(&R::MODEL))
     }
 
     pub fn new(model: &Model) -> Reference {

@@ -197,8 +197,7 @@ fn tree12_identities() {
 #[test]
 fn base_parameters_are_confirmed_by_a_second_seed() {
     fn confirm<R: Robot>() {
-        let mut model = dyngen_model::parse_urdf(R::urdf()).expect("URDF parses");
-        model.gravity = R::gravity();
+        let model = dyngen_reference::model_from_static(&R::MODEL);
         let g = dyngen_codegen::analyse_model(&model);
         assert!(
             g.standard.confirmed && g.principal.confirmed,

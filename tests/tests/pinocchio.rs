@@ -156,7 +156,10 @@ fn tree12_matches_pinocchio() {
 /// description changes, the committed URDF (and the fixture) must be regenerated.
 #[test]
 fn dsl_robot_urdfs_are_current() {
-    for (name, urdf) in [("planar2", Planar2::URDF), ("paper6", Paper6::URDF)] {
+    for (name, urdf) in [
+        ("planar2", dyngen_reference::urdf_of::<Planar2>()),
+        ("paper6", dyngen_reference::urdf_of::<Paper6>()),
+    ] {
         let path = dyngen_tests::workspace_root()
             .join("tests/fixtures")
             .join(format!("{name}.urdf"));

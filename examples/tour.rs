@@ -89,7 +89,7 @@ fn main() {
     tour::<Panda>();
 
     let model = Reference::of::<Paper6>().model().clone();
-    println!("\nThe paper's 6-DOF manipulator as a graph (DESIGN §4):");
+    println!("\nThe paper's 6-DOF manipulator as a graph (docs/design.md, \"The paper's graph theory\"):");
     println!("incidence matrix S (rows bodies 0..6, columns joints 1..6):");
     for row in graph::incidence(&model) {
         println!("  {}", row.iter().map(|x| format!("{x:>3}")).collect::<String>());

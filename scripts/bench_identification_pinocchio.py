@@ -13,7 +13,7 @@ total are timed separately; median of --reps runs.
 Run with the Pinocchio oracle's python, in the same sitting as
 `cargo bench -p dyngen-tests --bench identification`:
 
-    ${PIN_HOME:-$HOME/.cache/pinocchio-oracle}/.venv/bin/python \
+    python3 \
         scripts/bench_identification_pinocchio.py
 
 `--alt` also times the same compressed algorithm dyngen uses (QR of the stacked

@@ -1,17 +1,15 @@
 #!/usr/bin/env python3
 """Write Pinocchio reference fixtures (JSON) for dyngen's tests.
 
-Usage, from anywhere (needs a python with pip `pin`, e.g. the oracle venv that
-../shared/pinocchio/setup.sh creates):
+Usage, from anywhere (needs a python with `pip install pin==4.1.0 numpy`):
 
-    PY=${PIN_HOME:-$HOME/.cache/pinocchio-oracle}/.venv/bin/python
+    PY=python3
     $PY scripts/make_fixtures.py --all
     $PY scripts/make_fixtures.py --urdf path/to/robot.urdf --name robot [--samples 50] [--seed 0]
 
 --all regenerates every fixture the project ships (FIXTURES below). --urdf/--name
 writes tests/fixtures/NAME.json (or --out-dir DIR/NAME.json) for any URDF, e.g. one
-that dyngen wrote out. (../shared/pinocchio/py cannot run it: that wrapper only runs
-scripts that live in ../shared/pinocchio/.) The schema is documented in tests/fixtures/README.md.
+that dyngen wrote out. The schema is documented in tests/fixtures/README.md.
 
 Conventions are Pinocchio's: spatial vectors linear first then angular; per joint i
 everything is in the local frame of joint i (the URDF child-link frame of that joint);

@@ -1,4 +1,4 @@
-//! MIM as in the paper (DESIGN §5): identification of the principal
+//! MIM as in the paper (docs/design.md, "The paper's decoupled body model"): identification of the principal
 //! parameters `θ_i = (m, J1, J2, J3)` on the decoupled multibody model, and of the
 //! identifiable combinations from joint torques alone.
 //!

@@ -1,4 +1,4 @@
-//! The Roberson–Wittenburg description of a tree (DESIGN §4): incidence matrix `S`
+//! The Roberson–Wittenburg description of a tree (docs/design.md, "The paper's graph theory"): incidence matrix `S`
 //! with its base row, path matrix `T = S⁻¹`, body-joint vectors `c_ia`, `C = [S_ia c_ia]`
 //! and `D = C T`. Arcs point to the base: `S_ia = +1` on the outboard body `i⁺(a)`,
 //! `−1` on the inboard body `i⁻(a)`.

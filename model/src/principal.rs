@@ -1,6 +1,6 @@
 //! The paper's principal parameterisation: each body's `θ = (m, J1, J2, J3)`, with
 //! its centre of mass and principal axes fixed by the description, and the constant
-//! 10 × 4 matrix `P` with `π = P θ` (DESIGN §3).
+//! 10 × 4 matrix `P` with `π = P θ` (docs/design.md, "Conventions").
 
 use crate::ir::{Inertial, Model};
 use crate::math::{Mat3, Vec3, IDENTITY};

@@ -232,7 +232,7 @@ pub struct BodyNim {
 /// `[1 − spread, 1 + spread]` and each of its three principal second moments of mass
 /// `s_k = ∫ x_k² dm` likewise, so every draw is physically consistent (`J1 = s2 +
 /// s3`, … satisfy the triangle inequalities by construction). Each body's resultant
-/// under a draw is `[F; M] = A_i θ_i` (DESIGN §5), exact along a prescribed motion;
+/// under a draw is `[F; M] = A_i θ_i` (docs/design.md, "The paper's decoupled body model"), exact along a prescribed motion;
 /// windows of `window` consecutive samples start anywhere along the motion.
 ///
 /// **Identifiability.** A parameter that does not enter its body's equations along

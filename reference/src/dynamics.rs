@@ -55,11 +55,11 @@ pub trait Dynamics {
     fn joint_wrenches(&self, q: &[f64], v: &[f64], a: &[f64], params: &[f64], wrenches: &mut [Wrench<f64>]);
 
     /// The paper's per-body regressors `A_i` (centroidal principal frames,
-    /// DESIGN §5). `out`: `n`.
+    /// docs/design.md, "The paper's decoupled body model"). `out`: `n`.
     fn body_regressors(&self, q: &[f64], v: &[f64], a: &[f64], out: &mut [BodyRegressor<f64>]);
 
     /// Each body's resultant of the joint reactions, moment about the centre of mass,
-    /// in its centroidal principal frame (DESIGN §4). `out`: `n`.
+    /// in its centroidal principal frame (docs/design.md, "The paper's graph theory"). `out`: `n`.
     fn body_resultants(&self, q: &[f64], v: &[f64], a: &[f64], params: &[f64], out: &mut [Wrench<f64>]);
 
     /// `Y(q, v, a)` with `tau = Y π`, row-major into `y` (`n × 10 n`).

@@ -21,7 +21,7 @@
 //! - regressors, linear in the standard parameters: [`Reference::joint_torque_regressor`],
 //!   [`Reference::joint_wrench_regressor`], and in the principal parameters
 //!   [`Reference::principal_regressor`];
-//! - the paper's decoupled body model (MIM, DESIGN §4–§5): [`Reference::body_regressor`]
+//! - the paper's decoupled body model (MIM, docs/design.md, "The paper's decoupled body model"): [`Reference::body_regressor`]
 //!   and [`Reference::body_resultants`], per body in its centroidal principal frame.
 
 mod aba;

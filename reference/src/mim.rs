@@ -1,4 +1,4 @@
-//! The paper's decoupled body model (DESIGN §4–§5), the ground truth of MIM.
+//! The paper's decoupled body model (docs/design.md, "The paper's decoupled body model"), the ground truth of MIM.
 //!
 //! Cut every joint: each body `i` then carries the reaction wrenches of the joints
 //! it touches, and its Newton–Euler equations about its own centre of mass, in its
@@ -40,7 +40,7 @@ pub fn euler_matrix(w: &Vector3<f64>, dw: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 impl Reference {
-    /// The paper's per-body regressor (DESIGN §5), one `6 × 4` matrix per moving
+    /// The paper's per-body regressor (docs/design.md, "The paper's decoupled body model"), one `6 × 4` matrix per moving
     /// body, body 1 first: in body `i`'s centroidal principal frame (origin at the
     /// nominal centre of mass `c_i`, axes the columns of `R_i`, both from
     /// [`dyngen_model::PrincipalFrame`]),
@@ -78,7 +78,7 @@ impl Reference {
     /// Each moving body's resultant of the joint reaction wrenches acting on it,
     /// body 1 first: the force, and the moment about its (nominal) centre of mass,
     /// both in its centroidal principal frame. Computed through the graph matrices
-    /// (DESIGN §4),
+    /// (docs/design.md, "The paper's graph theory"),
     ///
     /// ```text
     /// F_i = Σ_a S_ia F_a

@@ -47,7 +47,7 @@ impl Reference {
     }
 
     /// The joint torque regressor `Y(q, v, a)` (`n × 10n`) with
-    /// `rnea(q, v, a, π) = Y π`, in Pinocchio's parameter order (DESIGN §3):
+    /// `rnea(q, v, a, π) = Y π`, in Pinocchio's parameter order (docs/design.md, "Conventions"):
     /// row `j` is the projection `S_jᵀ` of joint `j`'s rows of
     /// [`Reference::joint_wrench_regressor`]. Block `(j, i)` (row `j`, columns
     /// `10(i−1)..10i`) is zero unless joint `j` supports body `i`. Panics if a

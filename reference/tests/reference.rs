@@ -384,7 +384,7 @@ fn single_body_wrench_is_its_own_newton_euler() {
     }
 }
 
-/// The paper's decoupling (DESIGN §4): the joint wrench on body `i` minus what it
+/// The paper's decoupling (docs/design.md, "The paper's graph theory"): the joint wrench on body `i` minus what it
 /// passes on to its children is body `i`'s own Newton–Euler, about its frame origin.
 #[test]
 fn every_body_obeys_its_own_newton_euler() {

@@ -198,7 +198,7 @@ fn check_incidence_shape(cx: &Ctxt, m: &Matrix) -> Option<usize> {
 }
 
 /// Every column must have one +1 and one -1 and the bodies must form a tree rooted
-/// at the base (DESIGN §4); returns the entries and the tree when it does.
+/// at the base (docs/design.md, "The paper's graph theory"); returns the entries and the tree when it does.
 fn check_incidence_tree(cx: &Ctxt, m: &Matrix, n: Option<usize>) -> Option<(Vec<Vec<i64>>, IncidenceTree)> {
     n?;
     let rows: Vec<_> = m.rows.iter().flatten().collect();

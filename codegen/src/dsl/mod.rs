@@ -52,7 +52,7 @@
 //!
 //! # Meaning
 //!
-//! The paper's conventions (DESIGN §4): every body frame is that body's centroidal
+//! The paper's conventions (docs/design.md, "The paper's graph theory"): every body frame is that body's centroidal
 //! principal frame. `S_ia` is +1/−1 where joint `a` touches body `i`; a column may
 //! be oriented either way. `c_ia`, in body `i`'s frame, goes from body `i`'s centre of
 //! mass (for body 0: the base frame origin) to the point of joint `a` on body `i`; it

@@ -5,7 +5,7 @@
 //! # CSV schema
 //!
 //! The first line is a header of column names; each following line is one sample.
-//! For a robot with `n` joints (numbered `1..=n` in regular labelling, DESIGN §3):
+//! For a robot with `n` joints (numbered `1..=n` in regular labelling, docs/design.md, "Conventions"):
 //!
 //! | columns | meaning | unit | |
 //! |---|---|---|---|

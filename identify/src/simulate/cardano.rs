@@ -1,4 +1,4 @@
-//! Cardano angles, the orientation the paper measures (DESIGN §5): `R = Rx(α1)
+//! Cardano angles, the orientation the paper measures (docs/design.md, "The paper's decoupled body model"): `R = Rx(α1)
 //! Ry(α2) Rz(α3)` (x–y–z, each rotation about the axis already turned by the ones
 //! before it), and their rates from the body-axes angular velocity.
 //!
@@ -39,7 +39,7 @@ pub fn cardano_angles(r: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(alpha1, alpha2, alpha3)
 }
 
-/// `K(α)` with `ω = K(α) α̇`, `ω` the angular velocity in body axes (DESIGN §5):
+/// `K(α)` with `ω = K(α) α̇`, `ω` the angular velocity in body axes (docs/design.md, "The paper's decoupled body model"):
 ///
 /// ```text
 /// K = [  c2c3   s3   0 ]

@@ -359,7 +359,7 @@ impl Recording {
     }
 
     /// Body `body`'s (0-based: body 1 is 0) regressor `A_i` at sample `k`, from the
-    /// recorded channels, noisy or not (DESIGN §5):
+    /// recorded channels, noisy or not (docs/design.md, "The paper's decoupled body model"):
     ///
     /// ```text
     /// force  = [a_c − R(α)ᵀ g, 0, 0, 0]

@@ -22,7 +22,7 @@ pub mod sym;
 
 pub use base::{analyse_model, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
-pub use generate::{generate, is_type_name, Generated, Options};
+pub use generate::{generate, is_type_name, GeneratedCode, Options};
 
 use proc_macro2::TokenStream;
 use quote::quote;

@@ -3,10 +3,10 @@
 //! numerically in `generated_vs_reference.rs` and `pinocchio.rs`. The descriptions
 //! are read from the robot crates' sources, so there is one copy of each.
 
-use dyngen_codegen::{analyse_model, generate, Generated, Options};
+use dyngen_codegen::{analyse_model, generate, GeneratedCode, Options};
 
 /// Generates the robot declared by the `robot!` invocation in a robot crate's source.
-fn generate_from_crate(dir: &str) -> Generated {
+fn generate_from_crate(dir: &str) -> GeneratedCode {
     let (name, model) = dyngen_tests::robot_crate_model(dir);
     generate(&model, &name, &analyse_model(&model), &Options::default())
 }

@@ -724,6 +724,8 @@ fn model_expr(model: &Model) -> TokenStream {
             }
             None => quote!(::core::option::Option::None),
         };
+        let damping = emit::f64_lit(j.dynamics.damping);
+        let friction = emit::f64_lit(j.dynamics.friction);
         quote!(::dyngen::JointModel {
             name: #name,
             kind: ::dyngen::JointType::#kind,
@@ -732,6 +734,8 @@ fn model_expr(model: &Model) -> TokenStream {
             translation: #translation,
             axis: #axis,
             limits: #limits,
+            damping: #damping,
+            friction: #friction,
         })
     });
     let bodies = model.bodies.iter().map(|b| {

@@ -36,6 +36,10 @@ pub struct JointModel {
     /// Unit axis in the joint (= child body) frame.
     pub axis: [f64; 3],
     pub limits: Option<JointLimits>,
+    /// Nominal viscous friction `Fv` (URDF `<dynamics damping>`): `τ += Fv·q̇`.
+    pub damping: f64,
+    /// Nominal Coulomb friction `Fc` (URDF `<dynamics friction>`): `τ += Fc·sign(q̇)`.
+    pub friction: f64,
 }
 
 /// One moving body; its frame is its joint's frame.

@@ -24,6 +24,7 @@
 //! from its singular values ([`BaseParams::rank_check`]), which must equal the number
 //! of columns the QR kept.
 
+use crate::joint_params::{append_joint_columns, joint_param_names, Coulomb};
 use crate::math::singular_values;
 use crate::names::{principal_param_names, standard_param_names};
 use crate::regressor::{principal_from_standard, torque_regressor, PRINCIPAL_PER_BODY, STANDARD_PER_BODY};
@@ -50,13 +51,17 @@ pub enum Parameterisation {
     /// `θ_i = (m, J1, J2, J3)` with the nominal centre of mass and principal axes,
     /// 4 per body: `τ = Y blkdiag(P_i) θ` ([`crate::PrincipalFrame::p_matrix`]).
     Principal,
+    /// The standard parameters followed by the joint parameters `[Ia, Fv, Fc, F0]` of
+    /// every joint (`10n + 4n` columns, [`crate::joint_params`]), with the Coulomb
+    /// term as `sign(q̇)`: the model identified on a real robot.
+    StandardAndJoints,
 }
 
 impl Parameterisation {
     /// Parameters per body: 10 or 4.
     pub fn per_body(self) -> usize {
         match self {
-            Parameterisation::Standard => STANDARD_PER_BODY,
+            Parameterisation::Standard | Parameterisation::StandardAndJoints => STANDARD_PER_BODY,
             Parameterisation::Principal => PRINCIPAL_PER_BODY,
         }
     }
@@ -66,6 +71,11 @@ impl Parameterisation {
         match self {
             Parameterisation::Standard => standard_param_names(n),
             Parameterisation::Principal => principal_param_names(n),
+            Parameterisation::StandardAndJoints => {
+                let mut names = standard_param_names(n);
+                names.extend(joint_param_names(n));
+                names
+            }
         }
     }
 }
@@ -154,6 +164,11 @@ fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64) -> Vec<
         match parameterisation {
             Parameterisation::Standard => rows.extend(y),
             Parameterisation::Principal => rows.extend(principal_from_standard(model, &y)),
+            Parameterisation::StandardAndJoints => {
+                let mut y = y;
+                append_joint_columns(&mut y, &s.v, &s.a, Coulomb::Sign);
+                rows.extend(y);
+            }
         }
     }
     rows
@@ -305,6 +320,37 @@ fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize
 mod tests {
     use super::*;
 
+    /// With rotor inertia and friction every joint adds 4 columns, all identifiable
+    /// but the rotor inertias of the first two joints: the first moves only with body
+    /// 1 about the same axis, and with the second axis perpendicular to and meeting
+    /// the first, the second's rotor enters exactly as body 2's `Izz` does (the
+    /// classical regrouping `ZZ2R = ZZ2 + Ia2`).
+    #[test]
+    fn joint_parameters_add_four_columns_per_joint_but_the_first_two_rotors() {
+        let model = crate::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap();
+        let standard = analyse(&model, Parameterisation::Standard);
+        let all = analyse(&model, Parameterisation::StandardAndJoints);
+        assert!(all.is_consistent(), "{all}");
+        assert_eq!(all.count(), standard.count() + 4 * 6 - 2, "{all}");
+        assert_eq!(Parameterisation::StandardAndJoints.names(6).len(), 84);
+        assert_eq!(&all.independent[..standard.count()], &standard.independent[..]);
+        for (ia, izz) in [(60, "Izz1"), (64, "Izz2")] {
+            assert!(!all.independent.contains(&ia), "{all}");
+            let name = &Parameterisation::StandardAndJoints.names(6)[ia];
+            assert!(
+                all.groupings
+                    .iter()
+                    .any(|g| g.starts_with(izz) && g.contains(name.as_str())),
+                "{all}"
+            );
+        }
+        for c in 60..84 {
+            if c != 60 && c != 64 {
+                assert!(all.independent.contains(&c), "column {c} of {all}");
+            }
+        }
+    }
+
     #[test]
     fn coefficients_snap_to_short_decimals_only_when_within_rounding() {
         assert_eq!(clean(0.18062499999999998), 0.180625);
@@ -411,6 +457,7 @@ mod tests {
                     let y = match param {
                         Parameterisation::Standard => joint_torque_regressor(&model, &s.q, &s.v, &s.a),
                         Parameterisation::Principal => principal_regressor(&model, &s.q, &s.v, &s.a),
+                        Parameterisation::StandardAndJoints => unreachable!("not among the cases"),
                     }
                     .unwrap();
                     for row in &y {

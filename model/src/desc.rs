@@ -4,7 +4,7 @@
 //! declaration order, or by joint name as Pinocchio and urdfdom number them).
 
 use crate::error::{Element, ErrorKind, ModelError};
-use crate::ir::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
+use crate::ir::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
 use std::collections::HashMap;
 
@@ -33,6 +33,8 @@ pub struct JointDesc {
     pub origin: Placement,
     pub axis: [f64; 3],
     pub limits: Option<Limits>,
+    /// `<dynamics damping friction>`; zero when not given.
+    pub dynamics: JointDynamics,
     pub line: Option<usize>,
 }
 
@@ -170,6 +172,19 @@ impl Description {
                     errors.push(err(el(), j.line, ErrorKind::ZeroAxis));
                 }
             }
+            let d = j.dynamics;
+            if !(d.damping.is_finite() && d.friction.is_finite()) {
+                errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("<dynamics>")));
+            } else if d.damping < 0.0 || d.friction < 0.0 {
+                errors.push(err(
+                    el(),
+                    j.line,
+                    ErrorKind::NegativeFriction {
+                        damping: d.damping,
+                        friction: d.friction,
+                    },
+                ));
+            }
             if let Some(l) = j.limits {
                 if !(l.lower.is_finite() && l.upper.is_finite() && l.velocity.is_finite() && l.effort.is_finite()) {
                     errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("a limit")));
@@ -265,6 +280,7 @@ impl Description {
                         origin,
                         axis: math::scale(1.0 / math::norm(&j.axis), &j.axis),
                         limits: if *kind == JointKind::Continuous { None } else { j.limits },
+                        dynamics: j.dynamics,
                     });
                     model.bodies.push(Body {
                         name: self.links[link].name.clone(),

@@ -62,6 +62,11 @@ pub enum ErrorKind {
         lower: f64,
         upper: f64,
     },
+    /// `<dynamics>` with a negative damping or friction: friction dissipates.
+    NegativeFriction {
+        damping: f64,
+        friction: f64,
+    },
     NoMovingJoint,
 }
 
@@ -122,6 +127,11 @@ impl fmt::Display for ModelError {
             ErrorKind::BadLimits { lower, upper } => {
                 write!(f, "limits lower = {lower} > upper = {upper}; the lower limit must not exceed the upper")
             }
+            ErrorKind::NegativeFriction { damping, friction } => write!(
+                f,
+                "<dynamics damping=\"{damping}\" friction=\"{friction}\"> is negative; friction only dissipates, \
+                 give values ≥ 0"
+            ),
             ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
         }
     }

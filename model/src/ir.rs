@@ -174,6 +174,17 @@ impl Inertial {
     }
 }
 
+/// What a joint does besides moving its body, as the description gives it (URDF
+/// `<dynamics damping friction>`): the nominal viscous and Coulomb friction of the
+/// joint parameters `[Ia, Fv, Fc, F0]` ([`crate::joint_params`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointDynamics {
+    /// Viscous friction `Fv` (N·m·s/rad or N·s/m): `τ += Fv·q̇`.
+    pub damping: f64,
+    /// Coulomb friction `Fc` (N·m or N): `τ += Fc·sign(q̇)`.
+    pub friction: f64,
+}
+
 /// A joint of the checked model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Joint {
@@ -186,6 +197,7 @@ pub struct Joint {
     /// Unit axis in the joint (= child body) frame.
     pub axis: Vec3,
     pub limits: Option<Limits>,
+    pub dynamics: JointDynamics,
 }
 
 /// A moving body of the checked model; its frame is its joint's frame.

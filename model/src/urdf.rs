@@ -5,7 +5,7 @@
 
 use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
-use crate::ir::{Inertial, JointKind, Limits, Model, Placement};
+use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
 use crate::xml::{scan, SyntaxError, Tag};
 use std::path::Path;
@@ -122,6 +122,14 @@ fn read(text: &str) -> Result<(Description, Option<usize>), Vec<ModelError>> {
                 origin: Placement::from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0),
                 axis: joint.axis.xyz.0,
                 limits,
+                dynamics: joint
+                    .dynamics
+                    .as_ref()
+                    .map(|d| JointDynamics {
+                        damping: d.damping,
+                        friction: d.friction,
+                    })
+                    .unwrap_or_default(),
                 line: source.map(|s| s.tag.line),
             }
         })

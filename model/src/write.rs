@@ -92,6 +92,14 @@ pub fn to_urdf(model: &Model) -> String {
                 num(velocity)
             ));
         }
+        let d = joint.dynamics;
+        if d.damping != 0.0 || d.friction != 0.0 {
+            out.push_str(&format!(
+                "    <dynamics damping=\"{}\" friction=\"{}\"/>\n",
+                num(d.damping),
+                num(d.friction)
+            ));
+        }
         out.push_str("  </joint>\n");
     }
     out.push_str("</robot>\n");

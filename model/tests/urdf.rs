@@ -897,3 +897,48 @@ fn to_urdf_escapes_names() {
     assert_eq!(back.name, m.name);
     assert_eq!(back.bodies[0].name, "a'b");
 }
+
+#[test]
+fn joint_dynamics_are_read_and_written_back() {
+    let dynamics = r#"<limit lower="-1" upper="1" effort="1" velocity="1"/><dynamics damping="0.7" friction="1.25"/>"#;
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "revolute", "base", "a", dynamics),
+    ]);
+    let model = parse_urdf(&text).unwrap();
+    assert_eq!(model.joints[0].dynamics.damping, 0.7);
+    assert_eq!(model.joints[0].dynamics.friction, 1.25);
+    assert_eq!(
+        dyngen_model::joint_params::nominal_joint_params(&model),
+        [0.0, 0.7, 1.25, 0.0]
+    );
+    let written = to_urdf(&model);
+    assert!(
+        written.contains(r#"<dynamics damping="0.7" friction="1.25"/>"#),
+        "{written}"
+    );
+    assert_eq!(
+        parse_urdf(&written).unwrap().joints[0].dynamics,
+        model.joints[0].dynamics
+    );
+}
+
+#[test]
+fn negative_friction() {
+    let dynamics = r#"<dynamics damping="-0.5" friction="1"/>"#;
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", dynamics),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(
+        e.kind,
+        ErrorKind::NegativeFriction {
+            damping: -0.5,
+            friction: 1.0
+        }
+    );
+    assert!(e.to_string().contains("give values ≥ 0"), "{e}");
+}

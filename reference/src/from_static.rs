@@ -3,7 +3,7 @@
 //! so the reference, identification and NIM see exactly the generator's numbering.
 
 use dyngen::{JointType, Robot, RobotModel};
-use dyngen_model::{Body, Inertial, Joint, JointKind, Limits, Model, Placement};
+use dyngen_model::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 
 /// The runtime model of a generated robot's `MODEL`.
 pub fn model_from_static(m: &RobotModel) -> Model {
@@ -33,6 +33,10 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     velocity: l.velocity,
                     effort: l.effort,
                 }),
+                dynamics: JointDynamics {
+                    damping: j.damping,
+                    friction: j.friction,
+                },
             })
             .collect(),
         bodies: m

@@ -50,6 +50,7 @@ fn joint(name: &str, kind: JointKind, parent: &str, child: &str, origin: Placeme
         origin,
         axis,
         limits,
+        dynamics: Default::default(),
         line: None,
     }
 }

@@ -104,6 +104,7 @@ impl RandomTree {
                 origin,
                 axis,
                 limits,
+                dynamics: Default::default(),
                 line: None,
             });
             links.push(GenLink {

@@ -32,6 +32,11 @@ fn check<R: Robot>(want: &Model) {
         assert_eq!(g.rotation, w.origin.rotation, "{who}: {j} rotation");
         assert_eq!(g.translation, w.origin.translation, "{who}: {j} translation");
         assert_eq!(g.axis, w.axis, "{who}: {j} axis");
+        assert_eq!(
+            [g.damping, g.friction],
+            [w.dynamics.damping, w.dynamics.friction],
+            "{who}: {j} dynamics"
+        );
         match (&g.limits, &w.limits) {
             (None, None) => {}
             (Some(g), Some(w)) => {

@@ -59,6 +59,7 @@ pub fn lower(robot: &Robot, tree: &IncidenceTree) -> Option<Description> {
                 velocity: 0.0,
                 effort: 0.0,
             }),
+            dynamics: Default::default(),
             line: None,
         });
     }

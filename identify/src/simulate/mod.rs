@@ -30,6 +30,7 @@ mod cardano;
 mod excitation;
 mod experiment;
 mod integrate;
+mod logger;
 mod motion;
 mod nelder_mead;
 mod noise;
@@ -38,5 +39,6 @@ pub use cardano::{cardano_angles, cardano_matrix, cardano_rate_matrix, cardano_r
 pub use excitation::{base_columns, moment_sigma, Criterion, ExcitationDesign, JointLimits, OptimisedExcitation};
 pub use experiment::{record, record_trajectory, BodyMeasurement, Experiment, Motion, Recording, Sample};
 pub use integrate::{simulate_rk4, Simulation};
+pub use logger::{add_joint_terms, Logger};
 pub use motion::{FourierExcitation, RaisedCosine, SampledMotion, Trajectory};
 pub use noise::{Channel, Gaussian, NoiseModel, Sigma};

@@ -32,6 +32,7 @@ pub mod data;
 pub mod mim;
 pub mod report;
 pub mod simulate;
+pub mod validate;
 
 mod accumulate;
 mod dense;

@@ -48,6 +48,7 @@ use crate::faer::Mat;
 use crate::simulate::Recording;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options, ParamEstimate, Status};
 use dyngen::Robot;
+use dyngen_model::joint_params::{joint_regressor_row, Coulomb, PER_JOINT};
 use dyngen_model::{principal_frames, Model};
 use dyngen_reference::Dynamics;
 use nalgebra::DMatrix;
@@ -541,6 +542,10 @@ pub enum TorqueRegressor {
     Principal,
     /// A generated robot's principal base regressor (`n × NBASE_PRINCIPAL`).
     PrincipalBase { columns: usize, regressor: RegressorFn },
+    /// `[Y | J]` (`n × 14n`): the standard parameters, then per joint rotor inertia,
+    /// viscous and Coulomb friction and an offset `[Ia, Fv, Fc, F0]`
+    /// ([`dyngen_model::joint_params`]): the model of a real robot's joint torques.
+    StandardAndJoints(Coulomb),
 }
 
 impl fmt::Debug for TorqueRegressor {
@@ -549,6 +554,7 @@ impl fmt::Debug for TorqueRegressor {
             TorqueRegressor::Standard => write!(f, "Standard"),
             TorqueRegressor::Principal => write!(f, "Principal"),
             TorqueRegressor::PrincipalBase { columns, .. } => write!(f, "PrincipalBase({columns})"),
+            TorqueRegressor::StandardAndJoints(c) => write!(f, "StandardAndJoints({c:?})"),
         }
     }
 }
@@ -560,6 +566,7 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => 10 * n,
             TorqueRegressor::Principal => 4 * n,
             TorqueRegressor::PrincipalBase { columns, .. } => *columns,
+            TorqueRegressor::StandardAndJoints(_) => (10 + PER_JOINT) * n,
         }
     }
 
@@ -569,6 +576,27 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => dynamics.joint_torque_regressor(q, v, a, y),
             TorqueRegressor::Principal => dynamics.principal_regressor(q, v, a, y),
             TorqueRegressor::PrincipalBase { regressor, .. } => regressor(q, v, a, y),
+            TorqueRegressor::StandardAndJoints(coulomb) => {
+                let n = q.len();
+                let p = (10 + PER_JOINT) * n;
+                y[..n * p].fill(0.0);
+                // The rigid-body block is computed into the first 10n columns of each
+                // row, written row by row so that one buffer serves.
+                let mut rigid = [0.0; 10 * 64];
+                let mut scratch = Vec::new();
+                let rigid: &mut [f64] = if 10 * n * n <= rigid.len() {
+                    &mut rigid[..10 * n * n]
+                } else {
+                    scratch.resize(10 * n * n, 0.0);
+                    &mut scratch
+                };
+                dynamics.joint_torque_regressor(q, v, a, rigid);
+                for j in 0..n {
+                    y[j * p..j * p + 10 * n].copy_from_slice(&rigid[j * 10 * n..(j + 1) * 10 * n]);
+                    let at = j * p + 10 * n + PER_JOINT * j;
+                    y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], *coulomb));
+                }
+            }
         }
     }
 }
@@ -824,6 +852,35 @@ pub fn torque_principal_base<R: Robot>(
         regressor,
         names,
         Some(&truth),
+        weighting,
+        opts,
+    )
+}
+
+/// Identification of a real robot's joint torques: the standard parameters and, per
+/// joint, rotor inertia, viscous and Coulomb friction and an offset
+/// ([`TorqueRegressor::StandardAndJoints`]), with rank handling. `truth`: `14n`
+/// (`10n` standard parameters, then `[Ia, Fv, Fc, F0]` per joint).
+#[allow(clippy::too_many_arguments)]
+pub fn torque_with_joints(
+    dynamics: &dyn Dynamics,
+    recording: &Recording,
+    range: Range<usize>,
+    coulomb: Coulomb,
+    truth: Option<&[f64]>,
+    weighting: Weighting,
+    opts: &Options,
+) -> Result<TorqueEstimate, IdentifyError> {
+    let n = dynamics.nv();
+    let mut names = standard_names(n);
+    names.extend(dyngen_model::joint_params::joint_param_names(n));
+    torque_estimate(
+        dynamics,
+        recording,
+        range,
+        TorqueRegressor::StandardAndJoints(coulomb),
+        names,
+        truth,
         weighting,
         opts,
     )

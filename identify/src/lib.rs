@@ -29,6 +29,7 @@
 //! ```
 
 pub mod data;
+pub mod friction;
 pub mod mim;
 pub mod report;
 pub mod simulate;

@@ -30,6 +30,7 @@
 
 pub mod data;
 pub mod friction;
+pub mod gains;
 pub mod mim;
 pub mod report;
 pub mod simulate;

@@ -33,6 +33,7 @@ mod integrate;
 mod logger;
 mod motion;
 mod nelder_mead;
+pub(crate) use nelder_mead::minimise;
 mod noise;
 
 pub use cardano::{cardano_angles, cardano_matrix, cardano_rate_matrix, cardano_rates};

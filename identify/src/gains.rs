@@ -1,0 +1,288 @@
+//! Drive gains identified with the robot (Gautier and Briot's global
+//! identification): motor currents `i` relate to torques by `τ_j = k_j·i_j` with
+//! unknown `k`. Without a known load the scale of `k` and of every dynamic parameter
+//! is free (`k` and the parameters can all be doubled); one recording with a known
+//! payload fixes it. The unknowns `x = [π; φ; k]` (`10n` standard parameters, `4n`
+//! joint parameters `[Ia, Fv, Fc, F0]`, `n` gains) solve, stacked over both
+//! recordings,
+//!
+//! ```text
+//! Y(q, q̇, q̈) π + J(q̇, q̈) φ − diag(i) k = −Y_L(q, q̇, q̈) π_L
+//! ```
+//!
+//! where `Y_L` is the payload regressor (the 10 columns of the body carrying the
+//! load) and `π_L` the payload's known standard parameters; the right side is zero
+//! for the recording without payload.
+//!
+//! Solved as it stands by least squares, the measured current sits in the regressor
+//! and its noise biases every gain toward zero (errors in variables: 2–3 % at 1 %
+//! current noise on a joint the payload barely loads). So the stacked solution only
+//! starts an alternating least squares in current units, where the noise belongs:
+//! `i_j = w_j (Y_j π + J_j φ + Y_Lj π_L)` with `w_j = 1/k_j`; for fixed `w` the
+//! parameters solve a weighted linear problem, for fixed parameters each `w_j` is a
+//! ratio of sums. Each step lowers the same sum of squares, so it converges; all the
+//! sums come from one pass over the data (the Gram matrices of the accumulator).
+
+use crate::data::Trajectory;
+use crate::faer::Mat;
+use crate::{Accumulator, Channels, Estimate, IdentifyError, Options};
+use dyngen_model::joint_params::{joint_regressor_row, Coulomb, PER_JOINT};
+use dyngen_reference::Dynamics;
+
+/// A load of known mass properties fixed to one body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Payload {
+    /// The carrying body, `1..=n`.
+    pub body: usize,
+    /// Its standard parameters in that body's frame (`[m, m·c, I about the body
+    /// origin]`, 10, the order of the standard parameters).
+    pub params: [f64; 10],
+}
+
+/// The outcome.
+#[derive(Clone, Debug)]
+pub struct GainEstimate {
+    /// The stacked least-squares estimate over `[π; φ; k]` that starts the
+    /// alternation: its rank and identifiable combinations hold for the final one.
+    pub initial: Estimate,
+    /// `k_j` per joint.
+    pub gains: Vec<f64>,
+    /// `[π; φ]` (`14n`) at the end: a minimum-norm solution (use it to predict; the
+    /// identifiable combinations are those of [`GainEstimate::initial`]).
+    pub solution: Vec<f64>,
+    /// Linear solves spent (alternations and simplex trials), and the relative
+    /// change of the gains the simplex search made after the alternation.
+    pub iterations: usize,
+    pub last_change: f64,
+}
+
+/// Identifies drive gains, standard and joint parameters from two recordings whose
+/// "torque" columns hold motor currents (read without gains), with velocities and
+/// accelerations: `unloaded` without the payload, `loaded` with it.
+pub fn identify_gains(
+    dynamics: &dyn Dynamics,
+    unloaded: &Trajectory,
+    loaded: &Trajectory,
+    payload: &Payload,
+    coulomb: Coulomb,
+    opts: &Options,
+) -> Result<GainEstimate, IdentifyError> {
+    let n = dynamics.nv();
+    if payload.body == 0 || payload.body > n {
+        return Err(IdentifyError::InvalidArgument {
+            what: "payload body",
+            reason: format!("{} is not a moving body (1..={n})", payload.body),
+        });
+    }
+    let rigid = 10 * n;
+    let pa = rigid + PER_JOINT * n;
+    // Columns: A (π, φ), then −i_j of each joint (the stacked problem's k), then the
+    // payload term l; the observation is −l. One accumulator serves both the stacked
+    // solution and, through its per-joint Gram matrices, the alternation.
+    let p = pa + n + 1;
+    let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n))?;
+    let mut y = vec![0.0; n * rigid];
+    let mut row = Mat::<f64>::zeros(n, p);
+    let mut rhs = vec![0.0; n];
+    for (traj, with_load) in [(unloaded, false), (loaded, true)] {
+        if traj.dof() != n {
+            return Err(IdentifyError::DimensionMismatch {
+                what: "joints of a recording",
+                expected: n,
+                found: traj.dof(),
+            });
+        }
+        for s in traj.samples() {
+            let (v, a) = match (s.v, s.a) {
+                (Some(v), Some(a)) => (v, a),
+                _ => {
+                    return Err(IdentifyError::InvalidArgument {
+                        what: "recording",
+                        reason: "velocities and accelerations are needed (estimate them first)".into(),
+                    })
+                }
+            };
+            dynamics.joint_torque_regressor(s.q, v, a, &mut y);
+            for j in 0..n {
+                for c in 0..p {
+                    row[(j, c)] = 0.0;
+                }
+                for c in 0..rigid {
+                    row[(j, c)] = y[j * rigid + c];
+                }
+                let jr = joint_regressor_row(v[j], a[j], coulomb);
+                for (m, x) in jr.iter().enumerate() {
+                    row[(j, rigid + PER_JOINT * j + m)] = *x;
+                }
+                row[(j, pa + j)] = -s.tau[j];
+                let l = if with_load {
+                    let b = payload.body - 1;
+                    (0..10)
+                        .map(|m| y[j * rigid + 10 * b + m] * payload.params[m])
+                        .sum::<f64>()
+                } else {
+                    0.0
+                };
+                row[(j, p - 1)] = l;
+                rhs[j] = -l;
+            }
+            acc.push_rows(row.as_ref(), &rhs)?;
+        }
+    }
+    // The stacked solution, without the payload column (it is known: 0 there).
+    let grams: Vec<Mat<f64>> = acc.factors()?.iter().map(|f| f.r.transpose() * &f.r).collect();
+    let mut stacked = Accumulator::new(pa + n);
+    let gram_all = grams.iter().fold(Mat::<f64>::zeros(p + 1, p + 1), |s, g| s + g);
+    let initial = {
+        // ‖[A −I] x − (−l)‖²: push the Gram's factor of the first pa + n columns and
+        // the observation column.
+        let keep: Vec<usize> = (0..pa + n).chain([p]).collect();
+        let g = Mat::from_fn(keep.len(), keep.len(), |r, c| gram_all[(keep[r], keep[c])]);
+        let f = gram_root(g.as_ref())?;
+        stacked.push_rows(
+            f.as_ref().subcols(0, pa + n),
+            &(0..f.nrows()).map(|r| f[(r, pa + n)]).collect::<Vec<_>>(),
+        )?;
+        stacked.ols(opts)?
+    };
+    let mut w: Vec<f64> = (0..n)
+        .map(|j| {
+            let k = initial.solution[pa + j];
+            if k.is_finite() && k != 0.0 {
+                Ok(1.0 / k)
+            } else {
+                Err(IdentifyError::InvalidArgument {
+                    what: "recordings",
+                    reason: format!("they do not determine the gain of joint {}", j + 1),
+                })
+            }
+        })
+        .collect::<Result<_, _>>()?;
+    let block = |g: &Mat<f64>, r0: usize, c0: usize, rows: usize, cols: usize| {
+        Mat::from_fn(rows, cols, |r, c| g[(r0 + r, c0 + c)])
+    };
+    // For fixed w the parameters solve Σ_j w_j² A_jᵀA_j x = Σ_j w_j (A_jᵀ i_j − w_j A_jᵀ l_j)
+    // (column pa + j holds −i_j); the sum of squares in current units is then
+    // Σ_j (Σ i² − 2 w_j Σ i f + w_j² Σ f²) with f = A_j x + l_j.
+    let ata: Vec<Mat<f64>> = grams.iter().map(|g| block(g, 0, 0, pa, pa)).collect();
+    let solve = |w: &[f64]| -> Result<Vec<f64>, IdentifyError> {
+        let mut lhs = Mat::<f64>::zeros(pa, pa);
+        let mut b = vec![0.0; pa];
+        for (j, g) in grams.iter().enumerate() {
+            lhs += &ata[j] * (w[j] * w[j]);
+            for c in 0..pa {
+                b[c] += w[j] * (-g[(c, pa + j)] - w[j] * g[(c, p - 1)]);
+            }
+        }
+        min_norm_solve(lhs.as_ref(), &b)
+    };
+    // Per joint: (Σ i f, Σ f²) at x.
+    let sums = |x: &[f64]| -> Vec<(f64, f64)> {
+        grams
+            .iter()
+            .enumerate()
+            .map(|(j, g)| {
+                let i_f: f64 = (0..pa).map(|c| -g[(c, pa + j)] * x[c]).sum::<f64>() - g[(pa + j, p - 1)];
+                let quad: f64 = (0..pa)
+                    .map(|r| x[r] * (0..pa).map(|c| ata[j][(r, c)] * x[c]).sum::<f64>())
+                    .sum();
+                let cross: f64 = (0..pa).map(|c| g[(c, p - 1)] * x[c]).sum();
+                (i_f, quad + 2.0 * cross + g[(p - 1, p - 1)])
+            })
+            .collect()
+    };
+    let objective = |w: &[f64], x: &[f64]| -> f64 {
+        sums(x)
+            .iter()
+            .enumerate()
+            .map(|(j, (i_f, ff))| grams[j][(pa + j, pa + j)] - 2.0 * w[j] * i_f + w[j] * w[j] * ff)
+            .sum()
+    };
+    // Alternating least squares first (each step lowers the sum of squares) ...
+    let mut iterations = 0;
+    for _ in 0..30 {
+        iterations += 1;
+        let x = solve(&w)?;
+        for (j, (i_f, ff)) in sums(&x).into_iter().enumerate() {
+            let new = i_f / ff;
+            if !(new.is_finite() && new != 0.0) {
+                return Err(IdentifyError::NotConverged {
+                    algorithm: "alternating least squares of the drive gains",
+                    iterations,
+                });
+            }
+            w[j] = new;
+        }
+    }
+    // ... then, as alternation crawls along the weakly determined common scale, the
+    // sum of squares minimised over the gains alone (the parameters solved for each
+    // trial), by a simplex search in log w.
+    let start: Vec<f64> = w.iter().map(|w| w.abs().ln()).collect();
+    let signs: Vec<f64> = w.iter().map(|w| w.signum()).collect();
+    let to_w = |u: &[f64]| -> Vec<f64> { u.iter().zip(&signs).map(|(u, s)| s * u.exp()).collect() };
+    let mut evaluations = 0;
+    let best = crate::simulate::minimise(
+        &mut |u: &[f64]| {
+            let w = to_w(u);
+            match solve(&w) {
+                Ok(x) => objective(&w, &x),
+                Err(_) => f64::INFINITY,
+            }
+        },
+        &start,
+        &vec![1e-3; n],
+        4000,
+        &mut evaluations,
+    );
+    let last_change = best
+        .x
+        .iter()
+        .zip(&start)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    w = to_w(&best.x);
+    iterations += evaluations;
+    let x = solve(&w)?;
+    Ok(GainEstimate {
+        initial,
+        gains: w.iter().map(|w| 1.0 / w).collect(),
+        solution: x,
+        iterations,
+        last_change,
+    })
+}
+
+/// `F` with `FᵀF = G` for a symmetric positive semi-definite `G`.
+fn gram_root(g: faer::MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
+    let n = g.nrows();
+    let eigen = g
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| IdentifyError::DecompositionFailed {
+            what: "eigendecomposition of the normal equations",
+        })?;
+    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    Ok(Mat::from_fn(n, n, |i, j| values[i].max(0.0).sqrt() * vectors[(j, i)]))
+}
+
+/// The minimum-norm solution of the symmetric system `G x = b`, eigenvalues below
+/// `1e-12` of the largest counted as zero.
+fn min_norm_solve(g: faer::MatRef<'_, f64>, b: &[f64]) -> Result<Vec<f64>, IdentifyError> {
+    let n = g.nrows();
+    let eigen = g
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| IdentifyError::DecompositionFailed {
+            what: "eigendecomposition of the normal equations",
+        })?;
+    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    let largest = (0..n).map(|i| values[i].abs()).fold(0.0, f64::max);
+    let mut x = vec![0.0; n];
+    for i in 0..n {
+        if values[i] > 1e-12 * largest {
+            let proj: f64 = (0..n).map(|r| vectors[(r, i)] * b[r]).sum::<f64>() / values[i];
+            for r in 0..n {
+                x[r] += proj * vectors[(r, i)];
+            }
+        }
+    }
+    Ok(x)
+}

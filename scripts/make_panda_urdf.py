@@ -48,7 +48,7 @@ import sys
 
 import numpy as np
 
-from urdf_writer import exact_cs, fmt, link_xml, main
+from urdf_writer import exact_cs, joint_xml, link_xml, main
 
 PI = math.pi
 
@@ -151,21 +151,11 @@ def urdf_text():
     s.append('  <link name="panda_link0"/>\n')
     for i in range(7):
         xyz, rpy = origin(i)
-        s.append(f'  <joint name="panda_joint{i + 1}" type="revolute">\n'
-                 f'    <parent link="panda_link{i}"/>\n'
-                 f'    <child link="panda_link{i + 1}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(Q_MIN[i])}" upper="{repr(Q_MAX[i])}" '
-                 f'effort="{repr(TAU_MAX[i])}" velocity="{repr(DQ_MAX[i])}"/>\n'
-                 f'  </joint>\n')
+        s.append(joint_xml(f"panda_joint{i + 1}", "revolute", f"panda_link{i}", f"panda_link{i + 1}", xyz, rpy,
+                           "0 0 1", (Q_MIN[i], Q_MAX[i], TAU_MAX[i], DQ_MAX[i])))
         s.append(link_xml(f"panda_link{i + 1}", MASS[i], COM[i], tensor(INERTIA[i])))
     xyz, rpy = origin(7)
-    s.append('  <joint name="panda_joint8" type="fixed">\n'
-             '    <parent link="panda_link7"/>\n'
-             '    <child link="panda_link8"/>\n'
-             f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("panda_joint8", "fixed", "panda_link7", "panda_link8", xyz, rpy))
     s.append('  <link name="panda_link8"/>\n')
     s.append('</robot>\n')
     return "".join(s)

@@ -44,7 +44,7 @@ import sys
 
 import numpy as np
 
-from urdf_writer import fmt, link_xml, main, rotx
+from urdf_writer import joint_xml, link_xml, main, rotx
 
 PI = math.pi
 DEG = PI / 180.0
@@ -158,22 +158,12 @@ def urdf_text():
         else:
             xyz, rpy = [A[i - 1], 0.0, D[i - 1]], [ALPHA[i - 1], 0.0, 0.0]
         lo, hi = QLIM_DEG[i]
-        s.append(f'  <joint name="{JOINTS[i]}" type="revolute">\n'
-                 f'    <parent link="{parent}"/>\n'
-                 f'    <child link="{LINKS[i]}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(lo * DEG)}" upper="{repr(hi * DEG)}" '
-                 f'effort="{repr(EFFORT[i])}" velocity="{repr(VELOCITY[i])}"/>\n'
-                 f'  </joint>\n')
+        s.append(joint_xml(JOINTS[i], "revolute", parent, LINKS[i], xyz, rpy, "0 0 1",
+                           (lo * DEG, hi * DEG, EFFORT[i], VELOCITY[i])))
         m, c, I = params[i]
         s.append(link_xml(LINKS[i], m, c, I))
         parent = LINKS[i]
-    s.append('  <joint name="flange_fixed_joint" type="fixed">\n'
-             '    <parent link="link6"/>\n'
-             '    <child link="flange"/>\n'
-             f'    <origin xyz="{fmt([A[5], 0.0, D[5]])}" rpy="{fmt([ALPHA[5], 0.0, 0.0])}"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("flange_fixed_joint", "fixed", "link6", "flange", [A[5], 0.0, D[5]], [ALPHA[5], 0.0, 0.0]))
     s.append('  <link name="flange"/>\n')
     s.append('</robot>\n')
     return "".join(s)

@@ -25,7 +25,7 @@ import sys
 
 import numpy as np
 
-from urdf_writer import fmt, link_xml, main
+from urdf_writer import joint_xml, link_xml, main
 
 # Links: name -> (mass kg, com xyz in link frame, box dims (x, y, z) m, box rpy in link frame)
 LINKS = {
@@ -106,20 +106,15 @@ def inertia(name):
     return I
 
 
-def joint_xml(j):
+def tree_joint_xml(j):
     name, typ, parent, child, xyz, rpy, axis, lim, effort, vel = j
-    s = (f'  <joint name="{name}" type="{typ}">\n'
-         f'    <parent link="{parent}"/>\n'
-         f'    <child link="{child}"/>\n'
-         f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n')
-    if axis is not None:
-        s += f'    <axis xyz="{fmt(axis)}"/>\n'
     if typ in ("revolute", "prismatic"):
-        s += (f'    <limit lower="{repr(lim[0])}" upper="{repr(lim[1])}" '
-              f'effort="{repr(effort)}" velocity="{repr(vel)}"/>\n')
+        limit = (lim[0], lim[1], effort, vel)
     elif typ == "continuous":
-        s += f'    <limit effort="{repr(effort)}" velocity="{repr(vel)}"/>\n'
-    return s + '  </joint>\n'
+        limit = (effort, vel)
+    else:
+        limit = None
+    return joint_xml(name, typ, parent, child, xyz, rpy, axis, limit)
 
 
 HEADER = """<?xml version="1.0"?>
@@ -165,7 +160,7 @@ def urdf_text():
     by_child = {j[3]: j for j in JOINTS}
     for name in LINK_ORDER:
         if name in by_child:
-            s.append(joint_xml(by_child[name]))
+            s.append(tree_joint_xml(by_child[name]))
         m, com, _, _ = LINKS[name]
         s.append(link_xml(name, m, com, inertia(name)))
     s.append("</robot>\n")

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from urdf_writer import fmt, link_xml, main, rotx
+from urdf_writer import joint_xml, link_xml, main, rotx
 
 PI = math.pi
 
@@ -146,28 +146,16 @@ def urdf_text():
             xyz, rpy = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
         else:
             xyz, rpy = [A[i - 1], 0.0, D[i - 1]], [ALPHA[i - 1], 0.0, 0.0]
-        s.append(f'  <joint name="{JOINTS[i]}" type="revolute">\n'
-                 f'    <parent link="{parent}"/>\n'
-                 f'    <child link="{LINKS[i]}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(-LIMIT)}" upper="{repr(LIMIT)}" effort="{repr(EFFORT[i])}" velocity="{repr(VELOCITY)}"/>\n'
-                 f'  </joint>\n')
+        s.append(joint_xml(JOINTS[i], "revolute", parent, LINKS[i], xyz, rpy, "0 0 1",
+                           (-LIMIT, LIMIT, EFFORT[i], VELOCITY)))
         m, c, I = params[i]
         s.append(link_xml(LINKS[i], m, c, I))
         parent = LINKS[i]
     It = cylinder(TOOL0["mass"], TOOL0["radius"], TOOL0["length"], "z")
-    s.append('  <joint name="wrist_3_link-tool0_fixed_joint" type="fixed">\n'
-             '    <parent link="wrist_3_link"/>\n'
-             '    <child link="tool0"/>\n'
-             f'    <origin xyz="{fmt([A[5], 0.0, D[5]])}" rpy="{fmt([ALPHA[5], 0.0, 0.0])}"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("wrist_3_link-tool0_fixed_joint", "fixed", "wrist_3_link", "tool0",
+                       [A[5], 0.0, D[5]], [ALPHA[5], 0.0, 0.0]))
     s.append(link_xml("tool0", TOOL0["mass"], TOOL0["com"], It))
-    s.append('  <joint name="ee_fixed_joint" type="fixed">\n'
-             '    <parent link="tool0"/>\n'
-             '    <child link="ee_link"/>\n'
-             f'    <origin xyz="{fmt(EE_XYZ)}" rpy="0 0 0"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("ee_fixed_joint", "fixed", "tool0", "ee_link", EE_XYZ, [0.0, 0.0, 0.0]))
     s.append('  <link name="ee_link"/>\n')
     s.append("</robot>\n")
     return "".join(s)

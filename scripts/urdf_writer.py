@@ -56,6 +56,25 @@ def link_xml(name, mass, com, I):
     return f'  <link name="{name}">\n' + inertial_xml(mass, com, I) + '  </link>\n'
 
 
+def joint_xml(name, kind, parent, child, xyz, rpy, axis=None, limit=None):
+    """A `<joint>`. `axis`: a list, or text written as it is; `limit`: `(lower, upper,
+    effort, velocity)`, or `(effort, velocity)` for a continuous joint."""
+    s = (f'  <joint name="{name}" type="{kind}">\n'
+         f'    <parent link="{parent}"/>\n'
+         f'    <child link="{child}"/>\n'
+         f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n')
+    if axis is not None:
+        s += f'    <axis xyz="{axis if isinstance(axis, str) else fmt(axis)}"/>\n'
+    if limit is not None and len(limit) == 4:
+        lower, upper, effort, velocity = limit
+        s += (f'    <limit lower="{repr(lower)}" upper="{repr(upper)}" '
+              f'effort="{repr(effort)}" velocity="{repr(velocity)}"/>\n')
+    elif limit is not None:
+        effort, velocity = limit
+        s += f'    <limit effort="{repr(effort)}" velocity="{repr(velocity)}"/>\n'
+    return s + '  </joint>\n'
+
+
 def main(doc, urdf_text, default_output):
     """The command line of a generator script: writes `urdf_text()` to
     `default_output` (relative to the repository root), `-o PATH`, or stdout (`-o -`)."""

@@ -155,7 +155,7 @@ def urdf_text():
     s.append(joint_xml("wrist_3_link-tool0_fixed_joint", "fixed", "wrist_3_link", "tool0",
                        [A[5], 0.0, D[5]], [ALPHA[5], 0.0, 0.0]))
     s.append(link_xml("tool0", TOOL0["mass"], TOOL0["com"], It))
-    s.append(joint_xml("ee_fixed_joint", "fixed", "tool0", "ee_link", EE_XYZ, [0.0, 0.0, 0.0]))
+    s.append(joint_xml("ee_fixed_joint", "fixed", "tool0", "ee_link", EE_XYZ, "0 0 0"))
     s.append('  <link name="ee_link"/>\n')
     s.append("</robot>\n")
     return "".join(s)

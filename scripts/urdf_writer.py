@@ -57,14 +57,17 @@ def link_xml(name, mass, com, I):
 
 
 def joint_xml(name, kind, parent, child, xyz, rpy, axis=None, limit=None):
-    """A `<joint>`. `axis`: a list, or text written as it is; `limit`: `(lower, upper,
+    """A `<joint>`. `xyz`, `rpy`, `axis`: lists, or text written as it is; `limit`: `(lower, upper,
     effort, velocity)`, or `(effort, velocity)` for a continuous joint."""
+    def vec(v):
+        return v if isinstance(v, str) else fmt(v)
+
     s = (f'  <joint name="{name}" type="{kind}">\n'
          f'    <parent link="{parent}"/>\n'
          f'    <child link="{child}"/>\n'
-         f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n')
+         f'    <origin xyz="{vec(xyz)}" rpy="{vec(rpy)}"/>\n')
     if axis is not None:
-        s += f'    <axis xyz="{axis if isinstance(axis, str) else fmt(axis)}"/>\n'
+        s += f'    <axis xyz="{vec(axis)}"/>\n'
     if limit is not None and len(limit) == 4:
         lower, upper, effort, velocity = limit
         s += (f'    <limit lower="{repr(lower)}" upper="{repr(upper)}" '

@@ -91,21 +91,6 @@ pub fn is_type_name(name: &str) -> bool {
     syn::parse_str::<syn::Ident>(name).is_ok()
 }
 
-/// Names of the standard parameters, `m1, mx1, …, Izz1, m2, …`.
-pub fn standard_param_names(n: usize) -> Vec<String> {
-    const NAMES: [&str; 10] = ["m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"];
-    (1..=n)
-        .flat_map(|i| NAMES.iter().map(move |s| format!("{s}{i}")))
-        .collect()
-}
-
-/// Names of the principal parameters, `m1, J1_1, J2_1, J3_1, m2, …`.
-pub fn principal_param_names(n: usize) -> Vec<String> {
-    (1..=n)
-        .flat_map(|i| [format!("m{i}"), format!("J1_{i}"), format!("J2_{i}"), format!("J3_{i}")])
-        .collect()
-}
-
 /// A regressor as output nodes, structural zeros as the constant 0.
 fn matrix_ids<'g>(g: &'g Graph, y: &[Vec<Option<Expr<'g>>>]) -> Vec<NodeId> {
     y.iter()

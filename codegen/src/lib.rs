@@ -22,7 +22,8 @@ pub mod sym;
 
 pub use base::{analyse_model, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
-pub use generate::{generate, is_type_name, principal_param_names, standard_param_names, Generated, Options};
+pub use dyngen_model::names::{principal_param_names, standard_param_names};
+pub use generate::{generate, is_type_name, Generated, Options};
 
 use proc_macro2::TokenStream;
 use quote::quote;

@@ -42,7 +42,7 @@ fn repeat(experiment: &Experiment, periods: usize) -> Experiment {
 fn generalising_nim_meets_its_targets_on_unseen_draws() {
     let robot = Generated::<Paper6>::new();
     let model = robot.model().clone();
-    let nominal = mim::true_theta(&model);
+    let nominal = dyngen_model::principal_params(&model);
     let experiment = designed(&robot);
     let training = record(&robot, Paper6::nominal_params(), &repeat(&experiment, 2));
     let config = NimConfig::default();

@@ -20,7 +20,7 @@ use faer::prelude::*;
 use faer::{Mat, MatRef, Side};
 use nalgebra::{Matrix4, SymmetricEigen};
 
-use super::accumulate::{Accumulator, OlsStart};
+use super::accumulate::Accumulator;
 use super::dense::{column, first_column, mat_vec};
 use super::error::{check_finite_vector, check_len, IdentifyError, Input};
 use super::estimate::{Estimate, Method, Residuals, Status};
@@ -327,14 +327,8 @@ impl Accumulator {
                 reason: format!("{}: must be finite and > 0", lopts.eigenvalue_floor),
             });
         }
-        let OlsStart {
-            factors,
-            tri,
-            sub,
-            x_ols,
-            dof,
-            noise,
-        } = self.ols_start(opts)?;
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, x_ols, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.x_ols, ols.dof, ols.noise);
         let start = match &lopts.start {
             Some(s) => {
                 check_len(s, p, "start")?;

@@ -8,7 +8,7 @@
 use faer::prelude::*;
 use faer::{Mat, MatRef};
 
-use super::accumulate::{prior_or_zero, Accumulator, OlsStart};
+use super::accumulate::{prior_or_zero, Accumulator};
 use super::dense::{column, dot, first_column, mat_t_vec, mat_vec};
 use super::error::IdentifyError;
 use super::estimate::{ActiveConstraint, ConstraintKind, Estimate, Method, Residuals, Status};
@@ -136,14 +136,8 @@ impl Accumulator {
             }
         }
         let prior = prior_or_zero(popts.prior.as_ref(), p)?;
-        let OlsStart {
-            factors,
-            tri,
-            sub,
-            x_ols: _,
-            dof,
-            noise,
-        } = self.ols_start(opts)?;
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.dof, ols.noise);
 
         // ½‖M x − b‖² with M = [R; √δ V₂ᵀ], b = [z; √δ V₂ᵀ prior].
         let q = p - sub.rank;

@@ -14,7 +14,7 @@ use faer::prelude::*;
 use faer::{Mat, Side};
 use nalgebra::{Matrix4, SymmetricEigen};
 
-use super::accumulate::{prior_or_zero, Accumulator, OlsStart};
+use super::accumulate::{prior_or_zero, Accumulator};
 use super::dense::{dot, mat_t_vec, mat_vec};
 use super::error::IdentifyError;
 use super::estimate::{Estimate, Method, Residuals, Status};
@@ -146,14 +146,8 @@ impl Accumulator {
             });
         }
         let prior = prior_or_zero(sopts.prior.as_ref(), p)?;
-        let OlsStart {
-            factors,
-            tri,
-            sub,
-            x_ols,
-            dof,
-            noise,
-        } = self.ols_start(opts)?;
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.dof, ols.noise);
         let q = p - sub.rank;
         let problem = Problem {
             r: &tri.r,

@@ -147,7 +147,7 @@ impl Accumulator {
         }
         let prior = prior_or_zero(sopts.prior.as_ref(), p)?;
         let ols = self.ols_start(opts)?;
-        let (factors, tri, sub, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.dof, ols.noise);
+        let (factors, tri, sub, x_ols, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.x_ols, ols.dof, ols.noise);
         let q = p - sub.rank;
         let problem = Problem {
             r: &tri.r,

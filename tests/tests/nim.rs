@@ -5,7 +5,7 @@
 //! squares. Times are measured by the benchmarks and the demo, not here.
 
 use dyngen::Robot;
-use dyngen_identify::mim::{self, Verdict};
+use dyngen_identify::mim::Verdict;
 use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
 use dyngen_nim::online::{track, Tracking};
 use dyngen_nim::{draw_theta, Nim, NimConfig};

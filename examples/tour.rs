@@ -144,9 +144,9 @@ fn main() {
                 }
             })
             .collect();
-        let err = (0..4)
-            .filter(|&k| !unidentifiable(k))
-            .fold(0.0f64, |m, k| m.max(((theta[k] - truth[k]) / truth[k]).abs()));
+        let err = (0..4).filter(|&k| !unidentifiable(k)).fold(0.0f64, |m, k| {
+            m.max(dyngen_identify::relative_error(theta[k], truth[k]))
+        });
         println!(
             "  B{}: m {:>9}  J1 {:>14}  J2 {:>14}  J3 {:>8}  (max rel. error {err:.1e})",
             i + 1,

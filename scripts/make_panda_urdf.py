@@ -43,12 +43,12 @@ URDF origin of joint i is therefore xyz (a_(i-1), -sin(alpha_(i-1)) d_i,
 cos(alpha_(i-1)) d_i), rpy (alpha_(i-1), 0, 0), axis z; sines and cosines of the
 multiples of pi/2 are taken exactly, so translations carry no 1e-17 noise.
 """
-import argparse
 import math
-import os
 import sys
 
 import numpy as np
+
+from urdf_writer import exact_cs, joint_xml, link_xml, main
 
 PI = math.pi
 
@@ -84,23 +84,6 @@ INERTIA = [  # about the centre of mass, link-frame axes: Ixx, Ixy, Ixz, Iyy, Iy
     [1.9640e-03, 1.0900e-04, -1.1580e-03, 4.3540e-03, 3.4100e-04, 5.4330e-03],
     [1.2516e-02, -4.2800e-04, -1.1960e-03, 1.0027e-02, -7.4100e-04, 4.8150e-03],
 ]
-
-
-def exact_cs(angle):
-    """cos/sin, exact for multiples of pi/2."""
-    k = angle / (PI / 2)
-    if abs(k - round(k)) < 1e-12:
-        return [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(k)) % 4]
-    return math.cos(angle), math.sin(angle)
-
-
-def clean(x):
-    x = float(x)
-    return 0.0 if x == 0.0 else x  # no "-0.0"
-
-
-def fmt(v):
-    return " ".join(repr(clean(x)) for x in v)
 
 
 def tensor(p):
@@ -168,49 +151,15 @@ def urdf_text():
     s.append('  <link name="panda_link0"/>\n')
     for i in range(7):
         xyz, rpy = origin(i)
-        s.append(f'  <joint name="panda_joint{i + 1}" type="revolute">\n'
-                 f'    <parent link="panda_link{i}"/>\n'
-                 f'    <child link="panda_link{i + 1}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(Q_MIN[i])}" upper="{repr(Q_MAX[i])}" '
-                 f'effort="{repr(TAU_MAX[i])}" velocity="{repr(DQ_MAX[i])}"/>\n'
-                 f'  </joint>\n')
-        xx, xy, xz, yy, yz, zz = INERTIA[i]
-        s.append(f'  <link name="panda_link{i + 1}">\n'
-                 f'    <inertial>\n'
-                 f'      <origin xyz="{fmt(COM[i])}" rpy="0 0 0"/>\n'
-                 f'      <mass value="{repr(MASS[i])}"/>\n'
-                 f'      <inertia ixx="{repr(xx)}" ixy="{repr(xy)}" ixz="{repr(xz)}" '
-                 f'iyy="{repr(yy)}" iyz="{repr(yz)}" izz="{repr(zz)}"/>\n'
-                 f'    </inertial>\n'
-                 f'  </link>\n')
+        s.append(joint_xml(f"panda_joint{i + 1}", "revolute", f"panda_link{i}", f"panda_link{i + 1}", xyz, rpy,
+                           "0 0 1", (Q_MIN[i], Q_MAX[i], TAU_MAX[i], DQ_MAX[i])))
+        s.append(link_xml(f"panda_link{i + 1}", MASS[i], COM[i], tensor(INERTIA[i])))
     xyz, rpy = origin(7)
-    s.append('  <joint name="panda_joint8" type="fixed">\n'
-             '    <parent link="panda_link7"/>\n'
-             '    <child link="panda_link8"/>\n'
-             f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("panda_joint8", "fixed", "panda_link7", "panda_link8", xyz, rpy))
     s.append('  <link name="panda_link8"/>\n')
     s.append('</robot>\n')
     return "".join(s)
 
 
-def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("-o", "--output", default=os.path.join(root, "robots", "panda", "panda.urdf"),
-                    help="output path, '-' for stdout")
-    args = ap.parse_args()
-    text = urdf_text()
-    if args.output == "-":
-        sys.stdout.write(text)
-    else:
-        os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)
-        with open(args.output, "w") as f:
-            f.write(text)
-        print(f"wrote {os.path.relpath(args.output)}")
-
-
 if __name__ == "__main__":
-    main()
+    main(__doc__, urdf_text, "robots/panda/panda.urdf")

@@ -39,12 +39,12 @@ i+1's origin in link i is Tz(d_i) Tx(a_i) Rx(alpha_i) = xyz (a_i, 0, d_i), rpy
 in DH frame i is (a_i, 0, d_i) + Rx(alpha_i) c in L_i and an inertia I is
 Rx(alpha_i) I Rx(alpha_i)^T; multiples of pi/2 are built exactly.
 """
-import argparse
 import math
-import os
 import sys
 
 import numpy as np
+
+from urdf_writer import joint_xml, link_xml, main, rotx
 
 PI = math.pi
 DEG = PI / 180.0
@@ -86,28 +86,6 @@ VELOCITY = [3.0] * 6
 
 LINKS = [f"link{i}" for i in range(1, 7)]
 JOINTS = [f"joint{i}" for i in range(1, 7)]
-
-
-def exact_cs(angle):
-    """cos/sin, exact for multiples of pi/2."""
-    k = angle / (PI / 2)
-    if abs(k - round(k)) < 1e-12:
-        return [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(k)) % 4]
-    return math.cos(angle), math.sin(angle)
-
-
-def rotx(angle):
-    c, s = exact_cs(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def clean(x):
-    x = float(x)
-    return 0.0 if x == 0.0 else x  # no "-0.0"
-
-
-def fmt(v):
-    return " ".join(repr(clean(x)) for x in v)
 
 
 def check_physical(i):
@@ -180,50 +158,16 @@ def urdf_text():
         else:
             xyz, rpy = [A[i - 1], 0.0, D[i - 1]], [ALPHA[i - 1], 0.0, 0.0]
         lo, hi = QLIM_DEG[i]
-        s.append(f'  <joint name="{JOINTS[i]}" type="revolute">\n'
-                 f'    <parent link="{parent}"/>\n'
-                 f'    <child link="{LINKS[i]}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(lo * DEG)}" upper="{repr(hi * DEG)}" '
-                 f'effort="{repr(EFFORT[i])}" velocity="{repr(VELOCITY[i])}"/>\n'
-                 f'  </joint>\n')
+        s.append(joint_xml(JOINTS[i], "revolute", parent, LINKS[i], xyz, rpy, "0 0 1",
+                           (lo * DEG, hi * DEG, EFFORT[i], VELOCITY[i])))
         m, c, I = params[i]
-        s.append(f'  <link name="{LINKS[i]}">\n'
-                 f'    <inertial>\n'
-                 f'      <origin xyz="{fmt(c)}" rpy="0 0 0"/>\n'
-                 f'      <mass value="{repr(float(m))}"/>\n'
-                 f'      <inertia ixx="{repr(clean(I[0, 0]))}" ixy="{repr(clean(I[0, 1]))}" '
-                 f'ixz="{repr(clean(I[0, 2]))}" iyy="{repr(clean(I[1, 1]))}" '
-                 f'iyz="{repr(clean(I[1, 2]))}" izz="{repr(clean(I[2, 2]))}"/>\n'
-                 f'    </inertial>\n'
-                 f'  </link>\n')
+        s.append(link_xml(LINKS[i], m, c, I))
         parent = LINKS[i]
-    s.append('  <joint name="flange_fixed_joint" type="fixed">\n'
-             '    <parent link="link6"/>\n'
-             '    <child link="flange"/>\n'
-             f'    <origin xyz="{fmt([A[5], 0.0, D[5]])}" rpy="{fmt([ALPHA[5], 0.0, 0.0])}"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("flange_fixed_joint", "fixed", "link6", "flange", [A[5], 0.0, D[5]], [ALPHA[5], 0.0, 0.0]))
     s.append('  <link name="flange"/>\n')
     s.append('</robot>\n')
     return "".join(s)
 
 
-def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("-o", "--output", default=os.path.join(root, "robots", "puma560", "puma560.urdf"),
-                    help="output path, '-' for stdout")
-    args = ap.parse_args()
-    text = urdf_text()
-    if args.output == "-":
-        sys.stdout.write(text)
-    else:
-        os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)
-        with open(args.output, "w") as f:
-            f.write(text)
-        print(f"wrote {os.path.relpath(args.output)}")
-
-
 if __name__ == "__main__":
-    main()
+    main(__doc__, urdf_text, "robots/puma560/puma560.urdf")

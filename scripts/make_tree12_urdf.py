@@ -20,12 +20,12 @@ turned by a fixed rpy relative to the link frame, giving full tensors that are
 physical by construction; the tensors are rounded to 6 significant digits and
 re-checked (positive definite, triangle inequalities with margin).
 """
-import argparse
 import math
-import os
 import sys
 
 import numpy as np
+
+from urdf_writer import joint_xml, link_xml, main
 
 # Links: name -> (mass kg, com xyz in link frame, box dims (x, y, z) m, box rpy in link frame)
 LINKS = {
@@ -106,37 +106,15 @@ def inertia(name):
     return I
 
 
-def fmt(v):
-    return " ".join(repr(0.0 if float(x) == 0.0 else float(x)) for x in v)
-
-
-def link_xml(name):
-    m, com, _, _ = LINKS[name]
-    I = inertia(name)
-    return (f'  <link name="{name}">\n'
-            f'    <inertial>\n'
-            f'      <origin xyz="{fmt(com)}" rpy="0 0 0"/>\n'
-            f'      <mass value="{repr(float(m))}"/>\n'
-            f'      <inertia ixx="{repr(float(I[0, 0]))}" ixy="{repr(float(I[0, 1]))}" ixz="{repr(float(I[0, 2]))}" '
-            f'iyy="{repr(float(I[1, 1]))}" iyz="{repr(float(I[1, 2]))}" izz="{repr(float(I[2, 2]))}"/>\n'
-            f'    </inertial>\n'
-            f'  </link>\n')
-
-
-def joint_xml(j):
+def tree_joint_xml(j):
     name, typ, parent, child, xyz, rpy, axis, lim, effort, vel = j
-    s = (f'  <joint name="{name}" type="{typ}">\n'
-         f'    <parent link="{parent}"/>\n'
-         f'    <child link="{child}"/>\n'
-         f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n')
-    if axis is not None:
-        s += f'    <axis xyz="{fmt(axis)}"/>\n'
     if typ in ("revolute", "prismatic"):
-        s += (f'    <limit lower="{repr(lim[0])}" upper="{repr(lim[1])}" '
-              f'effort="{repr(effort)}" velocity="{repr(vel)}"/>\n')
+        limit = (lim[0], lim[1], effort, vel)
     elif typ == "continuous":
-        s += f'    <limit effort="{repr(effort)}" velocity="{repr(vel)}"/>\n'
-    return s + '  </joint>\n'
+        limit = (effort, vel)
+    else:
+        limit = None
+    return joint_xml(name, typ, parent, child, xyz, rpy, axis, limit)
 
 
 HEADER = """<?xml version="1.0"?>
@@ -182,27 +160,12 @@ def urdf_text():
     by_child = {j[3]: j for j in JOINTS}
     for name in LINK_ORDER:
         if name in by_child:
-            s.append(joint_xml(by_child[name]))
-        s.append(link_xml(name))
+            s.append(tree_joint_xml(by_child[name]))
+        m, com, _, _ = LINKS[name]
+        s.append(link_xml(name, m, com, inertia(name)))
     s.append("</robot>\n")
     return "".join(s)
 
 
-def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("-o", "--output", default=os.path.join(root, "tests", "fixtures", "tree12.urdf"),
-                    help="output path, '-' for stdout")
-    args = ap.parse_args()
-    text = urdf_text()
-    if args.output == "-":
-        sys.stdout.write(text)
-    else:
-        os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)
-        with open(args.output, "w") as f:
-            f.write(text)
-        print(f"wrote {os.path.relpath(args.output)}")
-
-
 if __name__ == "__main__":
-    main()
+    main(__doc__, urdf_text, "tests/fixtures/tree12.urdf")

@@ -26,12 +26,11 @@ frame i is D_i c = (a_i, 0, d_i) + Rx(alpha_i) c in the URDF link frame, and an 
 I (DH-frame axes) is Rx(alpha_i) I Rx(alpha_i)^T. Rotations by multiples of pi/2 are
 built exactly (entries 0, +-1), so the numbers carry no 1e-17 noise.
 """
-import argparse
 import math
-import os
-import sys
 
 import numpy as np
+
+from urdf_writer import joint_xml, link_xml, main, rotx
 
 PI = math.pi
 
@@ -77,44 +76,12 @@ TOOL0 = dict(mass=0.1, com=[0.0, 0.0, 0.005], radius=0.0315, length=0.01)
 EE_XYZ = [0.0, 0.0, 0.05]
 
 
-def exact_cs(angle):
-    """cos/sin, exact for multiples of pi/2 (matches what a careful parser does)."""
-    k = angle / (PI / 2)
-    if abs(k - round(k)) < 1e-12:
-        return [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(k)) % 4]
-    return math.cos(angle), math.sin(angle)
-
-
-def rotx(angle):
-    c, s = exact_cs(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
 def cylinder(mass, radius, length, axis):
     """Inertia about the centre of a solid cylinder, axis one of x, y, z."""
     i_ax = 0.5 * mass * radius ** 2
     i_tr = mass * (3.0 * radius ** 2 + length ** 2) / 12.0
     d = {"x": [i_ax, i_tr, i_tr], "y": [i_tr, i_ax, i_tr], "z": [i_tr, i_tr, i_ax]}[axis]
     return np.diag(d)
-
-
-def clean(x):
-    x = float(x)
-    return 0.0 if x == 0.0 else x  # no "-0.0"
-
-
-def fmt(v):
-    return " ".join(repr(clean(x)) for x in v)
-
-
-def inertial_xml(mass, com, I, indent="    "):
-    return (f"{indent}<inertial>\n"
-            f"{indent}  <origin xyz=\"{fmt(com)}\" rpy=\"0 0 0\"/>\n"
-            f"{indent}  <mass value=\"{repr(float(mass))}\"/>\n"
-            f"{indent}  <inertia ixx=\"{repr(clean(I[0, 0]))}\" ixy=\"{repr(clean(I[0, 1]))}\" "
-            f"ixz=\"{repr(clean(I[0, 2]))}\" iyy=\"{repr(clean(I[1, 1]))}\" "
-            f"iyz=\"{repr(clean(I[1, 2]))}\" izz=\"{repr(clean(I[2, 2]))}\"/>\n"
-            f"{indent}</inertial>\n")
 
 
 def link_params():
@@ -171,7 +138,7 @@ def urdf_text():
              "-->\n")
     s.append('<robot name="ur5">\n')
     Ib = cylinder(BASE["mass"], BASE["radius"], BASE["length"], "z")
-    s.append('  <link name="base_link">\n' + inertial_xml(BASE["mass"], BASE["com"], Ib) + "  </link>\n")
+    s.append(link_xml("base_link", BASE["mass"], BASE["com"], Ib))
     params = link_params()
     parent = "base_link"
     for i in range(6):
@@ -179,48 +146,20 @@ def urdf_text():
             xyz, rpy = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
         else:
             xyz, rpy = [A[i - 1], 0.0, D[i - 1]], [ALPHA[i - 1], 0.0, 0.0]
-        s.append(f'  <joint name="{JOINTS[i]}" type="revolute">\n'
-                 f'    <parent link="{parent}"/>\n'
-                 f'    <child link="{LINKS[i]}"/>\n'
-                 f'    <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-                 f'    <axis xyz="0 0 1"/>\n'
-                 f'    <limit lower="{repr(-LIMIT)}" upper="{repr(LIMIT)}" effort="{repr(EFFORT[i])}" velocity="{repr(VELOCITY)}"/>\n'
-                 f'  </joint>\n')
+        s.append(joint_xml(JOINTS[i], "revolute", parent, LINKS[i], xyz, rpy, "0 0 1",
+                           (-LIMIT, LIMIT, EFFORT[i], VELOCITY)))
         m, c, I = params[i]
-        s.append(f'  <link name="{LINKS[i]}">\n' + inertial_xml(m, c, I) + "  </link>\n")
+        s.append(link_xml(LINKS[i], m, c, I))
         parent = LINKS[i]
     It = cylinder(TOOL0["mass"], TOOL0["radius"], TOOL0["length"], "z")
-    s.append('  <joint name="wrist_3_link-tool0_fixed_joint" type="fixed">\n'
-             '    <parent link="wrist_3_link"/>\n'
-             '    <child link="tool0"/>\n'
-             f'    <origin xyz="{fmt([A[5], 0.0, D[5]])}" rpy="{fmt([ALPHA[5], 0.0, 0.0])}"/>\n'
-             '  </joint>\n')
-    s.append('  <link name="tool0">\n' + inertial_xml(TOOL0["mass"], TOOL0["com"], It) + "  </link>\n")
-    s.append('  <joint name="ee_fixed_joint" type="fixed">\n'
-             '    <parent link="tool0"/>\n'
-             '    <child link="ee_link"/>\n'
-             f'    <origin xyz="{fmt(EE_XYZ)}" rpy="0 0 0"/>\n'
-             '  </joint>\n')
+    s.append(joint_xml("wrist_3_link-tool0_fixed_joint", "fixed", "wrist_3_link", "tool0",
+                       [A[5], 0.0, D[5]], [ALPHA[5], 0.0, 0.0]))
+    s.append(link_xml("tool0", TOOL0["mass"], TOOL0["com"], It))
+    s.append(joint_xml("ee_fixed_joint", "fixed", "tool0", "ee_link", EE_XYZ, "0 0 0"))
     s.append('  <link name="ee_link"/>\n')
     s.append("</robot>\n")
     return "".join(s)
 
 
-def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("-o", "--output", default=os.path.join(root, "robots", "ur5", "ur5.urdf"),
-                    help="output path, '-' for stdout")
-    args = ap.parse_args()
-    text = urdf_text()
-    if args.output == "-":
-        sys.stdout.write(text)
-    else:
-        os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)
-        with open(args.output, "w") as f:
-            f.write(text)
-        print(f"wrote {os.path.relpath(args.output)}")
-
-
 if __name__ == "__main__":
-    main()
+    main(__doc__, urdf_text, "robots/ur5/ur5.urdf")

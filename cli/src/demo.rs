@@ -98,7 +98,7 @@ pub fn run(args: &DemoArgs, progress: &Progress) -> Result<()> {
         "simulating the paper's experiment on paper6 (2 s, 100 steps)",
         || record(&robot, &Paper6::NOMINAL_PARAMS, &experiment),
     );
-    let truth = mim::true_theta(&model);
+    let truth = dyngen_model::principal_params(&model);
     let options = MimOptions::default();
     // Samples 1..=100: the paper's 100 sets (sample 0 is the state at rest).
     let all = 1..clean.samples.len();
@@ -413,7 +413,7 @@ impl Worst {
         for (j, (v, t)) in values.iter().zip(truth).enumerate() {
             match v {
                 Some(v) if expected[j] => {
-                    let rel = ((v - t) / t).abs();
+                    let rel = dyngen_identify::relative_error(*v, *t);
                     if j % 4 == 0 {
                         self.mass = self.mass.max(rel);
                     } else {
@@ -543,7 +543,7 @@ fn side_by_side(
                 .zip(truth)
                 .zip(&paper.identifiable)
                 .filter(|(_, &ok)| ok)
-                .map(|((v, t), _)| ((v - t) / t).abs())
+                .map(|((&v, &t), _)| dyngen_identify::relative_error(v, t))
                 .fold(0.0, f64::max)
     );
     Ok(())
@@ -741,7 +741,7 @@ fn noise_study(
                     for &(i, k) in &identifiable {
                         match est.value(i, k) {
                             Some(v) => {
-                                let rel = ((v - truth[4 * i + k]) / truth[4 * i + k]).abs();
+                                let rel = dyngen_identify::relative_error(v, truth[4 * i + k]);
                                 if worst.is_none_or(|(w, _, _)| rel > w) {
                                     worst = Some((rel, i, k));
                                 }

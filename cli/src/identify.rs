@@ -304,7 +304,7 @@ impl Identified {
         if self.per_body == 10 {
             model.standard_params()
         } else {
-            mim::true_theta(model)
+            dyngen_model::principal_params(model)
         }
     }
 }
@@ -342,7 +342,7 @@ fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress:
         Method::Tls => acc.tls(&opts),
         Method::Ridge => {
             let prior = if principal {
-                mim::true_theta(model)
+                dyngen_model::principal_params(model)
             } else {
                 model.standard_params()
             };
@@ -352,7 +352,7 @@ fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress:
     .map_err(|e| e.to_string())?;
 
     let names = if principal {
-        mim::theta_names(n)
+        dyngen_model::names::principal_param_names(n)
     } else {
         standard_param_names(n)
     };
@@ -385,13 +385,13 @@ fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress:
 fn by_mim(args: &IdentifyArgs, model: &Model, traj: &Trajectory) -> Result<Identified> {
     let robot = Reference::new(model);
     let recording = Recording::from_measurements(&robot, traj).map_err(|e| format!("{}: {e}", args.data.display()))?;
-    let truth = args.truth_from_urdf.then(|| mim::true_theta(model));
+    let truth = args.truth_from_urdf.then(|| dyngen_model::principal_params(model));
     let estimate: MimEstimate =
         mim::whole_robot(&recording, 0..recording.len(), truth.as_deref(), &MimOptions::default())
             .map_err(|e| format!("{}: {e}", args.data.display()))?;
     println!("{estimate}");
     // The torques of the identified model: θ where identified, the URDF's elsewhere.
-    let nominal = mim::true_theta(model);
+    let nominal = dyngen_model::principal_params(model);
     let theta: Vec<f64> = estimate
         .theta()
         .iter()
@@ -433,7 +433,7 @@ fn print_errors(identified: &Identified, model: &Model) {
     let mut count = 0;
     for (p, t) in identified.report.parameters.iter().zip(&truth) {
         if let (Some(v), true) = (p.value, t.abs() > 1e-12) {
-            let rel = ((v - t) / t).abs();
+            let rel = dyngen_identify::relative_error(v, *t);
             count += 1;
             if worst.is_none_or(|(w, _)| rel > w) {
                 worst = Some((rel, &p.name));
@@ -578,7 +578,7 @@ fn identified_inertial(identified: &Identified, model: &Model, body: usize) -> s
         x.copy_from_slice(&values);
     } else {
         // θ of this body, the URDF's θ elsewhere (only this body's 10 are used).
-        let mut theta = mim::true_theta(model);
+        let mut theta = dyngen_model::principal_params(model);
         theta[4 * body..4 * body + 4].copy_from_slice(&values);
         let standard = dyngen_reference::principal_params_to_standard(model, &theta);
         x.copy_from_slice(&standard[10 * body..10 * body + 10]);

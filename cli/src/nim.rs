@@ -158,7 +158,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
     let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
     let motion = SampledMotion::from_data(&traj).ok_or("the motion has no velocities or accelerations")?;
     let robot = Reference::new(&model);
-    let nominal = mim::true_theta(&model);
+    let nominal = dyngen_model::principal_params(&model);
     let recording = record_trajectory(&robot, &model.standard_params(), &motion, motion.times());
 
     let mut config = NimConfig {
@@ -339,7 +339,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
         .identify(&recording, stride)
         .map_err(|e| format!("{}: {e}", args.data.display()))?;
     let estimate = if args.truth_from_urdf {
-        estimate.with_truth(&mim::true_theta(&model))
+        estimate.with_truth(&dyngen_model::principal_params(&model))
     } else {
         estimate
     };

@@ -202,7 +202,7 @@ fn identify_by_mim_rewrites_the_identified_bodies() {
 
     let report = ParameterReport::read(&json).unwrap();
     assert_eq!(report.parameters.len(), 24);
-    let truth = dyngen_identify::mim::true_theta(&dyngen_model::load_urdf(&ur5()).unwrap());
+    let truth = dyngen_model::principal_params(&dyngen_model::load_urdf(&ur5()).unwrap());
     for (j, (p, t)) in report.parameters.iter().zip(&truth).enumerate() {
         if j == 1 || j == 2 {
             assert_eq!(p.status, ParamStatus::NoEffect, "{p:?}");

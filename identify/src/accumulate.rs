@@ -17,7 +17,8 @@ use faer::linalg::qr::no_pivoting::factor as qr;
 use faer::prelude::default;
 use faer::{Accum, Mat, MatRef, Par, Side};
 
-use super::error::{IdentifyError, Input};
+use super::error::{check_finite_vector, check_len, IdentifyError, Input};
+use super::subspace::Subspace;
 use super::Channels;
 
 /// Streaming accumulation of `y = A x + e`, the common entry point of every batch
@@ -102,6 +103,30 @@ pub(crate) struct Factor {
     pub rows: usize,
     /// Made from the normal equations ([`Accumulation::NormalEquations`]).
     pub normal_equations: bool,
+}
+
+/// [`Accumulator::ols_start`].
+pub(crate) struct OlsStart {
+    pub factors: Vec<Factor>,
+    pub tri: Triangle,
+    pub sub: Subspace,
+    pub x_ols: Vec<f64>,
+    /// Rows less rank.
+    pub dof: f64,
+    /// The OLS residual's standard deviation (`None` without spare rows).
+    pub noise: Option<f64>,
+}
+
+/// `prior` checked against `p` parameters, or zeros when there is none.
+pub(crate) fn prior_or_zero(prior: Option<&Vec<f64>>, p: usize) -> Result<Vec<f64>, IdentifyError> {
+    match prior {
+        Some(x) => {
+            check_len(x, p, "prior")?;
+            check_finite_vector(x, Input::Prior)?;
+            Ok(x.clone())
+        }
+        None => Ok(vec![0.0; p]),
+    }
 }
 
 /// The total (possibly weighted) problem, compressed: `‖A x − y‖² = ‖R x − z‖² + ρ²`.
@@ -279,6 +304,26 @@ impl Accumulator {
     /// Equal to [`Accumulator::ols`] on the stacked rows.
     pub fn finish(&self) -> Result<super::Estimate, IdentifyError> {
         self.ols(&super::Options::default())
+    }
+
+    /// The unweighted problem and its OLS solution: where every constrained
+    /// estimator starts, and what its noise estimate is measured against.
+    pub(crate) fn ols_start(&self, opts: &super::Options) -> Result<OlsStart, IdentifyError> {
+        let factors = self.factors()?;
+        let tri = combine(&factors, None, self.p);
+        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
+        let x_ols = sub.min_norm_solution(&tri.z);
+        let dof = tri.rows as f64 - sub.rank as f64;
+        let rss_ols: f64 = channel_rss(&factors, &x_ols).iter().sum();
+        let noise = (dof > 0.0).then(|| (rss_ols / dof).sqrt());
+        Ok(OlsStart {
+            factors,
+            tri,
+            sub,
+            x_ols,
+            dof,
+            noise,
+        })
     }
 
     /// Every channel's factor with pending rows folded in (the accumulator is not

@@ -64,6 +64,19 @@ pub use standard::StandardOptions;
 
 use faer::MatRef;
 
+/// How far an estimate is from the truth, relative to the truth:
+/// `|estimate − truth| / |truth|`. Where the truth is exactly 0 no relative error
+/// exists, and the absolute error is given instead, so that a parameter that is
+/// truly zero is still judged by how far its estimate strays.
+pub fn relative_error(estimate: f64, truth: f64) -> f64 {
+    let absolute = (estimate - truth).abs();
+    if truth == 0.0 {
+        absolute
+    } else {
+        absolute / truth.abs()
+    }
+}
+
 /// How rows are grouped into channels (e.g. joints) for per-channel weights and
 /// residual RMS.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

@@ -20,12 +20,11 @@ use faer::prelude::*;
 use faer::{Mat, MatRef, Side};
 use nalgebra::{Matrix4, SymmetricEigen};
 
-use super::accumulate::{combine, Accumulator};
+use super::accumulate::Accumulator;
 use super::dense::{column, first_column, mat_vec};
 use super::error::{check_finite_vector, check_len, IdentifyError, Input};
 use super::estimate::{Estimate, Method, Residuals, Status};
 use super::least_squares::scale;
-use super::subspace::Subspace;
 use super::{Layout, Options};
 
 /// Options of [`Accumulator::log_cholesky`].
@@ -328,10 +327,8 @@ impl Accumulator {
                 reason: format!("{}: must be finite and > 0", lopts.eigenvalue_floor),
             });
         }
-        let factors = self.factors()?;
-        let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
-        let x_ols = sub.min_norm_solution(&tri.z);
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, x_ols, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.x_ols, ols.dof, ols.noise);
         let start = match &lopts.start {
             Some(s) => {
                 check_len(s, p, "start")?;
@@ -369,9 +366,6 @@ impl Accumulator {
         )?;
         let x = map.pi(&phi);
 
-        let dof = tri.rows as f64 - sub.rank as f64;
-        let rss_ols: f64 = super::accumulate::channel_rss(&factors, &x_ols).iter().sum();
-        let noise = (dof > 0.0).then(|| (rss_ols / dof).sqrt());
         // The same fit as OLS (to roundoff) means the constraints are inactive.
         let diff: Vec<f64> = x.iter().zip(&x_ols).map(|(a, b)| a - b).collect();
         let fit_ols = super::dense::norm(&mat_vec(tri.r.as_ref(), &x_ols));

@@ -36,7 +36,7 @@
 //! let model = dyngen_model::parse_urdf(urdf).unwrap();
 //! let robot = dyngen_reference::Reference::new(&model);
 //! let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
-//! let truth = mim::true_theta(&model);
+//! let truth = dyngen_model::principal_params(&model);
 //! let est = mim::instant(&recording, 1.5, Some(&truth), &MimOptions::default()).unwrap();
 //! assert!((est.value(0, 0).unwrap() - 1.0).abs() < 1e-9); // the mass
 //! assert!((est.value(0, 2).unwrap() - 0.12).abs() < 1e-9); // J2, about the hinge
@@ -49,14 +49,14 @@ use crate::simulate::Recording;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options, ParamEstimate, Status};
 use dyngen::Robot;
 use dyngen_model::joint_params::{joint_regressor_row, Coulomb, PER_JOINT};
-use dyngen_model::{principal_frames, Model};
+use dyngen_model::names::{principal_param_names, standard_param_names};
 use dyngen_reference::Dynamics;
 use nalgebra::DMatrix;
 use std::fmt;
 use std::ops::Range;
 
 /// Names of the four principal parameters of a body.
-pub const THETA_NAMES: [&str; 4] = ["m", "J1", "J2", "J3"];
+pub use dyngen_model::names::PRINCIPAL as THETA_NAMES;
 
 /// Settings of the MIM solvers.
 #[derive(Clone, Debug, PartialEq)]
@@ -101,17 +101,6 @@ impl Verdict {
             Verdict::NotSignificant => "n/s",
         }
     }
-}
-
-/// The principal parameters `θ = (θ_1, …, θ_n)` of a model (`4n`, body 1 first), the
-/// truth MIM is compared with: masses and principal moments from
-/// [`dyngen_model::PrincipalFrame`], the frames the recordings use.
-pub fn true_theta(model: &Model) -> Vec<f64> {
-    principal_frames(model)
-        .iter()
-        .zip(&model.bodies)
-        .flat_map(|(f, b)| f.theta(b.inertial.mass))
-        .collect()
 }
 
 /// How the MIM equations were set up.
@@ -251,7 +240,7 @@ impl MimEstimate {
                         estimate,
                         verdict: self.verdict(body, index),
                         absolute,
-                        relative: absolute.map(|a| if t == 0.0 { a } else { a / t.abs() }),
+                        relative: estimate.map(|e| crate::relative_error(e, t)),
                     }
                 })
                 .collect(),
@@ -347,11 +336,7 @@ impl fmt::Display for ThetaTable<'_> {
                 let cell = match self.cells[j] {
                     Ok(v) => {
                         let absolute = (v - truth[j]).abs();
-                        let relative = if truth[j] == 0.0 {
-                            absolute
-                        } else {
-                            absolute / truth[j].abs()
-                        };
+                        let relative = crate::relative_error(v, truth[j]);
                         if worst.is_none_or(|(w, _)| relative > w) {
                             worst = Some((relative, j));
                         }
@@ -454,7 +439,7 @@ fn per_body(
 
 /// Every body from its resultant at the one sample nearest to `t` (the paper:
 /// `t = 1.5 s`): `A_i θ_i = [F_i; M_i]`, 6 × 4 per body, solved with rank
-/// handling. `truth`: `θ` (`4n`) for the error table, e.g. [`true_theta`].
+/// handling. `truth`: `θ` (`4n`) for the error table, e.g. [`dyngen_model::principal_params`].
 pub fn instant(
     recording: &Recording,
     t: f64,
@@ -698,7 +683,7 @@ impl TorqueEstimate {
                         estimate: c.value,
                         truth: t,
                         absolute,
-                        relative: if t == 0.0 { absolute } else { absolute / t.abs() },
+                        relative: crate::relative_error(c.value, t),
                     }
                 })
                 .collect(),
@@ -786,21 +771,6 @@ fn torque_estimate(
     })
 }
 
-/// `m1, J1_1, J2_1, J3_1, m2, …`.
-pub fn theta_names(n: usize) -> Vec<String> {
-    (1..=n)
-        .flat_map(|i| THETA_NAMES.iter().map(move |p| format!("{p}_{i}")))
-        .collect()
-}
-
-/// Pinocchio's standard parameter names with the body number: `m_1, mx_1, …`.
-pub fn standard_names(n: usize) -> Vec<String> {
-    const NAMES: [&str; 10] = ["m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"];
-    (1..=n)
-        .flat_map(|i| NAMES.iter().map(move |p| format!("{p}_{i}")))
-        .collect()
-}
-
 /// MIM from joint torques alone through the principal regressor `τ = Y_θ θ`
 /// ([`Dynamics::principal_regressor`]): the rank and the identifiable combinations
 /// come from the data ([`Estimate::combinations`]); each `θ` is reported as
@@ -813,7 +783,7 @@ pub fn torque_principal(
     weighting: Weighting,
     opts: &Options,
 ) -> Result<TorqueEstimate, IdentifyError> {
-    let names = theta_names(dynamics.nv());
+    let names = principal_param_names(dynamics.nv());
     torque_estimate(
         dynamics,
         recording,
@@ -872,7 +842,7 @@ pub fn torque_with_joints(
     opts: &Options,
 ) -> Result<TorqueEstimate, IdentifyError> {
     let n = dynamics.nv();
-    let mut names = standard_names(n);
+    let mut names = standard_param_names(n);
     names.extend(dyngen_model::joint_params::joint_param_names(n));
     torque_estimate(
         dynamics,
@@ -897,7 +867,7 @@ pub fn torque_standard(
     weighting: Weighting,
     opts: &Options,
 ) -> Result<TorqueEstimate, IdentifyError> {
-    let names = standard_names(dynamics.nv());
+    let names = standard_param_names(dynamics.nv());
     torque_estimate(
         dynamics,
         recording,

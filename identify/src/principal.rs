@@ -8,12 +8,11 @@
 use faer::prelude::*;
 use faer::{Mat, MatRef};
 
-use super::accumulate::{channel_rss, combine, Accumulator};
+use super::accumulate::{prior_or_zero, Accumulator};
 use super::dense::{column, dot, first_column, mat_t_vec, mat_vec};
-use super::error::{check_finite_vector, check_len, IdentifyError, Input};
+use super::error::IdentifyError;
 use super::estimate::{ActiveConstraint, ConstraintKind, Estimate, Method, Residuals, Status};
 use super::least_squares::scale;
-use super::subspace::Subspace;
 use super::{Layout, Options};
 
 /// Margins of the principal-form constraints (SI units).
@@ -136,21 +135,9 @@ impl Accumulator {
                 });
             }
         }
-        let prior = match &popts.prior {
-            Some(x) => {
-                check_len(x, p, "prior")?;
-                check_finite_vector(x, Input::Prior)?;
-                x.clone()
-            }
-            None => vec![0.0; p],
-        };
-        let factors = self.factors()?;
-        let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
-        let x_ols = sub.min_norm_solution(&tri.z);
-        let dof = tri.rows as f64 - sub.rank as f64;
-        let rss_ols: f64 = channel_rss(&factors, &x_ols).iter().sum();
-        let noise = (dof > 0.0).then(|| (rss_ols / dof).sqrt());
+        let prior = prior_or_zero(popts.prior.as_ref(), p)?;
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.dof, ols.noise);
 
         // ½‖M x − b‖² with M = [R; √δ V₂ᵀ], b = [z; √δ V₂ᵀ prior].
         let q = p - sub.rank;

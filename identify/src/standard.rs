@@ -14,13 +14,12 @@ use faer::prelude::*;
 use faer::{Mat, Side};
 use nalgebra::{Matrix4, SymmetricEigen};
 
-use super::accumulate::{channel_rss, combine, Accumulator};
+use super::accumulate::{prior_or_zero, Accumulator};
 use super::dense::{dot, mat_t_vec, mat_vec};
-use super::error::{check_finite_vector, check_len, IdentifyError, Input};
+use super::error::IdentifyError;
 use super::estimate::{Estimate, Method, Residuals, Status};
 use super::least_squares::scale;
 use super::log_cholesky::pseudo_inertia;
-use super::subspace::Subspace;
 use super::{Layout, Options};
 
 /// Options of [`Accumulator::standard_consistent`].
@@ -146,21 +145,9 @@ impl Accumulator {
                 reason: format!("{}: must be finite and > 0", sopts.gap_tolerance),
             });
         }
-        let prior = match &sopts.prior {
-            Some(x) => {
-                check_len(x, p, "prior")?;
-                check_finite_vector(x, Input::Prior)?;
-                x.clone()
-            }
-            None => vec![0.0; p],
-        };
-        let factors = self.factors()?;
-        let tri = combine(&factors, None, p);
-        let sub = Subspace::analyse(tri.r.as_ref(), tri.rows, tri.floor, opts)?;
-        let x_ols = sub.min_norm_solution(&tri.z);
-        let dof = tri.rows as f64 - sub.rank as f64;
-        let rss_ols: f64 = channel_rss(&factors, &x_ols).iter().sum();
-        let noise = (dof > 0.0).then(|| (rss_ols / dof).sqrt());
+        let prior = prior_or_zero(sopts.prior.as_ref(), p)?;
+        let ols = self.ols_start(opts)?;
+        let (factors, tri, sub, x_ols, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.x_ols, ols.dof, ols.noise);
         let q = p - sub.rank;
         let problem = Problem {
             r: &tri.r,

@@ -402,15 +402,7 @@ mod tests {
     /// comparison of generated code checks it.
     #[test]
     fn counts_match_the_rank_of_pinocchios_stacked_regressor() {
-        for (name, path) in [
-            ("ur5", "robots/ur5/ur5.urdf"),
-            ("puma560", "robots/puma560/puma560.urdf"),
-            ("panda", "robots/panda/panda.urdf"),
-            ("gripper_arm", "robots/gripper_arm/gripper_arm.urdf"),
-            ("planar2", "tests/fixtures/planar2.urdf"),
-            ("paper6", "tests/fixtures/paper6.urdf"),
-            ("tree12", "tests/fixtures/tree12.urdf"),
-        ] {
+        for (name, path) in crate::regressor::PINOCCHIO_FIXTURES {
             let file = format!("{}/../tests/fixtures/{name}.json", env!("CARGO_MANIFEST_DIR"));
             let fx: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
             let vec = |v: &serde_json::Value| -> Vec<f64> {

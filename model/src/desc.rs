@@ -82,11 +82,12 @@ pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
     check_triangle(ev)
 }
 
-/// Checks one link's share of a body before merging. A part only has to be physical
-/// (mass ≥ 0, inertia positive semi-definite, triangle inequalities): point masses
-/// and massless frames are common on fixed joints, and only the merged body needs
-/// the strict [`check_inertial`].
-fn check_part(inertial: &Inertial) -> Result<(), ErrorKind> {
+/// Checks that an inertial is physical: finite, mass ≥ 0, inertia about the centre
+/// of mass positive semi-definite and satisfying the triangle inequalities. Each
+/// link's share of a body is held to this before merging (point masses and massless
+/// frames are common on fixed joints, and only the merged body needs the strict
+/// [`check_inertial`]), and so is an identified inertial before it is written.
+pub fn check_physical(inertial: &Inertial) -> Result<(), ErrorKind> {
     check_finite(inertial)?;
     if inertial.mass < 0.0 {
         return Err(ErrorKind::NonPositiveMass(inertial.mass));
@@ -302,7 +303,7 @@ impl Description {
                         None => moved,
                     });
                     if !is_massless_marker(inertial) {
-                        if let Err(kind) = check_part(inertial) {
+                        if let Err(kind) = check_physical(inertial) {
                             let l = &self.links[link];
                             errors.push(err(Element::Link(l.name.clone()), l.line, kind));
                         }

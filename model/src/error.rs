@@ -75,8 +75,14 @@ impl fmt::Display for ModelError {
         if let Some(line) = self.line {
             write!(f, "line {line}: ")?;
         }
-        write!(f, "{}: ", self.element)?;
-        match &self.kind {
+        write!(f, "{}: {}", self.element, self.kind)
+    }
+}
+
+impl fmt::Display for ErrorKind {
+    /// What is wrong, without the element and line a [`ModelError`] adds.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
             ErrorKind::Io(m) => write!(f, "cannot read the file: {m}"),
             ErrorKind::Parse(m) => write!(f, "not valid URDF: {m}"),
             ErrorKind::Xacro => write!(

@@ -36,9 +36,11 @@ mod write;
 pub mod xml;
 
 pub use base::{BaseParams, Parameterisation};
-pub use desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
+pub use desc::{
+    check_inertial, check_physical, DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY,
+};
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, parse_urdf};
-pub use write::to_urdf;
+pub use write::{inertial_element, to_urdf};

@@ -248,6 +248,19 @@ fn axis_rotation(axis: &Vec3, angle: f64) -> Mat3 {
     ]
 }
 
+/// The robots with a Pinocchio fixture (`tests/fixtures/<name>.json`) and their
+/// URDF, relative to the workspace root.
+#[cfg(test)]
+pub(crate) const PINOCCHIO_FIXTURES: [(&str, &str); 7] = [
+    ("ur5", "robots/ur5/ur5.urdf"),
+    ("puma560", "robots/puma560/puma560.urdf"),
+    ("panda", "robots/panda/panda.urdf"),
+    ("gripper_arm", "robots/gripper_arm/gripper_arm.urdf"),
+    ("planar2", "tests/fixtures/planar2.urdf"),
+    ("paper6", "tests/fixtures/paper6.urdf"),
+    ("tree12", "tests/fixtures/tree12.urdf"),
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -361,15 +374,7 @@ mod tests {
     /// Pinocchio's `tau` and `Y` for each fixture sample, with the fixture's gravity.
     #[test]
     fn matches_pinocchio_fixtures() {
-        for (name, path) in [
-            ("ur5", "robots/ur5/ur5.urdf"),
-            ("puma560", "robots/puma560/puma560.urdf"),
-            ("panda", "robots/panda/panda.urdf"),
-            ("gripper_arm", "robots/gripper_arm/gripper_arm.urdf"),
-            ("planar2", "tests/fixtures/planar2.urdf"),
-            ("paper6", "tests/fixtures/paper6.urdf"),
-            ("tree12", "tests/fixtures/tree12.urdf"),
-        ] {
+        for (name, path) in crate::regressor::PINOCCHIO_FIXTURES {
             let mut model = robot(path);
             let file = format!("{}/../tests/fixtures/{name}.json", env!("CARGO_MANIFEST_DIR"));
             let text = std::fs::read_to_string(&file).unwrap();

@@ -3,7 +3,7 @@
 //! the same model. Numbers are written in their shortest exact form, so they round-trip.
 
 use crate::desc::DEFAULT_GRAVITY;
-use crate::ir::{JointKind, Model};
+use crate::ir::{Inertial, JointKind, Model};
 use crate::math::Vec3;
 
 /// Bound written for the position, velocity and effort of a revolute or prismatic
@@ -35,10 +35,6 @@ pub fn to_urdf(model: &Model) -> String {
     out.push_str(&format!("<robot name=\"{}\">\n", attr(&model.name)));
     out.push_str(&format!("  <link name=\"{}\"/>\n", attr(&model.base)));
     for (body, joint) in model.bodies.iter().zip(&model.joints) {
-        let i = &body.inertial;
-        let m = &i.inertia;
-        // Written from the upper triangle; the average absorbs any rounding asymmetry.
-        let sym = |r: usize, c: usize| num(0.5 * (m[r][c] + m[c][r]));
         out.push_str(&format!("  <link name=\"{}\">\n", attr(&body.name)));
         if !body.merged.is_empty() {
             out.push_str(&format!(
@@ -46,19 +42,9 @@ pub fn to_urdf(model: &Model) -> String {
                 comment(&body.merged.join(", "))
             ));
         }
-        out.push_str("    <inertial>\n");
-        out.push_str(&format!("      <origin xyz=\"{}\" rpy=\"0 0 0\"/>\n", vec3(&i.com)));
-        out.push_str(&format!("      <mass value=\"{}\"/>\n", num(i.mass)));
-        out.push_str(&format!(
-            "      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>\n",
-            num(m[0][0]),
-            sym(0, 1),
-            sym(0, 2),
-            num(m[1][1]),
-            sym(1, 2),
-            num(m[2][2])
-        ));
-        out.push_str("    </inertial>\n");
+        out.push_str("    ");
+        out.push_str(&inertial_element(&body.inertial, "    ", "  ", "\n"));
+        out.push('\n');
         out.push_str("  </link>\n");
 
         let parent = match joint.parent {
@@ -104,6 +90,31 @@ pub fn to_urdf(model: &Model) -> String {
     }
     out.push_str("</robot>\n");
     out
+}
+
+/// An `<inertial>` element: `<origin xyz="com" rpy="0 0 0"/>`, `<mass>`, and
+/// `<inertia>` about the centre of mass in body axes, numbers in their shortest exact
+/// form. Its lines are joined by `newline`; the first is not indented (it goes where
+/// the caller's cursor is), the children are indented by `indent` + `unit`, the
+/// closing tag by `indent`.
+pub fn inertial_element(i: &Inertial, indent: &str, unit: &str, newline: &str) -> String {
+    // Written from both triangles' average, which absorbs any rounding asymmetry.
+    let s = |r: usize, c: usize| num(0.5 * (i.inertia[r][c] + i.inertia[c][r]));
+    format!(
+        "<inertial>{newline}\
+         {indent}{unit}<origin xyz=\"{}\" rpy=\"0 0 0\"/>{newline}\
+         {indent}{unit}<mass value=\"{}\"/>{newline}\
+         {indent}{unit}<inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>{newline}\
+         {indent}</inertial>",
+        vec3(&i.com),
+        num(i.mass),
+        s(0, 0),
+        s(0, 1),
+        s(0, 2),
+        s(1, 1),
+        s(1, 2),
+        s(2, 2),
+    )
 }
 
 /// Shortest decimal that parses back to the same `f64` (`Debug` switches to

@@ -693,14 +693,14 @@ pub struct NimEstimate {
 
 impl NimEstimate {
     /// The report of a NIM estimate ([`crate::Nim::identify`]): `θ` named
-    /// `m_1, J1_1, …`; a parameter the body's equations do not carry is
+    /// `m1, J1_1, …`; a parameter the body's equations do not carry is
     /// `no_effect`, one whose window predictions disagree `not_significant`, both
     /// without value. `sigma` is the standard error of the mean of the window
     /// predictions (their spread over the square root of the number of windows
     /// that share no sample); `rank` counts the parameters with a value.
     pub fn report(&self, robot: &str) -> dyngen_identify::report::ParameterReport {
         let estimate = self;
-        let names = dyngen_identify::mim::theta_names(estimate.body_names.len());
+        let names = dyngen_model::names::principal_param_names(estimate.body_names.len());
         let parameters: Vec<dyngen_identify::report::ParamReport> = names
             .into_iter()
             .enumerate()
@@ -763,7 +763,7 @@ impl NimEstimate {
         let mut worst = (0.0f64, 0.0f64);
         for (j, (v, t)) in self.theta.iter().zip(truth).enumerate() {
             if let Some(v) = v {
-                let rel = ((v - t) / t).abs();
+                let rel = dyngen_identify::relative_error(*v, *t);
                 if j % 4 == 0 {
                     worst.0 = worst.0.max(rel);
                 } else {
@@ -1035,7 +1035,7 @@ mod tests {
     #[test]
     fn draws_are_physically_consistent_and_within_the_spread() {
         let (model, _) = paper6();
-        let nominal = mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let mut rng = SplitMix64::new(4);
         for _ in 0..200 {
             let theta = draw_theta(&nominal, 0.3, &mut rng);
@@ -1084,7 +1084,7 @@ mod tests {
     #[test]
     fn the_wrench_of_a_draw_is_the_simulated_one() {
         let (model, robot) = paper6();
-        let nominal = mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let theta = draw_theta(&nominal, 0.3, &mut SplitMix64::new(2));
         let params = dyngen_reference::principal_params_to_standard(&model, &theta);
         let drawn = record(&robot, &params, &Experiment::paper(&model));
@@ -1110,7 +1110,7 @@ mod tests {
     #[test]
     fn a_small_nim_trains_saves_and_identifies() {
         let (model, robot) = paper6();
-        let nominal = mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
         let done = std::sync::atomic::AtomicUsize::new(0);
         let (nim, training) = Nim::train("paper6", &recording, &nominal, &small_config(), &|_| {
@@ -1168,7 +1168,7 @@ mod tests {
     #[test]
     fn damaged_identifier_files_are_refused() {
         let (model, robot) = paper6();
-        let nominal = mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
         let mut config = small_config();
         config.train.max_steps = 1;
@@ -1204,7 +1204,7 @@ mod tests {
     #[test]
     fn bad_training_settings_are_errors() {
         let (model, robot) = paper6();
-        let nominal = mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let recording = record(&robot, &model.standard_params(), &Experiment::paper(&model));
         let train = |config: NimConfig, nominal: &[f64]| {
             Nim::train("paper6", &recording, nominal, &config, &|_| {})

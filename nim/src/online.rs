@@ -133,7 +133,7 @@ fn summarise(
     window: usize,
     seconds_per_sample: f64,
 ) -> TrackingSummary {
-    let relative = |k: usize, p: usize| values[k][p].map(|v| ((v - track.truth[k][p]) / track.truth[k][p]).abs());
+    let relative = |k: usize, p: usize| values[k][p].map(|v| dyngen_identify::relative_error(v, track.truth[k][p]));
     // Parameters the estimator does not give are left out of the moment figures.
     let moments: Vec<usize> = (1..4).filter(|&p| values.iter().any(|v| v[p].is_some())).collect();
     let error = |k: usize, params: &[usize]| {
@@ -196,7 +196,7 @@ mod tests {
     fn both_estimators_follow_a_change_and_bad_settings_are_errors() {
         let model = dyngen_model::parse_urdf(include_str!("../../tests/fixtures/paper6.urdf")).unwrap();
         let robot = Reference::new(&model);
-        let nominal = dyngen_identify::mim::true_theta(&model);
+        let nominal = dyngen_model::principal_params(&model);
         let experiment = Experiment::paper(&model);
         let base = record(&robot, &model.standard_params(), &experiment);
         let mut config = NimConfig {

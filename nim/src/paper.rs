@@ -231,7 +231,7 @@ impl PaperNim {
             .zip(&self.labels)
             .zip(&self.identifiable)
             .filter(|(_, &ok)| ok)
-            .map(|((v, l), _)| ((v - l) / l).abs())
+            .map(|((&v, &l), _)| dyngen_identify::relative_error(v, l))
             .fold(0.0, f64::max)
     }
 }
@@ -281,7 +281,7 @@ mod tests {
         let model = dyngen_model::parse_urdf(include_str!("../../tests/fixtures/paper6.urdf")).unwrap();
         let robot = Reference::new(&model);
         (
-            mim::true_theta(&model),
+            dyngen_model::principal_params(&model),
             record(&robot, &model.standard_params(), &Experiment::paper(&model)),
         )
     }

@@ -6,7 +6,7 @@
 //! length `nv()`, standard parameters `params` of length `10 nv()` in Pinocchio's
 //! order, row-major matrices. Base parameters are not part of the trait: a generated
 //! robot has them from generation time, the reference would have to compute them, so
-//! code that needs them finds its own (see `simulate::base_columns`).
+//! code that needs them asks `dyngen_model::base::analyse`.
 
 use crate::BodyMotion;
 use crate::Reference;

@@ -3,6 +3,9 @@
 //! projections, per-body Newton–Euler, kinematics by finite differences, linearity
 //! in the parameters, the mass matrix two ways, and the power balance.
 
+mod common;
+
+use common::{advance, assert_close, assert_vec3_close, mat3, vec3};
 use dyngen::Pose;
 use dyngen_model::{
     desc::check_inertial, DeclaredJointType, Description, Inertial, JointDesc, JointKind, Limits, LinkDesc, Model,
@@ -133,29 +136,6 @@ fn random_trees() -> Vec<Model> {
 }
 
 // ---------------------------------------------------------------- comparisons
-
-/// `|actual − expected| ≤ tol (1 + |expected|)` entry by entry.
-fn assert_close(actual: &[f64], expected: &[f64], tol: f64, what: &str) {
-    assert_eq!(actual.len(), expected.len(), "{what}: lengths");
-    for (k, (a, e)) in actual.iter().zip(expected).enumerate() {
-        assert!(
-            (a - e).abs() <= tol * (1.0 + e.abs()),
-            "{what}[{k}]: {a} vs {e} (tol {tol})\n{actual:?}\n{expected:?}"
-        );
-    }
-}
-
-fn assert_vec3_close(actual: &Vector3<f64>, expected: &Vector3<f64>, tol: f64, what: &str) {
-    assert_close(actual.as_slice(), expected.as_slice(), tol, what);
-}
-
-fn mat3(m: &[[f64; 3]; 3]) -> Matrix3<f64> {
-    Matrix3::from_fn(|r, c| m[r][c])
-}
-
-fn vec3(v: &[f64; 3]) -> Vector3<f64> {
-    Vector3::new(v[0], v[1], v[2])
-}
 
 // ---------------------------------------------------------------- closed forms
 
@@ -456,17 +436,6 @@ fn forward_kinematics_composes_placements() {
                 assert_vec3_close(&pose.translation, &expected.translation.vector, 1e-14, "translation");
             }
         }
-    }
-}
-
-/// The state along `q(t) = q + t q̇ + ½ t² q̈`, `q̇(t) = q̇ + t q̈`.
-fn advance(s: &State, t: f64) -> State {
-    State {
-        q: (0..s.q.len())
-            .map(|k| s.q[k] + t * s.v[k] + 0.5 * t * t * s.a[k])
-            .collect(),
-        v: (0..s.q.len()).map(|k| s.v[k] + t * s.a[k]).collect(),
-        a: s.a.clone(),
     }
 }
 

@@ -52,7 +52,7 @@ fn setup() -> Setup {
     Setup {
         recording: record(&robot, &Paper6::NOMINAL_PARAMS, &experiment),
         training: record(&robot, &Paper6::NOMINAL_PARAMS, &two),
-        nominal: mim::true_theta(robot.model()),
+        nominal: dyngen_model::principal_params(robot.model()),
     }
 }
 

@@ -69,7 +69,7 @@ fn paper6_noise_free_mim_is_exact() {
     let (robot, recording) = paper6_recording();
     let truth = Paper6::nominal_theta();
     // The truth from the model's principal frames is the generator's.
-    let from_model = mim::true_theta(robot.model());
+    let from_model = dyngen_model::principal_params(robot.model());
     for (a, b) in from_model.iter().zip(truth) {
         assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0));
     }

@@ -5,7 +5,7 @@
 //! squares. Times are measured by the benchmarks and the demo, not here.
 
 use dyngen::Robot;
-use dyngen_identify::mim::{self, Verdict};
+use dyngen_identify::mim::Verdict;
 use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
 use dyngen_nim::online::{track, Tracking};
 use dyngen_nim::{draw_theta, Nim, NimConfig};
@@ -42,7 +42,7 @@ fn repeat(experiment: &Experiment, periods: usize) -> Experiment {
 fn generalising_nim_meets_its_targets_on_unseen_draws() {
     let robot = Generated::<Paper6>::new();
     let model = robot.model().clone();
-    let nominal = mim::true_theta(&model);
+    let nominal = dyngen_model::principal_params(&model);
     let experiment = designed(&robot);
     let training = record(&robot, Paper6::nominal_params(), &repeat(&experiment, 2));
     let config = NimConfig::default();

@@ -52,7 +52,9 @@ pub enum ReportError {
         line: usize,
         merged: Vec<String>,
     },
-    /// The inertial cannot be written (non-finite number, negative mass).
+    /// The inertial is not physical ([`dyngen_model::check_physical`]): a number is
+    /// not finite, the mass is negative, or the inertia is not positive
+    /// semi-definite or breaks the triangle inequality.
     InvalidInertial {
         link: String,
         reason: String,

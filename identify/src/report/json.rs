@@ -34,8 +34,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{write_new, ReportError};
-use crate::mim::{theta_names, MimEstimate, Verdict};
+use crate::mim::{MimEstimate, Verdict};
 use crate::{Estimate, Status};
+use dyngen_model::names::principal_param_names;
 
 /// The `schema` field this module writes and accepts.
 pub const SCHEMA: &str = "dyngen-parameters/1";
@@ -181,13 +182,13 @@ impl ParameterReport {
         }
     }
 
-    /// The report of a MIM estimate ([`crate::mim`]): `θ` named `m_1, J1_1, J2_1,
-    /// J3_1, m_2, …`, channels `<body>.Fx … <body>.Mz` (six per body), and the MIM
+    /// The report of a MIM estimate ([`crate::mim`]): `θ` named `m1, J1_1, J2_1,
+    /// J3_1, m2, …`, channels `<body>.Fx … <body>.Mz` (six per body), and the MIM
     /// verdicts: a parameter below the significance threshold is `not_significant`,
     /// without value or σ. A per-body estimate ([`crate::mim::samples`]) becomes one
     /// report: ranks add up, the condition number is the worst body's.
     pub fn from_mim(robot: &str, estimate: &MimEstimate) -> ParameterReport {
-        let names = theta_names(estimate.bodies());
+        let names = principal_param_names(estimate.bodies());
         let channels: Vec<String> = estimate
             .body_names
             .iter()

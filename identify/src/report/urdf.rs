@@ -12,7 +12,7 @@
 //! frames), so the file describes the identified robot exactly.
 
 use dyngen_model::xml::{scan, Tag};
-use dyngen_model::Inertial;
+use dyngen_model::{check_physical, inertial_element, Inertial};
 
 use super::ReportError;
 
@@ -108,39 +108,13 @@ pub fn rewrite_urdf_inertials_with<S: AsRef<str>>(
     Ok(out)
 }
 
+/// The model builder's own test for a part of a body, so the file written is one
+/// the model reads back.
 fn check_inertial(link: &str, i: &Inertial) -> Result<(), ReportError> {
-    let finite = i.mass.is_finite() && i.com.iter().chain(i.inertia.iter().flatten()).all(|x| x.is_finite());
-    let reason = if !finite {
-        "a number is not finite"
-    } else if i.mass < 0.0 {
-        "the mass is negative"
-    } else {
-        return Ok(());
-    };
-    Err(ReportError::InvalidInertial {
+    check_physical(i).map_err(|kind| ReportError::InvalidInertial {
         link: link.into(),
-        reason: reason.into(),
+        reason: kind.to_string(),
     })
-}
-
-/// The `<inertial>` element, its lines joined by `newline`, the first line not indented.
-fn inertial_text(i: &Inertial, indent: &str, unit: &str, newline: &str) -> String {
-    let s = |r: usize, c: usize| 0.5 * (i.inertia[r][c] + i.inertia[c][r]);
-    let [x, y, z] = i.com;
-    format!(
-        "<inertial>{newline}\
-         {indent}{unit}<origin xyz=\"{x:?} {y:?} {z:?}\" rpy=\"0 0 0\"/>{newline}\
-         {indent}{unit}<mass value=\"{:?}\"/>{newline}\
-         {indent}{unit}<inertia ixx=\"{:?}\" ixy=\"{:?}\" ixz=\"{:?}\" iyy=\"{:?}\" iyz=\"{:?}\" izz=\"{:?}\"/>{newline}\
-         {indent}</inertial>",
-        i.mass,
-        s(0, 0),
-        s(0, 1),
-        s(0, 2),
-        s(1, 1),
-        s(1, 2),
-        s(2, 2),
-    )
 }
 
 fn line_of(text: &str, pos: usize) -> usize {
@@ -298,7 +272,7 @@ impl<'a> Document<'a> {
             .filter(|u| !u.is_empty())
             .unwrap_or(doc_unit)
             .to_string();
-        let element = |indent: &str| inertial_text(i, indent, &unit, newline);
+        let element = |indent: &str| inertial_element(i, indent, &unit, newline);
         if let Some(k) = self.child(l, "inertial") {
             let t = &self.tags[k];
             let indent = self.indent_at(t.start.start).unwrap_or(&child_indent);

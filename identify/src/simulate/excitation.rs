@@ -4,10 +4,11 @@
 //!
 //! * for identification from joint torques, the condition number `σ_max/σ_min` of
 //!   the stacked base regressor `W_b = [Y(q_k, v_k, a_k)]_{k}` restricted to the
-//!   identifiable columns of `Y`. Those columns are found once, numerically, by
-//!   [`base_columns`]: with them, `Y π = Y_b β` where `Y_b = Y[:, base]` and `β` the
-//!   base parameters built on those columns, so `cond(W_b)` is the condition number
-//!   of the base-parameter least squares problem the trajectory will feed;
+//!   identifiable columns of `Y`. Those columns are the model's base-parameter
+//!   columns ([`dyngen_model::base::analyse`]): with them, `Y π = Y_b β` where
+//!   `Y_b = Y[:, base]` and `β` the base parameters built on those columns, so
+//!   `cond(W_b)` is the condition number of the base-parameter least squares problem
+//!   the trajectory will feed, and the same columns the generated base regressor has;
 //! * for MIM on body measurements, the worst relative standard deviation of a
 //!   principal moment: per body `i`, with `B_i` stacked over the samples and
 //!   `M_i = B_i J_i` its moments at the nominal parameters,
@@ -16,9 +17,10 @@
 //!   noise on the moments (5.7 means 5.7 % at 1 % noise). Masses are left out: gravity
 //!   alone makes them well conditioned.
 
-use super::motion::{FourierExcitation, Trajectory};
+use super::motion::{FourierExcitation, JointMotion};
 use super::nelder_mead;
 use dyngen::BodyRegressor;
+use dyngen_model::base::{self, Parameterisation};
 use dyngen_model::{JointKind, Model};
 use dyngen_reference::Dynamics;
 use dyngen_reference::{sample_states, SplitMix64};
@@ -70,65 +72,6 @@ impl JointLimits {
     }
 }
 
-/// The identifiable columns of the joint torque regressor `Y` (indices into its
-/// `10 n` columns, ascending): the columns a QR factorisation with column pivoting
-/// (largest remaining column first, modified Gram–Schmidt) accepts before the
-/// largest remaining residual norm falls below `10⁻⁸` times the first pivot's, on
-/// `Y` stacked over 40 random states from
-/// [`sample_states`](dyngen_reference::sample_states) with `seed` (`40 n` rows for
-/// `10 n` columns).
-///
-/// Their number is the number of base parameters. The choice of columns may differ
-/// from the generator's (which groups into a preferred order); the span is the same.
-pub fn base_columns(dynamics: &dyn Dynamics, seed: u64) -> Vec<usize> {
-    let n = dynamics.nv();
-    let p = dynamics.nparams();
-    let states = sample_states(dynamics.model(), 40, seed);
-    let mut w = DMatrix::zeros(n * states.len(), p);
-    let mut y = vec![0.0; n * p];
-    for (k, s) in states.iter().enumerate() {
-        dynamics.joint_torque_regressor(&s.q, &s.v, &s.a, &mut y);
-        for r in 0..n {
-            for c in 0..p {
-                w[(k * n + r, c)] = y[r * p + c];
-            }
-        }
-    }
-    pivoted_columns(w, 1e-8)
-}
-
-/// Column indices chosen by pivoted modified Gram–Schmidt, ascending.
-fn pivoted_columns(mut w: DMatrix<f64>, tolerance: f64) -> Vec<usize> {
-    let p = w.ncols();
-    let mut chosen = Vec::new();
-    let mut remaining: Vec<usize> = (0..p).collect();
-    let mut first = 0.0;
-    while !remaining.is_empty() {
-        let (slot, &pivot) = remaining
-            .iter()
-            .enumerate()
-            .max_by(|a, b| w.column(*a.1).norm().total_cmp(&w.column(*b.1).norm()))
-            .expect("non-empty");
-        let norm = w.column(pivot).norm();
-        if chosen.is_empty() {
-            first = norm;
-        }
-        if norm <= tolerance * first || norm == 0.0 {
-            break;
-        }
-        remaining.swap_remove(slot);
-        chosen.push(pivot);
-        let unit = w.column(pivot) / norm;
-        for &c in &remaining {
-            let projection = unit.dot(&w.column(c));
-            let mut col = w.column_mut(c);
-            col.axpy(-projection, &unit, 1.0);
-        }
-    }
-    chosen.sort_unstable();
-    chosen
-}
-
 /// What [`ExcitationDesign::optimise`] minimises (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Criterion {
@@ -168,7 +111,8 @@ pub struct ExcitationDesign {
     /// Impose `v(0) = 0` and `a(0) = 0` (so also at every multiple of the period):
     /// `a_i1 = −Σ_{l≥2} a_il`, `b_i1 = −Σ_{l≥2} l b_il`. Needs `L ≥ 2`.
     pub start_at_rest: bool,
-    /// Seeds the random initial coefficients and the column selection.
+    /// Seeds the random initial coefficients and the states on which the moments
+    /// that enter the body equations are found.
     pub seed: u64,
 }
 
@@ -220,7 +164,7 @@ impl ExcitationDesign {
             !self.start_at_rest || harmonics >= 2,
             "`start_at_rest` needs at least 2 harmonics"
         );
-        let base = base_columns(dynamics, self.seed);
+        let base = base::analyse(dynamics.model(), Parameterisation::Standard).independent;
         let objective = Objective::new(self, dynamics, &base);
         let layout = Layout {
             n,
@@ -314,7 +258,8 @@ pub struct OptimisedExcitation {
     pub initial_value: f64,
     /// Objective evaluations spent.
     pub evaluations: usize,
-    /// The identifiable columns of `Y` the criterion used ([`base_columns`]).
+    /// The identifiable columns of `Y` the criterion used
+    /// ([`BaseParams::independent`](dyngen_model::base::BaseParams::independent)).
     pub base_columns: Vec<usize>,
 }
 
@@ -508,14 +453,14 @@ impl<'a> Objective<'a> {
 /// let s = moment_sigma(&robot, &paper.motion, &paper.times());
 /// assert!(s > 1.0 && s.is_finite()); // > 1 % σ at 1 % noise: some moment is barely excited
 /// ```
-pub fn moment_sigma(dynamics: &dyn Dynamics, trajectory: &dyn Trajectory, times: &[f64]) -> f64 {
+pub fn moment_sigma(dynamics: &dyn Dynamics, trajectory: &dyn JointMotion, times: &[f64]) -> f64 {
     worst_moment_sigma(dynamics, &body_moments(dynamics, 1), trajectory, times)
 }
 
 fn worst_moment_sigma(
     dynamics: &dyn Dynamics,
     moments: &[([f64; 3], [bool; 3])],
-    trajectory: &dyn Trajectory,
+    trajectory: &dyn JointMotion,
     times: &[f64],
 ) -> f64 {
     let n = trajectory.nv();
@@ -557,7 +502,7 @@ fn worst_moment_sigma(
 fn body_moments(dynamics: &dyn Dynamics, seed: u64) -> Vec<([f64; 3], [bool; 3])> {
     let model = dynamics.model();
     let n = dynamics.nv();
-    let theta = crate::mim::true_theta(model);
+    let theta = dyngen_model::principal_params(model);
     let mut norms = vec![[0.0f64; 3]; n];
     let mut blocks = vec![BodyRegressor::default(); n];
     for s in sample_states(model, 40, seed) {
@@ -577,24 +522,4 @@ fn body_moments(dynamics: &dyn Dynamics, seed: u64) -> Vec<([f64; 3], [bool; 3])
             )
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pivoted_columns_finds_the_independent_ones() {
-        // Column 2 = column 0 + column 1, column 3 = 0.
-        let w = DMatrix::from_row_slice(
-            4,
-            4,
-            &[
-                1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 2.0, 1.0, 3.0, 0.0, 1.0, 3.0, 4.0, 0.0,
-            ],
-        );
-        let chosen = pivoted_columns(w, 1e-10);
-        assert_eq!(chosen.len(), 2);
-        assert!(!chosen.contains(&3));
-    }
 }

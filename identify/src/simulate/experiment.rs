@@ -6,7 +6,7 @@
 
 use super::cardano::{cardano_angles, cardano_matrix, cardano_rates, unwrap_angle};
 use super::excitation::JointLimits;
-use super::motion::{FourierExcitation, RaisedCosine, Trajectory};
+use super::motion::{FourierExcitation, JointMotion, RaisedCosine};
 use crate::data::DataError;
 use dyngen::{BodyRegressor, Pose, Wrench};
 use dyngen_model::{principal_frames, Model};
@@ -24,7 +24,7 @@ pub enum Motion {
     Fourier(FourierExcitation),
 }
 
-impl Trajectory for Motion {
+impl JointMotion for Motion {
     fn nv(&self) -> usize {
         match self {
             Motion::RaisedCosine(m) => m.nv(),
@@ -134,12 +134,12 @@ pub fn record(dynamics: &dyn Dynamics, params: &[f64], experiment: &Experiment) 
     record_trajectory(dynamics, params, &experiment.motion, &experiment.times())
 }
 
-/// Records any [`Trajectory`] at the given times (ascending, for the angle
+/// Records any [`JointMotion`] at the given times (ascending, for the angle
 /// unwrapping). Panics if `params` or the trajectory do not fit the model.
 pub fn record_trajectory(
     dynamics: &dyn Dynamics,
     params: &[f64],
-    trajectory: &dyn Trajectory,
+    trajectory: &dyn JointMotion,
     times: &[f64],
 ) -> Recording {
     let model = dynamics.model();

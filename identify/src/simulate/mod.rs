@@ -37,9 +37,9 @@ pub(crate) use nelder_mead::minimise;
 mod noise;
 
 pub use cardano::{cardano_angles, cardano_matrix, cardano_rate_matrix, cardano_rates};
-pub use excitation::{base_columns, moment_sigma, Criterion, ExcitationDesign, JointLimits, OptimisedExcitation};
+pub use excitation::{moment_sigma, Criterion, ExcitationDesign, JointLimits, OptimisedExcitation};
 pub use experiment::{record, record_trajectory, BodyMeasurement, Experiment, Motion, Recording, Sample};
 pub use integrate::{simulate_rk4, Simulation};
 pub use logger::{add_joint_terms, Logger};
-pub use motion::{FourierExcitation, RaisedCosine, SampledMotion, Trajectory};
+pub use motion::{FourierExcitation, JointMotion, RaisedCosine, SampledMotion};
 pub use noise::{Channel, Gaussian, NoiseModel, Sigma};

@@ -4,8 +4,9 @@
 
 use std::f64::consts::PI;
 
-/// A prescribed joint-space motion `q(t)` with its derivatives `v = q̇`, `a = q̈`.
-pub trait Trajectory {
+/// A prescribed joint-space motion `q(t)` with its derivatives `v = q̇`, `a = q̈`
+/// (a recorded data set is a [`Trajectory`](crate::data::Trajectory)).
+pub trait JointMotion {
     /// Number of joints `n`.
     fn nv(&self) -> usize;
     /// `q(t), v(t), a(t)`, `n` each. Panics if a slice has another length.
@@ -94,7 +95,7 @@ impl RaisedCosine {
     }
 }
 
-impl Trajectory for RaisedCosine {
+impl JointMotion for RaisedCosine {
     fn nv(&self) -> usize {
         self.q0.len()
     }
@@ -190,7 +191,7 @@ impl FourierExcitation {
     }
 }
 
-impl Trajectory for FourierExcitation {
+impl JointMotion for FourierExcitation {
     fn nv(&self) -> usize {
         self.q0.len()
     }
@@ -249,7 +250,7 @@ impl SampledMotion {
     }
 }
 
-impl Trajectory for SampledMotion {
+impl JointMotion for SampledMotion {
     fn nv(&self) -> usize {
         self.n
     }

@@ -116,12 +116,19 @@ fn check_finite(inertial: &Inertial) -> Result<(), ErrorKind> {
 /// Principal moments `ev` (ascending) of a real body: the largest is at most the sum
 /// of the other two.
 fn check_triangle(ev: [f64; 3]) -> Result<(), ErrorKind> {
-    // Thin rods sit exactly on the boundary; allow rounding there.
-    let tol = 1e-9 * (ev[0].abs() + ev[1].abs() + ev[2].abs());
-    if ev[2] > ev[0] + ev[1] + tol {
-        return Err(ErrorKind::TriangleInequality(ev));
+    match triangle_violation(ev) {
+        Some(_) => Err(ErrorKind::TriangleInequality(ev)),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// The moment (index into `moments`, in the order given) that exceeds the sum of
+/// the other two, if one does: no rigid body has one (`J1 + J2 − J3 = 2∫z² dm ≥ 0`).
+/// Thin rods sit exactly on the boundary, so rounding of `1e-9` of the sum is allowed.
+/// The one rule, for every front end.
+pub fn triangle_violation(moments: [f64; 3]) -> Option<usize> {
+    let tol = 1e-9 * (moments[0].abs() + moments[1].abs() + moments[2].abs());
+    (0..3).find(|&k| moments[k] > moments[(k + 1) % 3] + moments[(k + 2) % 3] + tol)
 }
 
 impl Description {

@@ -533,25 +533,21 @@ fn check_triangle_inequality(cx: &Ctxt, body: &Body) {
     if j.iter().any(|&x| x <= 0.0) {
         return; // reported by `check_moments_positive`
     }
-    // The same tolerance as `dyngen_model::desc::check_inertial` (thin rods are exact).
-    let tol = 1e-9 * (j[0] + j[1] + j[2]);
-    for k in 0..3 {
+    // The model's rule, so the DSL and URDF accept the same bodies.
+    if let Some(k) = dyngen_model::desc::triangle_violation(j) {
         let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-        if j[k] > j[a] + j[b] + tol {
-            cx.error_spanned_by(
-                moments.loc,
-                format!(
-                    "principal moments break the triangle inequality: J{} = {} exceeds J{} + J{} \
-                     = {}; no rigid body has one moment larger than the sum of the other two",
-                    k + 1,
-                    j[k],
-                    a.min(b) + 1,
-                    a.max(b) + 1,
-                    rounded(j[a] + j[b])
-                ),
-            );
-            return;
-        }
+        cx.error_spanned_by(
+            moments.loc,
+            format!(
+                "principal moments break the triangle inequality: J{} = {} exceeds J{} + J{} \
+                 = {}; no rigid body has one moment larger than the sum of the other two",
+                k + 1,
+                j[k],
+                a.min(b) + 1,
+                a.max(b) + 1,
+                rounded(j[a] + j[b])
+            ),
+        );
     }
 }
 

@@ -252,15 +252,21 @@ pub fn identify_gains(
     })
 }
 
-/// `F` with `FᵀF = G` for a symmetric positive semi-definite `G`.
-fn gram_root(g: faer::MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
-    let n = g.nrows();
-    let eigen = g
+/// The eigenvalues and eigenvectors (columns) of a symmetric `G`.
+fn eigen(g: faer::MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), IdentifyError> {
+    let e = g
         .self_adjoint_eigen(faer::Side::Lower)
         .map_err(|_| IdentifyError::DecompositionFailed {
             what: "eigendecomposition of the normal equations",
         })?;
-    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    let values = (0..g.nrows()).map(|i| e.S().column_vector()[i]).collect();
+    Ok((values, e.U().to_owned()))
+}
+
+/// `F` with `FᵀF = G` for a symmetric positive semi-definite `G`.
+fn gram_root(g: faer::MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
+    let n = g.nrows();
+    let (values, vectors) = eigen(g)?;
     Ok(Mat::from_fn(n, n, |i, j| values[i].max(0.0).sqrt() * vectors[(j, i)]))
 }
 
@@ -268,12 +274,7 @@ fn gram_root(g: faer::MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
 /// `1e-12` of the largest counted as zero.
 fn min_norm_solve(g: faer::MatRef<'_, f64>, b: &[f64]) -> Result<Vec<f64>, IdentifyError> {
     let n = g.nrows();
-    let eigen = g
-        .self_adjoint_eigen(faer::Side::Lower)
-        .map_err(|_| IdentifyError::DecompositionFailed {
-            what: "eigendecomposition of the normal equations",
-        })?;
-    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    let (values, vectors) = eigen(g)?;
     let largest = (0..n).map(|i| values[i].abs()).fold(0.0, f64::max);
     let mut x = vec![0.0; n];
     for i in 0..n {

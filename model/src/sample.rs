@@ -56,27 +56,7 @@ pub struct State {
 /// The draw order is fixed (per state: all `q`, then all `v`, then all `a`), so
 /// the same model, count and seed give the same states in every version.
 pub fn sample_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
-    let mut rng = SplitMix64::new(seed);
-    (0..count)
-        .map(|_| {
-            let q = model
-                .joints
-                .iter()
-                .map(|j| {
-                    // One turn, or ±0.5 m, within the limits when there are any (a
-                    // model written without limits carries wide placeholders).
-                    let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
-                    match j.limits {
-                        Some(l) => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
-                        None => rng.uniform(-reach, reach),
-                    }
-                })
-                .collect();
-            let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
-            let a = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
-            State { q, v, a }
-        })
-        .collect()
+    draw(model, count, seed, true)
 }
 
 /// `count` states for analysing the structure of the dynamics (which columns of a
@@ -91,6 +71,11 @@ pub fn sample_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
 /// placeholder limits (`lower = upper = 0`, or a narrow range) would pin a joint and
 /// hide parameters. A prismatic range wider than ±0.5 m would add nothing but scale.
 pub fn structure_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
+    draw(model, count, seed, false)
+}
+
+/// The draws of [`sample_states`] (`within_limits`) and [`structure_states`].
+fn draw(model: &Model, count: usize, seed: u64, within_limits: bool) -> Vec<State> {
     let mut rng = SplitMix64::new(seed);
     (0..count)
         .map(|_| {
@@ -98,8 +83,13 @@ pub fn structure_states(model: &Model, count: usize, seed: u64) -> Vec<State> {
                 .joints
                 .iter()
                 .map(|j| {
+                    // One turn, or ±0.5 m, within the limits when asked and there are
+                    // any (a model written without limits carries wide placeholders).
                     let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
-                    rng.uniform(-reach, reach)
+                    match j.limits {
+                        Some(l) if within_limits => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
+                        _ => rng.uniform(-reach, reach),
+                    }
                 })
                 .collect();
             let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();

@@ -30,6 +30,7 @@
 
 pub mod data;
 pub mod mim;
+pub mod pipeline;
 pub mod report;
 pub mod simulate;
 

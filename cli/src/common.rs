@@ -23,7 +23,9 @@ impl GravityArg {
         match &self.gravity {
             None => Ok(None),
             Some(g) if g.len() == 3 && g.iter().all(|x| x.is_finite()) => Ok(Some([g[0], g[1], g[2]])),
-            Some(g) => Err(CliError::usage(format!("--gravity needs three finite numbers, got {g:?}"))),
+            Some(g) => Err(CliError::usage(format!(
+                "--gravity needs three finite numbers, got {g:?}"
+            ))),
         }
     }
 }

@@ -214,7 +214,9 @@ impl RecipeArgs {
         ];
         for (flag, key, value) in flags {
             if let Some(value) = value {
-                recipe.set(key, value).map_err(|e| CliError::usage(format!("{flag}: {e}")))?;
+                recipe
+                    .set(key, value)
+                    .map_err(|e| CliError::usage(format!("{flag}: {e}")))?;
             }
         }
         recipe.check().map_err(|e| CliError::Input(format!("recipe: {e}")))?;
@@ -287,7 +289,10 @@ impl IdentifyArgs {
 
 pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if !(args.lambda.is_finite() && args.lambda >= 0.0) {
-        return Err(CliError::usage(format!("--lambda must be non-negative, got {}", args.lambda)));
+        return Err(CliError::usage(format!(
+            "--lambda must be non-negative, got {}",
+            args.lambda
+        )));
     }
     if args.mode == Mode::Mim && args.method.is_some() {
         return Err(CliError::usage(
@@ -450,7 +455,11 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
         );
     }
     if !rewrite.kept.is_empty() {
-        let kept: Vec<String> = rewrite.kept.iter().map(|(body, why)| format!("{body} ({why})")).collect();
+        let kept: Vec<String> = rewrite
+            .kept
+            .iter()
+            .map(|(body, why)| format!("{body} ({why})"))
+            .collect();
         println!(
             "note: kept the URDF inertials of {} of {} bodies: {}",
             kept.len(),

@@ -2,8 +2,8 @@
 //! along the joint motion of a CSV file (on simulated parameter draws), `predict`
 //! the principal parameters from measured data.
 
-use crate::error::CliError;
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use crate::error::CliError;
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::mim;
@@ -161,7 +161,9 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
     check_overwrite(&args.output, args.force)?;
     if let Some(svg) = &args.loss_svg {
         if svg == &args.output {
-            return Err(CliError::usage("--output and --loss-svg name the same file; give each its own"));
+            return Err(CliError::usage(
+                "--output and --loss-svg name the same file; give each its own",
+            ));
         }
         check_overwrite(svg, args.force)?;
     }
@@ -347,9 +349,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
         );
     }
     let stride = args.stride.unwrap_or((nim.window / 2).max(1));
-    let estimate = nim
-        .identify(&recording, stride)
-        .map_err(|e| nim_error(&args.data, e))?;
+    let estimate = nim.identify(&recording, stride).map_err(|e| nim_error(&args.data, e))?;
     let estimate = if args.truth_from_urdf {
         estimate.with_truth(&mim::true_theta(&model))
     } else {

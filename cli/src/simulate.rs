@@ -1,7 +1,7 @@
 //! `dyngen simulate`: an identification experiment on the nominal parameters, as CSV.
 
-use crate::error::CliError;
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
+use crate::error::CliError;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
 use dyngen_reference::Reference;
@@ -101,7 +101,9 @@ pub struct SimulateArgs {
 fn check_args(args: &SimulateArgs) -> Result<()> {
     if let Some(d) = args.duration {
         if !(d.is_finite() && d > 0.0) {
-            return Err(CliError::usage(format!("--duration must be a positive number of seconds, got {d}")));
+            return Err(CliError::usage(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            )));
         }
     }
     if args.steps < 1 {

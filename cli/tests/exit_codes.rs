@@ -10,10 +10,22 @@ fn exit_codes_say_what_kind_of_failure_it_was() {
     // 2: usage, from clap and from option values.
     assert_exit(&run!("identify"), 2, "");
     assert_exit(&run!("info", ur5(), "--no-such-flag"), 2, "--no-such-flag");
-    assert_exit(&run!("generate", ur5(), "--name", "not a type"), 2, "not a valid Rust type name");
+    assert_exit(
+        &run!("generate", ur5(), "--name", "not a type"),
+        2,
+        "not a valid Rust type name",
+    );
     let csv = simulate_ur5(&dir, 20, &[]);
-    assert_exit(&run!("identify", ur5(), csv, "--cutoff", "-1"), 2, "--cutoff must be a positive");
-    assert_exit(&run!("demo", "--draws", "0"), 2, "--draws and --test-draws must be at least 1");
+    assert_exit(
+        &run!("identify", ur5(), csv, "--cutoff", "-1"),
+        2,
+        "--cutoff must be a positive",
+    );
+    assert_exit(
+        &run!("demo", "--draws", "0"),
+        2,
+        "--draws and --test-draws must be at least 1",
+    );
 
     // 3: an input file that is missing or invalid.
     assert_exit(&run!("info", dir.join("missing.urdf")), 3, "missing.urdf");

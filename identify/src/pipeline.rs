@@ -153,7 +153,10 @@ impl fmt::Display for PipelineError {
         match self {
             Self::InvalidOption { option, reason } => write!(f, "{option} {reason}"),
             Self::Recipe(e) => write!(f, "recipe: {e}"),
-            Self::Data { path: Some(path), error } => write!(f, "{}: {error}", path.display()),
+            Self::Data {
+                path: Some(path),
+                error,
+            } => write!(f, "{}: {error}", path.display()),
             Self::Data { path: None, error } => write!(f, "{error}"),
             Self::DofMismatch { expected, found } => {
                 write!(f, "the recording has {found} joints, the robot {expected}")
@@ -194,7 +197,11 @@ pub fn load(path: &Path, recipe: &Recipe, dof: usize, options: &IdentifyOptions)
         error,
     };
     recipe.check().map_err(PipelineError::Recipe)?;
-    recipe.read(path, Some(dof)).map_err(data)?.with_derivatives(options.cutoff_hz).map_err(data)
+    recipe
+        .read(path, Some(dof))
+        .map_err(data)?
+        .with_derivatives(options.cutoff_hz)
+        .map_err(data)
 }
 
 /// How an identification predicts the joint torques.
@@ -202,7 +209,7 @@ pub fn load(path: &Path, recipe: &Recipe, dof: usize, options: &IdentifyOptions)
 pub enum Prediction {
     /// Regressor rows times the estimate's solution: exact on the identifiable
     /// subspace, whatever the unidentifiable directions hold.
-    Regressor(TorqueEstimate),
+    Regressor(Box<TorqueEstimate>),
     /// Inverse dynamics with these standard parameters (MIM: `θ` where identified,
     /// the model's elsewhere).
     Parameters(Vec<f64>),
@@ -305,12 +312,12 @@ fn from_torques(
         mode: options.mode,
         report,
         mim: None,
-        prediction: Prediction::Regressor(TorqueEstimate {
+        prediction: Prediction::Regressor(Box::new(TorqueEstimate {
             regressor,
             names,
             estimate,
             truth: options.model_is_truth.then_some(nominal),
-        }),
+        })),
     })
 }
 
@@ -326,8 +333,8 @@ fn by_mim(
         return Err(PipelineError::MissingWrenches { dof: model.dof() });
     }
     let reference = Reference::new(model);
-    let recording = Recording::from_measurements(&reference, traj)
-        .map_err(|error| PipelineError::Data { path: None, error })?;
+    let recording =
+        Recording::from_measurements(&reference, traj).map_err(|error| PipelineError::Data { path: None, error })?;
     let nominal = mim::true_theta(model);
     let truth = options.model_is_truth.then_some(nominal.as_slice());
     let mim_options = MimOptions {
@@ -541,7 +548,9 @@ mod tests {
         let robot = Reference::new(model);
         let experiment = Experiment::paper(model);
         let recording = crate::simulate::record(&robot, &model.standard_params(), &experiment);
-        recording.to_trajectory().expect("a simulated recording is a valid trajectory")
+        recording
+            .to_trajectory()
+            .expect("a simulated recording is a valid trajectory")
     }
 
     fn options(mode: Mode, estimator: Estimator) -> IdentifyOptions {
@@ -558,7 +567,12 @@ mod tests {
         let model = ur5();
         let robot = Reference::new(model);
         let traj = recording();
-        for estimator in [Estimator::Ols, Estimator::Wls, Estimator::Tls, Estimator::Ridge { lambda: 1e-6 }] {
+        for estimator in [
+            Estimator::Ols,
+            Estimator::Wls,
+            Estimator::Tls,
+            Estimator::Ridge { lambda: 1e-6 },
+        ] {
             let id = identify(&robot, &traj, &options(Mode::Standard, estimator)).unwrap();
             let errors = id.errors(model);
             let (worst, name) = errors.worst.clone().unwrap_or((0.0, String::new()));
@@ -566,7 +580,11 @@ mod tests {
             // Joint torques never determine every standard parameter; ridge fills in
             // the rest from the prior.
             let without_value = errors.relative.iter().any(|(_, e)| e.is_none());
-            assert_eq!(without_value, !matches!(estimator, Estimator::Ridge { .. }), "{estimator:?}");
+            assert_eq!(
+                without_value,
+                !matches!(estimator, Estimator::Ridge { .. }),
+                "{estimator:?}"
+            );
             let predicted = id.predict(&robot, &traj).unwrap();
             for (k, tau) in predicted.iter().enumerate() {
                 for (p, m) in tau.iter().zip(traj.tau(k)) {
@@ -583,8 +601,8 @@ mod tests {
         let id = identify(&robot, &recording(), &options(Mode::Mim, Estimator::Ols)).unwrap();
         let errors = id.errors(model);
         assert!(errors.worst.as_ref().is_some_and(|(w, _)| *w < 1e-6), "{errors:?}");
-        let urdf = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf"))
-            .unwrap();
+        let urdf =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf")).unwrap();
         match id.rewrite_urdf(&urdf, model, MergedLinks::Refuse) {
             Ok(rewrite) => assert!(!rewrite.updated.is_empty(), "{:?}", rewrite.kept),
             Err(PipelineError::MergedLinks { body, merged }) => assert!(!merged.is_empty(), "{body}"),
@@ -635,7 +653,13 @@ mod tests {
         assert!(matches!(err, PipelineError::Data { .. }));
         let text = err.to_string();
         assert!(text.contains("bad.csv") && text.contains("line 3"), "{text}");
-        let missing = load(&dir.join("nope.csv"), &Recipe::default(), 1, &IdentifyOptions::default()).unwrap_err();
+        let missing = load(
+            &dir.join("nope.csv"),
+            &Recipe::default(),
+            1,
+            &IdentifyOptions::default(),
+        )
+        .unwrap_err();
         assert!(missing.to_string().contains("nope.csv"), "{missing}");
         std::fs::remove_dir_all(&dir).ok();
     }
@@ -681,7 +705,13 @@ mod tests {
             .unwrap();
         let err = identify(&robot, &still, &IdentifyOptions::default()).unwrap_err();
         assert!(
-            matches!(err, PipelineError::Identify { error: IdentifyError::RankZero { .. }, .. }),
+            matches!(
+                err,
+                PipelineError::Identify {
+                    error: IdentifyError::RankZero { .. },
+                    ..
+                }
+            ),
             "{err:?}"
         );
         // Without velocities and accelerations there is no regressor.

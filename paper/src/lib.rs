@@ -13,7 +13,6 @@
 
 use dyngen_identify::mim::{self, MimOptions, Verdict, THETA_NAMES};
 use dyngen_identify::report;
-use std::fmt;
 use dyngen_identify::simulate::{
     moment_sigma, record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording,
 };
@@ -22,6 +21,7 @@ use dyngen_nim::{draw_theta, paper_nim, Nim, NimConfig, PaperNim, PaperNimConfig
 use dyngen_reference::{principal_params_to_standard, SplitMix64};
 use dyngen_reference::{Dynamics, Generated};
 use robot_paper6::Paper6;
+use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -422,15 +422,18 @@ fn paper_faithful_nim(
         let curves = loss_curves(&paper.body_names, paper.histories.iter().map(Some), |h, k| {
             h.train_mse[k]
         });
-        draw(progress, &LineChart {
-            title: "paper-faithful NIM: MSE against training step (cf. the paper's Fig. 5)",
-            x_label: "training step (full-batch gradient descent)",
-            y_label: "MSE (each target over its own size)",
-            log_y: true,
-            curves: &curves,
-            reference: Some(("threshold", config.mse_threshold)),
-            legend: Corner::UpperRight,
-        })
+        draw(
+            progress,
+            &LineChart {
+                title: "paper-faithful NIM: MSE against training step (cf. the paper's Fig. 5)",
+                x_label: "training step (full-batch gradient descent)",
+                y_label: "MSE (each target over its own size)",
+                log_y: true,
+                curves: &curves,
+                reference: Some(("threshold", config.mse_threshold)),
+                legend: Corner::UpperRight,
+            },
+        )
     })?;
     Ok(paper)
 }
@@ -545,15 +548,18 @@ fn generalising_nim(
             training.histories.iter().map(Option::as_ref),
             |h, k| h.validation_mse_original[k].sqrt(),
         );
-        draw(progress, &LineChart {
-            title: "generalising NIM: RMS relative error of one window's θ, on validation draws",
-            x_label: "Adam step (64 windows each)",
-            y_label: "RMS relative error",
-            log_y: true,
-            curves: &curves,
-            reference: None,
-            legend: Corner::UpperRight,
-        })
+        draw(
+            progress,
+            &LineChart {
+                title: "generalising NIM: RMS relative error of one window's θ, on validation draws",
+                x_label: "Adam step (64 windows each)",
+                y_label: "RMS relative error",
+                log_y: true,
+                curves: &curves,
+                reference: None,
+                legend: Corner::UpperRight,
+            },
+        )
     })?;
     Ok(Trained { nim, seconds, config })
 }
@@ -813,15 +819,18 @@ fn payload(
         }
     }
     write_figure(figure, args.force, || {
-        draw(progress, &LineChart {
-            title: "flange mass while a payload is picked up: NIM and recursive least squares",
-            x_label: "t (s)",
-            y_label: "m (kg)",
-            log_y: false,
-            curves: &curves,
-            reference: None,
-            legend: Corner::LowerRight,
-        })
+        draw(
+            progress,
+            &LineChart {
+                title: "flange mass while a payload is picked up: NIM and recursive least squares",
+                x_label: "t (s)",
+                y_label: "m (kg)",
+                log_y: false,
+                curves: &curves,
+                reference: None,
+                legend: Corner::LowerRight,
+            },
+        )
     })
 }
 

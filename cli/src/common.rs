@@ -1,13 +1,14 @@
 //! What every subcommand shares: loading a URDF, the gravity option, progress bars.
 
+use crate::error::CliError;
 use dyngen_model::Model;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Duration;
 
-/// A subcommand's result: the error text is printed after `error: `.
-pub type Result<T> = std::result::Result<T, String>;
+/// A subcommand's result: the error is printed after `error: ` and sets the exit code.
+pub type Result<T> = std::result::Result<T, CliError>;
 
 /// `--gravity gx gy gz`.
 #[derive(Clone, Debug, clap::Args)]
@@ -22,7 +23,9 @@ impl GravityArg {
         match &self.gravity {
             None => Ok(None),
             Some(g) if g.len() == 3 && g.iter().all(|x| x.is_finite()) => Ok(Some([g[0], g[1], g[2]])),
-            Some(g) => Err(format!("--gravity needs three finite numbers, got {g:?}")),
+            Some(g) => Err(CliError::usage(format!(
+                "--gravity needs three finite numbers, got {g:?}"
+            ))),
         }
     }
 }
@@ -30,7 +33,8 @@ impl GravityArg {
 /// Reads, parses and checks the URDF at `path` (all errors as `file:line: message`),
 /// then sets the gravity when given.
 pub fn load_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
-    let mut model = dyngen_model::load_urdf(path).map_err(|e| e.to_string())?;
+    // The model's errors already read `file:line: message`.
+    let mut model = dyngen_model::load_urdf(path).map_err(|e| CliError::Input(e.to_string()))?;
     if let Some(g) = gravity {
         model.gravity = g;
     }
@@ -41,7 +45,7 @@ pub fn load_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
 pub fn load_moving_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
     let model = load_model(path, gravity)?;
     if model.dof() == 0 {
-        return Err(format!("{}: the robot has no moving joints", path.display()));
+        return Err(CliError::input(path, "the robot has no moving joints"));
     }
     Ok(model)
 }
@@ -104,10 +108,7 @@ pub fn with_spinner<T>(progress: &Progress, message: &str, work: impl FnOnce() -
 /// Refuses to replace an existing file unless `force`.
 pub fn check_overwrite(path: &Path, force: bool) -> Result<()> {
     if !force && path.exists() {
-        return Err(format!(
-            "{} already exists; pass --force to overwrite it",
-            path.display()
-        ));
+        return Err(CliError::OutputExists(path.to_path_buf()));
     }
     Ok(())
 }

@@ -1,8 +1,9 @@
 //! `dyngen generate`: what `build.rs` (`dyngen_codegen::Config::compile_urdf`) does,
-//! to a file or stdout.
+//! to a file or stdout, through the same `Config`.
 
 use crate::common::{check_overwrite, load_model, with_spinner, GravityArg, Progress, Result};
-use dyngen_codegen::{analyse_model, generate, is_type_name, Options};
+use crate::error::CliError;
+use dyngen_codegen::Config;
 use std::path::PathBuf;
 
 pub const EXAMPLES: &str = "\
@@ -39,34 +40,33 @@ pub struct GenerateArgs {
 }
 
 pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
-    if !is_type_name(&args.name) {
-        return Err(format!(
-            "`{}` is not a valid Rust type name; use an identifier such as `Ur5`",
-            args.name
-        ));
-    }
     if let Some(out) = &args.output {
         check_overwrite(out, args.force)?;
     }
-    let model = load_model(&args.urdf, args.gravity.get()?)?;
-    let mut options = Options::default();
-    if let Some(n) = args.max_statements {
-        options.max_statements = n.max(1);
+    let model = load_model(&args.urdf, None)?;
+    let mut config = Config::new();
+    if let Some(g) = args.gravity.get()? {
+        config.gravity(g);
     }
-    let generated = with_spinner(progress, &format!("generating `{}`", args.name), || {
-        generate(&model, &args.name, &analyse_model(&model), &options)
-    });
+    if let Some(n) = args.max_statements {
+        config.max_statements(n);
+    }
     let source = args
         .urdf
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    // The same file as `Config::compile_urdf` writes.
-    let content = generated.file(&source);
+    let content = with_spinner(progress, &format!("generating `{}`", args.name), || {
+        config.generate_file(&model, &args.name, &source)
+    })
+    .map_err(|e| match e {
+        dyngen_codegen::Error::TypeName(_) => CliError::usage(e.to_string()),
+        e => CliError::failed(e),
+    })?;
     match &args.output {
         None => print!("{content}"),
         Some(path) => {
-            std::fs::write(path, &content).map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::write(path, &content).map_err(|e| CliError::output(path, e))?;
             eprintln!(
                 "wrote `{}` ({} joints, {} lines) to {}",
                 args.name,

@@ -2,15 +2,13 @@
 //! principal parameters from joint torques, or the principal parameters of every body
 //! by MIM from joint wrenches.
 
-use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
+use crate::error::CliError;
 use dyngen_identify::data::{Recipe, Trajectory};
-use dyngen_identify::mim::{self, MimEstimate, MimOptions};
-use dyngen_identify::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
-use dyngen_identify::simulate::Recording;
-use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate, Options};
-use dyngen_model::names::standard_param_names;
-use dyngen_model::{ErrorKind, Inertial, Model};
-use dyngen_reference::Dynamics;
+use dyngen_identify::pipeline::{self, Estimator, Identification, IdentifyOptions, PipelineError, Prediction};
+use dyngen_identify::report::{self, MergedLinks};
+use dyngen_identify::{Accumulation, Estimate};
+use dyngen_model::Model;
 use dyngen_reference::Reference;
 use std::path::{Path, PathBuf};
 
@@ -85,6 +83,9 @@ pub enum Method {
     Tls,
     /// Ridge regression toward the URDF's nominal parameters (weight --lambda).
     Ridge,
+    /// Physically consistent least squares: every body's mass and principal moments
+    /// positive and satisfying the triangle inequalities.
+    Consistent,
 }
 
 #[derive(Debug, clap::Args)]
@@ -199,7 +200,7 @@ impl RecipeArgs {
     /// The recipe: the file's (or the default), then the flags.
     pub fn recipe(&self) -> Result<Recipe> {
         let mut recipe = match &self.recipe {
-            Some(path) => Recipe::from_file(path).map_err(|e| format!("{}: {e}", path.display()))?,
+            Some(path) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,
             None => Recipe::default(),
         };
         let flags = [
@@ -213,10 +214,12 @@ impl RecipeArgs {
         ];
         for (flag, key, value) in flags {
             if let Some(value) = value {
-                recipe.set(key, value).map_err(|e| format!("{flag}: {e}"))?;
+                recipe
+                    .set(key, value)
+                    .map_err(|e| CliError::usage(format!("{flag}: {e}")))?;
             }
         }
-        recipe.check().map_err(|e| format!("recipe: {e}"))?;
+        recipe.check().map_err(|e| CliError::Input(format!("recipe: {e}")))?;
         Ok(recipe)
     }
 }
@@ -224,58 +227,118 @@ impl RecipeArgs {
 /// Reads a recording through the recipe the flags describe, estimates what it does
 /// not measure, and prints what was done.
 pub fn load_recording(path: &Path, recipe: &RecipeArgs, dof: usize, cutoff: f64) -> Result<Trajectory> {
-    let data_err = |e: dyngen_identify::data::DataError| format!("{}: {e}", path.display());
-    let loaded = recipe.recipe()?.read(path, Some(dof)).map_err(data_err)?;
-    let loaded = loaded.with_derivatives(cutoff).map_err(data_err)?;
+    let options = IdentifyOptions {
+        cutoff_hz: cutoff,
+        ..IdentifyOptions::default()
+    };
+    let loaded = pipeline::load(path, &recipe.recipe()?, dof, &options).map_err(|e| pipeline_error(path, e))?;
     println!("{}: {}", path.display(), loaded.report);
     Ok(loaded.trajectory)
 }
 
-pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
-    if !(args.cutoff.is_finite() && args.cutoff > 0.0) {
-        return Err(format!(
-            "--cutoff must be a positive frequency in Hz, got {}",
-            args.cutoff
-        ));
+/// A pipeline error as a command-line error; `data` names the recording.
+fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
+    match e {
+        PipelineError::InvalidOption { option, reason } => CliError::usage(format!("--{option} {reason}")),
+        PipelineError::Recipe(_) | PipelineError::Data { path: Some(_), .. } => CliError::Input(e.to_string()),
+        PipelineError::Data { path: None, .. } | PipelineError::DofMismatch { .. } => CliError::input(data, e),
+        PipelineError::MissingWrenches { dof } => CliError::Input(format!(
+            "{}: --mode mim needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, mz{dof}, which the file \
+             does not have; identify from the joint torques with --mode standard or principal instead",
+            data.display()
+        )),
+        // A row the estimator refuses is a bad line of the recording.
+        PipelineError::Identify { at: Some(at), error } => {
+            CliError::Input(format!("{}, {at}: {error}", data.display()))
+        }
+        PipelineError::Identify { at: None, error } => CliError::failed(error),
+        PipelineError::MergedLinks { body, merged } => CliError::usage(format!(
+            "--urdf-out: body `{body}` is fully identified, but its inertial includes the links [{}] attached by \
+             fixed joints; pass --lump-merged to write it to `{body}` and remove their <inertial> elements",
+            merged.join(", ")
+        )),
+        PipelineError::Report(e) => CliError::Input(e.to_string()),
     }
+}
+
+impl IdentifyArgs {
+    fn options(&self) -> IdentifyOptions {
+        IdentifyOptions {
+            mode: match self.mode {
+                Mode::Standard => pipeline::Mode::Standard,
+                Mode::Principal => pipeline::Mode::Principal,
+                Mode::Mim => pipeline::Mode::Mim,
+            },
+            estimator: match self.method.unwrap_or(Method::Ols) {
+                Method::Ols => Estimator::Ols,
+                Method::Wls => Estimator::Wls,
+                Method::Tls => Estimator::Tls,
+                Method::Ridge => Estimator::Ridge { lambda: self.lambda },
+                Method::Consistent => Estimator::Consistent,
+            },
+            accumulation: match self.accumulation {
+                AccumulationArg::Qr => Accumulation::Qr,
+                AccumulationArg::NormalEquations => Accumulation::NormalEquations,
+            },
+            cutoff_hz: self.cutoff,
+            model_is_truth: self.truth_from_urdf,
+            ..IdentifyOptions::default()
+        }
+    }
+}
+
+pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if !(args.lambda.is_finite() && args.lambda >= 0.0) {
-        return Err(format!("--lambda must be non-negative, got {}", args.lambda));
+        return Err(CliError::usage(format!(
+            "--lambda must be non-negative, got {}",
+            args.lambda
+        )));
     }
     if args.mode == Mode::Mim && args.method.is_some() {
-        return Err(
-            "--method applies to --mode standard and principal; MIM always uses least squares weighted per body axis"
-                .into(),
-        );
+        return Err(CliError::usage(
+            "--method applies to --mode standard and principal; MIM always uses least squares weighted per body axis",
+        ));
     }
     if args.mode == Mode::Mim && args.accumulation != AccumulationArg::Qr {
-        return Err("--accumulation applies to --mode standard and principal; MIM accumulates by QR".into());
+        return Err(CliError::usage(
+            "--accumulation applies to --mode standard and principal; MIM accumulates by QR",
+        ));
     }
+    let options = args.options();
+    options.check().map_err(|e| pipeline_error(&args.data, e))?;
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
     let n = model.dof();
     let traj = load_recording(&args.data, &args.recipe, n, args.cutoff)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
-        return Err(format!(
-            "{}: --mode mim needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, mz{n}, which the file \
-             does not have; identify from the joint torques with --mode standard or principal instead",
-            args.data.display()
-        ));
+        return Err(pipeline_error(&args.data, PipelineError::MissingWrenches { dof: n }));
     }
     println!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
-    let identified = match args.mode {
-        Mode::Standard | Mode::Principal => from_torques(args, &model, &traj, progress)?,
-        Mode::Mim => by_mim(args, &model, &traj)?,
-    };
+    let robot = Reference::new(&model);
+    let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
+        .map_err(|e| pipeline_error(&args.data, e))?;
+    match (&identified.prediction, &identified.mim) {
+        (_, Some(mim)) => println!("{mim}"),
+        (Prediction::Regressor(torque), None) => {
+            let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
+            println!("{}", torque.estimate.table(&names));
+            print_fit(&torque.estimate);
+            if args.truth_from_urdf {
+                print_errors(&identified, &model);
+            }
+        }
+        (Prediction::Parameters(_), None) => {}
+    }
 
     if let Some(path) = &args.params_json {
         identified
             .report
             .write(path, args.force)
-            .map_err(|e| report_error(path, e))?;
+            .map_err(|e| CliError::report(path, e))?;
         println!("wrote the parameters to {}", path.display());
     }
     if let Some(path) = &args.svg {
-        write_svg(args, path, &model, &traj, &identified, progress)?;
+        write_svg(args, path, &robot, &traj, &identified, progress)?;
     }
     if let Some(path) = &args.urdf_out {
         write_urdf(args, path, &model, &identified)?;
@@ -283,166 +346,14 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// An identification, whatever the mode: the report (names, values, σ, status per
-/// parameter) and how to predict the joint torques.
-struct Identified {
-    report: ParameterReport,
-    /// Standard (10 per body) or θ (4 per body).
-    per_body: usize,
-    prediction: Prediction,
-}
-
-enum Prediction {
-    /// Rows of this regressor times the estimate's solution.
-    Regressor { estimate: Box<Estimate>, principal: bool },
-    /// Inverse dynamics with these standard parameters.
-    Parameters(Vec<f64>),
-}
-
-impl Identified {
-    fn truth(&self, model: &Model) -> Vec<f64> {
-        if self.per_body == 10 {
-            model.standard_params()
-        } else {
-            dyngen_model::principal_params(model)
-        }
-    }
-}
-
-/// Standard or principal parameters from the joint torques, through the stacked
-/// regressor.
-fn from_torques(args: &IdentifyArgs, model: &Model, traj: &Trajectory, progress: &Progress) -> Result<Identified> {
-    let principal = args.mode == Mode::Principal;
-    let robot = Reference::new(model);
-    let n = model.dof();
-    let p = if principal { 4 * n } else { 10 * n };
-    let accumulation = match args.accumulation {
-        AccumulationArg::Qr => Accumulation::Qr,
-        AccumulationArg::NormalEquations => Accumulation::NormalEquations,
-    };
-    let mut acc =
-        Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation).map_err(|e| e.to_string())?;
-    let mut y = vec![0.0; n * p];
-    let bar = progress.bar(traj.len() as u64, "stacking regressors");
-    for k in 0..traj.len() {
-        let (q, v, a) = joint_state(args, traj, k)?;
-        regressor(&robot, principal, q, v, a, &mut y);
-        for j in 0..n {
-            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
-                .map_err(|e| format!("{}, {}: {e}", args.data.display(), traj.location(k)))?;
-        }
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-
-    let opts = Options::default();
-    let estimate = match args.method.unwrap_or(Method::Ols) {
-        Method::Ols => acc.ols(&opts),
-        Method::Wls => acc.wls(&opts),
-        Method::Tls => acc.tls(&opts),
-        Method::Ridge => {
-            let prior = if principal {
-                dyngen_model::principal_params(model)
-            } else {
-                model.standard_params()
-            };
-            acc.ridge(&prior, args.lambda, &opts)
-        }
-    }
-    .map_err(|e| e.to_string())?;
-
-    let names = if principal {
-        dyngen_model::names::principal_param_names(n)
-    } else {
-        standard_param_names(n)
-    };
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    println!("{}", estimate.table(&names));
-    print_fit(&estimate);
-    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    let parameterisation = if principal {
-        Parameterisation::Principal
-    } else {
-        Parameterisation::Standard
-    };
-    let report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &names, &joint_names);
-    let identified = Identified {
-        report,
-        per_body: if principal { 4 } else { 10 },
-        prediction: Prediction::Regressor {
-            estimate: Box::new(estimate),
-            principal,
-        },
-    };
-    if args.truth_from_urdf {
-        print_errors(&identified, model);
-    }
-    Ok(identified)
-}
-
-/// The paper's MIM on measured joint wrenches: every body's θ from its resultant,
-/// the whole robot as one block-diagonal least-squares problem.
-fn by_mim(args: &IdentifyArgs, model: &Model, traj: &Trajectory) -> Result<Identified> {
-    let robot = Reference::new(model);
-    let recording = Recording::from_measurements(&robot, traj).map_err(|e| format!("{}: {e}", args.data.display()))?;
-    let truth = args.truth_from_urdf.then(|| dyngen_model::principal_params(model));
-    let estimate: MimEstimate =
-        mim::whole_robot(&recording, 0..recording.len(), truth.as_deref(), &MimOptions::default())
-            .map_err(|e| format!("{}: {e}", args.data.display()))?;
-    println!("{estimate}");
-    // The torques of the identified model: θ where identified, the URDF's elsewhere.
-    let nominal = dyngen_model::principal_params(model);
-    let theta: Vec<f64> = estimate
-        .theta()
-        .iter()
-        .zip(&nominal)
-        .map(|(x, t)| x.unwrap_or(*t))
-        .collect();
-    Ok(Identified {
-        report: ParameterReport::from_mim(&model.name, &estimate),
-        per_body: 4,
-        prediction: Prediction::Parameters(dyngen_reference::principal_params_to_standard(model, &theta)),
-    })
-}
-
-/// `(q, v, a)` of sample `k` (v and a exist once the derivatives are estimated).
-fn joint_state<'a>(args: &IdentifyArgs, traj: &'a Trajectory, k: usize) -> Result<(&'a [f64], &'a [f64], &'a [f64])> {
-    match (traj.v(k), traj.a(k)) {
-        (Some(v), Some(a)) => Ok((traj.q(k), v, a)),
-        _ => Err(format!(
-            "{}: sample {k} has no velocities or accelerations",
-            args.data.display()
-        )),
-    }
-}
-
-/// The joint torque regressor, standard (`n × 10n`) or principal (`n × 4n`).
-fn regressor(robot: &Reference, principal: bool, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
-    if principal {
-        Dynamics::principal_regressor(robot, q, v, a, y);
-    } else {
-        Dynamics::joint_torque_regressor(robot, q, v, a, y);
-    }
-}
-
 /// Each identified parameter against the URDF's value (torque modes; MIM prints its
 /// own error table).
-fn print_errors(identified: &Identified, model: &Model) {
-    let truth = identified.truth(model);
-    let mut worst: Option<(f64, &str)> = None;
-    let mut count = 0;
-    for (p, t) in identified.report.parameters.iter().zip(&truth) {
-        if let (Some(v), true) = (p.value, t.abs() > 1e-12) {
-            let rel = dyngen_identify::relative_error(v, *t);
-            count += 1;
-            if worst.is_none_or(|(w, _)| rel > w) {
-                worst = Some((rel, &p.name));
-            }
-        }
-    }
-    match worst {
+fn print_errors(identified: &Identification, model: &Model) {
+    let errors = identified.errors(model);
+    match errors.worst {
         Some((w, name)) => println!(
-            "against the URDF: {count} identified parameters with a nonzero true value, largest relative error {w:.3e} ({name})"
+            "against the URDF: {} identified parameters with a nonzero true value, largest relative error {w:.3e} ({name})",
+            errors.compared
         ),
         None => println!("against the URDF: no identified parameter with a nonzero true value"),
     }
@@ -461,25 +372,17 @@ fn check_outputs(args: &IdentifyArgs) -> Result<()> {
     .collect();
     for (i, (flag, path)) in outputs.iter().enumerate() {
         if let Some((other, _)) = outputs[..i].iter().find(|(_, p)| p == path) {
-            return Err(format!(
+            return Err(CliError::usage(format!(
                 "{other} and {flag} both name {}; give each output its own file",
                 path.display()
-            ));
+            )));
         }
         check_overwrite(path, args.force)?;
     }
     if args.lump_merged && args.urdf_out.is_none() {
-        return Err("--lump-merged only applies with --urdf-out".into());
+        return Err(CliError::usage("--lump-merged only applies with --urdf-out"));
     }
     Ok(())
-}
-
-/// A report error as CLI text (`--force`, not the library's `overwrite`).
-fn report_error(path: &Path, e: ReportError) -> String {
-    match e {
-        ReportError::Exists { .. } => format!("{} already exists; pass --force to overwrite it", path.display()),
-        e => format!("{}: {e}", path.display()),
-    }
 }
 
 /// Measured against predicted torques (regressor rows times the estimate's
@@ -489,59 +392,24 @@ fn report_error(path: &Path, e: ReportError) -> String {
 fn write_svg(
     args: &IdentifyArgs,
     path: &Path,
-    model: &Model,
+    robot: &Reference,
     traj: &Trajectory,
-    identified: &Identified,
+    identified: &Identification,
     progress: &Progress,
 ) -> Result<()> {
-    let robot = Reference::new(model);
-    let n = model.dof();
-    let mut y = Vec::new();
-    let mut measured = Vec::with_capacity(traj.len());
-    let mut predicted = Vec::with_capacity(traj.len());
-    let bar = progress.bar(traj.len() as u64, "predicting torques");
-    for k in 0..traj.len() {
-        let (q, v, a) = joint_state(args, traj, k)?;
-        predicted.push(match &identified.prediction {
-            Prediction::Regressor { estimate, principal } => {
-                let p = estimate.n_params();
-                y.resize(n * p, 0.0);
-                regressor(&robot, *principal, q, v, a, &mut y);
-                (0..n).map(|j| estimate.predict(&y[j * p..(j + 1) * p])).collect()
-            }
-            Prediction::Parameters(params) => robot.rnea(q, v, a, params),
-        });
-        measured.push(traj.tau(k).to_vec());
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-
+    let model = dyngen_reference::Dynamics::model(robot);
+    let predicted = with_spinner(progress, "predicting torques", || identified.predict(robot, traj))
+        .map_err(|e| pipeline_error(&args.data, e))?;
+    let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
     let errors = args.truth_from_urdf.then(|| {
-        let truth = identified.truth(model);
-        let mut zero_truth = Vec::new();
-        let errors: Vec<(String, Option<f64>)> = identified
-            .report
-            .parameters
-            .iter()
-            .zip(&truth)
-            .filter_map(|(p, &x)| match p.value {
-                None => Some((p.name.clone(), None)),
-                // A relative error needs a nonzero true value.
-                Some(_) if x.abs() < 1e-12 => {
-                    zero_truth.push(p.name.as_str());
-                    None
-                }
-                Some(v) => Some((p.name.clone(), Some((v - x) / x))),
-            })
-            .filter(|(_, e)| e.is_none_or(f64::is_finite))
-            .collect();
-        if !zero_truth.is_empty() {
+        let errors = identified.errors(model);
+        if !errors.zero_truth.is_empty() {
             println!(
                 "note: parameter errors leave out {} (identified, but zero in the URDF, so no relative error)",
-                zero_truth.join(", ")
+                errors.zero_truth.join(", ")
             );
         }
-        errors
+        errors.relative
     });
     let title = format!(
         "{}: {} on {}",
@@ -553,96 +421,45 @@ fn write_svg(
     );
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let svg = crate::svg::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
-        .map_err(|e| report_error(path, e))?;
-    report::write_report(path, &svg, args.force).map_err(|e| report_error(path, e))?;
+        .map_err(|e| CliError::report(path, e))?;
+    report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
     println!("wrote the SVG report to {}", path.display());
     Ok(())
 }
 
-/// Why a body's inertial is not written, or its identified inertial: all of the
-/// body's parameters (10 standard, or θ with the URDF's centre of mass and principal
-/// axes) identified, and the result physically valid.
-fn identified_inertial(identified: &Identified, model: &Model, body: usize) -> std::result::Result<Inertial, String> {
-    let k = identified.per_body;
-    let params = &identified.report.parameters[k * body..k * (body + 1)];
-    let missing = params.iter().filter(|p| p.status != ParamStatus::Identified).count();
-    if missing > 0 {
-        return Err(format!("{missing} of its {k} parameters not identified"));
-    }
-    let values: Vec<f64> = params
-        .iter()
-        .map(|p| p.value.ok_or("a parameter has no value"))
-        .collect::<std::result::Result<_, _>>()?;
-    let mut x = [0.0; 10];
-    if k == 10 {
-        x.copy_from_slice(&values);
-    } else {
-        // θ of this body, the URDF's θ elsewhere (only this body's 10 are used).
-        let mut theta = dyngen_model::principal_params(model);
-        theta[4 * body..4 * body + 4].copy_from_slice(&values);
-        let standard = dyngen_reference::principal_params_to_standard(model, &theta);
-        x.copy_from_slice(&standard[10 * body..10 * body + 10]);
-    }
-    let inertial = Inertial::from_standard_params(&x).ok_or("identified mass is not positive")?;
-    dyngen_model::desc::check_inertial(&inertial).map_err(|e| match e {
-        ErrorKind::NonPositiveMass(m) => format!("identified mass {m} is not positive"),
-        ErrorKind::NotPositiveDefinite(ev) => {
-            format!("identified inertia about the centre of mass is not positive definite (moments {ev:?})")
-        }
-        ErrorKind::TriangleInequality(ev) => {
-            format!("identified principal moments {ev:?} violate the triangle inequality")
-        }
-        e => format!("identified inertial is not physical ({e:?})"),
-    })?;
-    Ok(inertial)
-}
-
 /// The input URDF with the inertials of the fully identified, physically valid
 /// bodies replaced; every other byte is kept.
-fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Identified) -> Result<()> {
-    let text = std::fs::read_to_string(&args.urdf).map_err(|e| format!("{}: {e}", args.urdf.display()))?;
-    let mut updates: Vec<(&str, Inertial)> = Vec::new();
-    let mut kept: Vec<String> = Vec::new();
-    for (i, body) in model.bodies.iter().enumerate() {
-        match identified_inertial(identified, model, i) {
-            Ok(inertial) => {
-                if !body.merged.is_empty() && !args.lump_merged {
-                    return Err(format!(
-                        "--urdf-out: body `{}` is fully identified, but its inertial includes the links [{}] \
-                         attached by fixed joints; pass --lump-merged to write it to `{}` and remove their \
-                         <inertial> elements",
-                        body.name,
-                        body.merged.join(", "),
-                        body.name
-                    ));
-                }
-                updates.push((&body.name, inertial));
-            }
-            Err(why) => kept.push(format!("{} ({why})", body.name)),
-        }
-    }
+fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Identification) -> Result<()> {
+    let text = std::fs::read_to_string(&args.urdf).map_err(|e| CliError::input(&args.urdf, e))?;
     let merged = if args.lump_merged {
         MergedLinks::Lump
     } else {
         MergedLinks::Refuse
     };
-    let out = report::rewrite_urdf_inertials_with(&text, &updates, merged)
-        .map_err(|e| format!("{}: {e}", args.urdf.display()))?;
-    report::write_new(path, &out, args.force).map_err(|e| report_error(path, e))?;
-    if updates.is_empty() {
+    let rewrite = identified.rewrite_urdf(&text, model, merged).map_err(|e| match e {
+        PipelineError::Report(e) => CliError::input(&args.urdf, e),
+        e => pipeline_error(&args.data, e),
+    })?;
+    report::write_new(path, &rewrite.text, args.force).map_err(|e| CliError::report(path, e))?;
+    if rewrite.updated.is_empty() {
         println!(
             "wrote {} unchanged: no body has all its parameters identified, so every inertial is the URDF's",
             path.display()
         );
     } else {
-        let names: Vec<&str> = updates.iter().map(|(n, _)| *n).collect();
+        let names: Vec<&str> = rewrite.updated.iter().map(|(n, _)| n.as_str()).collect();
         println!(
             "wrote {} with the identified inertials of {}",
             path.display(),
             names.join(", ")
         );
     }
-    if !kept.is_empty() {
+    if !rewrite.kept.is_empty() {
+        let kept: Vec<String> = rewrite
+            .kept
+            .iter()
+            .map(|(body, why)| format!("{body} ({why})"))
+            .collect();
         println!(
             "note: kept the URDF inertials of {} of {} bodies: {}",
             kept.len(),

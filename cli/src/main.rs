@@ -2,11 +2,21 @@
 //! run time, through the reference implementation (`dyngen_reference::Reference`, behind the
 //! `dyngen_reference::Dynamics` trait).
 //!
-//! Errors are printed as `error: …` on stderr with exit code 1; bad input never
-//! panics.
+//! Errors are printed as `error: …` on stderr; bad input never panics. The exit code
+//! says what kind of failure it was:
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success (also `--help`, `--version`) |
+//! | 1 | the computation failed (identification, training, an internal error) |
+//! | 2 | usage: unknown flag, missing argument, invalid or conflicting option values |
+//! | 3 | bad input: a URDF, recording, recipe or weights file that cannot be read or is invalid |
+//! | 4 | an output file exists (pass `--force` to replace it) |
+//! | 5 | an output file could not be written |
 
 mod common;
 mod demo;
+mod error;
 mod generate;
 mod identify;
 mod info;
@@ -26,12 +36,13 @@ Examples:
   dyngen nim train robots/ur5/ur5.urdf ur5.csv -o ur5-nim.json
   dyngen demo
 
-Run `dyngen <command> --help` for the options of one command.";
+Run `dyngen <command> --help` for the options of one command.
+";
 
 /// Robot dynamics from a URDF: inspect it, generate specialised Rust for it, simulate
 /// identification experiments, identify its inertial parameters.
 #[derive(Debug, Parser)]
-#[command(name = "dyngen", version, after_help = EXAMPLES)]
+#[command(name = "dyngen", version, after_help = format!("{EXAMPLES}\n{}", error::EXIT_CODES))]
 pub struct Cli {
     /// No progress bars (they are also hidden when stdout is not a terminal).
     #[arg(short, long, global = true)]
@@ -77,8 +88,8 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
-            // `--help` and `--version` are not errors.
-            let code = if e.use_stderr() { 1 } else { 0 };
+            // `--help` and `--version` are not errors; usage errors exit with 2.
+            let code = if e.use_stderr() { 2 } else { 0 };
             let _ = e.print();
             return ExitCode::from(code);
         }
@@ -96,13 +107,13 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            e.into()
         }
     }
 }
 
 /// A last resort: a panic is a bug of dyngen, never of the input, but it should
-/// still read like the other errors and exit with 1.
+/// still read like the other errors and exit with 1 (the computation failed).
 fn install_panic_hook() {
     std::panic::set_hook(Box::new(|info| {
         let message = info

@@ -3,6 +3,7 @@
 //! the principal parameters from measured data.
 
 use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use crate::error::CliError;
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::mim;
@@ -139,10 +140,20 @@ fn read_data(path: &Path, model: &Model, cutoff: f64, recipe: Option<&Path>) -> 
     crate::identify::load_recording(path, &recipe, model.dof(), cutoff)
 }
 
-fn nim_error(path: &Path, e: NimError) -> String {
+/// A NIM error about the file `path`: reading it is input, writing it output.
+fn nim_file_error(path: &Path, e: NimError, writing: bool) -> CliError {
     match e {
-        NimError::AlreadyExists { .. } => format!("{} already exists; pass --force to overwrite it", path.display()),
-        e => format!("{}: {e}", path.display()),
+        NimError::AlreadyExists { .. } => CliError::OutputExists(path.to_path_buf()),
+        e if writing => CliError::output(path, e),
+        e => CliError::input(path, e),
+    }
+}
+
+/// A training or identification error: options out of range are usage errors.
+fn nim_error(path: &Path, e: NimError) -> CliError {
+    match e {
+        NimError::InvalidOption { .. } => CliError::usage(format!("{}: {e}", path.display())),
+        e => CliError::failed(format!("{}: {e}", path.display())),
     }
 }
 
@@ -150,13 +161,16 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
     check_overwrite(&args.output, args.force)?;
     if let Some(svg) = &args.loss_svg {
         if svg == &args.output {
-            return Err("--output and --loss-svg name the same file; give each its own".into());
+            return Err(CliError::usage(
+                "--output and --loss-svg name the same file; give each its own",
+            ));
         }
         check_overwrite(svg, args.force)?;
     }
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
     let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
-    let motion = SampledMotion::from_data(&traj).ok_or("the motion has no velocities or accelerations")?;
+    let motion = SampledMotion::from_data(&traj)
+        .ok_or_else(|| CliError::input(&args.motion, "the motion has no velocities or accelerations"))?;
     let robot = Reference::new(&model);
     let nominal = dyngen_model::principal_params(&model);
     let recording = record_trajectory(&robot, &model.standard_params(), &motion, motion.times());
@@ -192,7 +206,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
     let bar = progress.bar(model.dof() as u64, "training bodies");
     let start = Instant::now();
     let (nim, training) = Nim::train(&model.name, &recording, &nominal, &config, &|_| bar.inc(1))
-        .map_err(|e| format!("{}: {e}", args.motion.display()))?;
+        .map_err(|e| nim_error(&args.motion, e))?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     for (i, (body, history)) in nim.bodies.iter().zip(&training.histories).enumerate() {
@@ -218,7 +232,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
     }
     println!("trained in {seconds:.1} s");
     nim.save(&args.output, args.force)
-        .map_err(|e| nim_error(&args.output, e))?;
+        .map_err(|e| nim_file_error(&args.output, e, true))?;
     println!("wrote the identifier to {}", args.output.display());
     if let Some(svg) = &args.loss_svg {
         // The targets are ln θ: the RMS error of a window's prediction is a relative
@@ -248,8 +262,8 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
             reference: None,
             legend: crate::svg::Corner::UpperRight,
         })
-        .map_err(|e| format!("{}: {e}", svg.display()))?;
-        report::write_new(svg, &text, args.force).map_err(|e| format!("{}: {e}", svg.display()))?;
+        .map_err(|e| CliError::report(svg, e))?;
+        report::write_new(svg, &text, args.force).map_err(|e| CliError::report(svg, e))?;
         println!("wrote the training curves to {}", svg.display());
     }
     if args.test_draws > 0 {
@@ -280,7 +294,7 @@ fn test_on_unseen_draws(
         );
         let estimate = nim
             .identify(&recording, (nim.window / 2).max(1))
-            .map_err(|e| e.to_string())?
+            .map_err(CliError::failed)?
             .with_truth(&theta);
         let (m, j) = estimate.max_relative_errors().unwrap_or((f64::NAN, f64::NAN));
         mass = mass.max(m);
@@ -301,10 +315,10 @@ fn predict(args: &PredictArgs) -> Result<()> {
         check_overwrite(path, args.force)?;
     }
     let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
-    let nim = Nim::load(&args.nim).map_err(|e| nim_error(&args.nim, e))?;
+    let nim = Nim::load(&args.nim).map_err(|e| nim_file_error(&args.nim, e, false))?;
     let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     if nim.body_names != body_names {
-        return Err(format!(
+        return Err(CliError::Input(format!(
             "{} was trained for {} with bodies [{}], but {} has bodies [{}]; train an identifier for this robot \
              with `dyngen nim train`",
             args.nim.display(),
@@ -312,19 +326,19 @@ fn predict(args: &PredictArgs) -> Result<()> {
             nim.body_names.join(", "),
             args.urdf.display(),
             body_names.join(", ")
-        ));
+        )));
     }
     let traj = read_data(&args.data, &model, args.cutoff, args.recipe.as_deref())?;
     if traj.joint_wrenches().is_none() {
-        return Err(format!(
+        return Err(CliError::Input(format!(
             "{}: NIM reads each body's resultant from the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, \
              mz{}, which the file does not have",
             args.data.display(),
             model.dof()
-        ));
+        )));
     }
     let robot = Reference::new(&model);
-    let recording = Recording::from_measurements(&robot, &traj).map_err(|e| format!("{}: {e}", args.data.display()))?;
+    let recording = Recording::from_measurements(&robot, &traj).map_err(|e| CliError::input(&args.data, e))?;
     let unfamiliar = nim.unfamiliar_fraction(&recording);
     if unfamiliar > 0.01 {
         eprintln!(
@@ -335,9 +349,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
         );
     }
     let stride = args.stride.unwrap_or((nim.window / 2).max(1));
-    let estimate = nim
-        .identify(&recording, stride)
-        .map_err(|e| format!("{}: {e}", args.data.display()))?;
+    let estimate = nim.identify(&recording, stride).map_err(|e| nim_error(&args.data, e))?;
     let estimate = if args.truth_from_urdf {
         estimate.with_truth(&dyngen_model::principal_params(&model))
     } else {
@@ -354,7 +366,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
         estimate
             .report(&model.name)
             .write(path, args.force)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+            .map_err(|e| CliError::report(path, e))?;
         println!("wrote the parameters to {}", path.display());
     }
     Ok(())

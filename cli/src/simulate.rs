@@ -1,7 +1,8 @@
 //! `dyngen simulate`: an identification experiment on the nominal parameters, as CSV.
 
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
-use dyngen_identify::data::{overwrite_csv, write_csv};
+use crate::error::CliError;
+use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
 use dyngen_reference::Reference;
 use std::path::PathBuf;
@@ -100,27 +101,29 @@ pub struct SimulateArgs {
 fn check_args(args: &SimulateArgs) -> Result<()> {
     if let Some(d) = args.duration {
         if !(d.is_finite() && d > 0.0) {
-            return Err(format!("--duration must be a positive number of seconds, got {d}"));
+            return Err(CliError::usage(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            )));
         }
     }
     if args.steps < 1 {
-        return Err("--steps must be at least 1".into());
+        return Err(CliError::usage("--steps must be at least 1"));
     }
     if !(args.noise.is_finite() && args.noise >= 0.0) {
-        return Err(format!(
+        return Err(CliError::usage(format!(
             "--noise must be a non-negative fraction (0.01 = 1 %), got {}",
             args.noise
-        ));
+        )));
     }
     if args.experiment == ExperimentKind::Fourier {
         if args.harmonics < 1 {
-            return Err("--harmonics must be at least 1".into());
+            return Err(CliError::usage("--harmonics must be at least 1"));
         }
         if !(args.base_frequency.is_finite() && args.base_frequency > 0.0) {
-            return Err(format!(
+            return Err(CliError::usage(format!(
                 "--base-frequency must be positive, got {}",
                 args.base_frequency
-            ));
+            )));
         }
     }
     Ok(())
@@ -186,13 +189,16 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     } else {
         clean
     };
-    let traj = recording.to_trajectory().map_err(|e| e.to_string())?;
+    let traj = recording.to_trajectory().map_err(CliError::failed)?;
     if args.force {
         overwrite_csv(&args.output, &traj)
     } else {
         write_csv(&args.output, &traj)
     }
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| match e {
+        DataError::FileExists { path } => CliError::OutputExists(path),
+        e => CliError::Output(e.to_string()),
+    })?;
     eprintln!(
         "wrote {} samples of {} joints ({} s, noise {}) to {}",
         traj.len(),

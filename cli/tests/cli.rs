@@ -177,9 +177,9 @@ fn bad_inputs_name_the_file_and_line() {
     // The ur5 needs six joints.
     assert_error(&run!("identify", ur5(), csv), "bad.csv");
 
-    // Usage errors exit with 1 too.
+    // Usage errors exit with 2, as clap's own.
     let o = run!("simulate", ur5());
-    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).starts_with("error: "), "{}", stderr(&o));
     assert_error(
         &run!("simulate", ur5(), "-o", dir.join("y.csv"), "--duration", "-1"),

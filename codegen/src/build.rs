@@ -2,7 +2,7 @@
 //! content changed, and tell Cargo what to watch. Errors print as `file:line: message`.
 
 use crate::generate::{self, Options};
-use dyngen_model::ModelErrors;
+use dyngen_model::{Model, ModelErrors};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -99,12 +99,12 @@ impl Config {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
         }
-        let mut model = dyngen_model::load_urdf(&urdf).map_err(Error::Model)?;
-        if let Some(g) = self.gravity {
-            model.gravity = g;
-        }
-        let bases = crate::base::analyse_model(&model);
-        let generated = generate::generate(&model, type_name, &bases, &self.options);
+        let model = dyngen_model::load_urdf(&urdf).map_err(Error::Model)?;
+        let source = urdf
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let content = self.generate_file(&model, type_name, &source)?;
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
             None => std::env::var_os("OUT_DIR").map(PathBuf::from).ok_or(Error::NoOutDir)?,
@@ -114,12 +114,23 @@ impl Config {
             None => format!("{}.rs", urdf.file_stem().and_then(|s| s.to_str()).unwrap_or(type_name)),
         };
         let path = out_dir.join(file_name);
-        let source = urdf
-            .file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        write_if_changed(&path, &generated.file(&source))?;
+        write_if_changed(&path, &content)?;
         Ok(path)
+    }
+
+    /// The file [`Config::compile_urdf`] writes, for a model already loaded (`source`
+    /// names it in the header), with this configuration's gravity and options; for
+    /// tools that write elsewhere than `OUT_DIR`, such as the `dyngen` command.
+    pub fn generate_file(&self, model: &Model, type_name: &str, source: &str) -> Result<String, Error> {
+        if !generate::is_type_name(type_name) {
+            return Err(Error::TypeName(type_name.to_string()));
+        }
+        let mut model = model.clone();
+        if let Some(g) = self.gravity {
+            model.gravity = g;
+        }
+        let bases = crate::base::analyse_model(&model);
+        Ok(generate::generate(&model, type_name, &bases, &self.options).file(source))
     }
 }
 

@@ -50,11 +50,16 @@ pub fn assert_ok(o: &Output) {
     );
 }
 
-/// Exit code 1, one `error: ` message containing `needle`, no panic.
+/// A failure (exit codes 1–5), one `error: ` message containing `needle`, no panic.
 #[track_caller]
 pub fn assert_error(o: &Output, needle: &str) {
     let err = stderr(o);
-    assert_eq!(o.status.code(), Some(1), "stdout:\n{}\nstderr:\n{err}", stdout(o));
+    assert!(
+        matches!(o.status.code(), Some(1..=5)),
+        "{:?}\nstdout:\n{}\nstderr:\n{err}",
+        o.status,
+        stdout(o)
+    );
     assert!(err.starts_with("error: "), "{err}");
     assert!(err.contains(needle), "expected `{needle}` in:\n{err}");
     assert!(!err.contains("panicked") && !err.contains("internal error"), "{err}");
@@ -90,4 +95,11 @@ pub fn without_wrenches(csv: &Path, dir: &Path) -> PathBuf {
     let path = dir.join("bare.csv");
     std::fs::write(&path, bare).unwrap();
     path
+}
+
+/// Exit code `code` and an error message containing `needle`.
+#[track_caller]
+pub fn assert_exit(o: &Output, code: i32, needle: &str) {
+    assert_error(o, needle);
+    assert_eq!(o.status.code(), Some(code), "{}", stderr(o));
 }

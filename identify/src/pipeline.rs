@@ -1,0 +1,722 @@
+//! Identification from a recording, end to end: read a log through a
+//! [`Recipe`], estimate the derivatives it does not measure, stack the regressor
+//! rows of any [`Dynamics`] (the reference on a URDF, or a generated robot), estimate,
+//! predict the torques, and produce the report: the JSON [`ParameterReport`] and the
+//! identified inertials for a URDF rewrite.
+//!
+//! Plain structs in and out, one error enum, no printing: `dyngen identify` is a
+//! front end of this module, and any other front end calls the same functions.
+//!
+//! ```no_run
+//! use dyngen_identify::data::Recipe;
+//! use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, Mode};
+//! let model = dyngen_model::load_urdf("ur5.urdf").unwrap();
+//! let robot = dyngen_reference::Reference::new(&model);
+//! let options = IdentifyOptions {
+//!     mode: Mode::Standard,
+//!     estimator: Estimator::Wls,
+//!     ..IdentifyOptions::default()
+//! };
+//! let loaded = pipeline::load(std::path::Path::new("ur5.csv"), &Recipe::default(), model.dof(), &options).unwrap();
+//! let identified = pipeline::identify(&robot, &loaded.trajectory, &options).unwrap();
+//! println!("{}", identified.report.to_json().unwrap());
+//! ```
+
+use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
+use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
+use crate::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
+use crate::simulate::Recording;
+use crate::{Accumulation, Accumulator, Channels, IdentifyError, Options, PrincipalOptions, StandardOptions};
+use dyngen_model::{ErrorKind, Inertial, Model};
+use dyngen_reference::{principal_params_to_standard, Dynamics, Reference};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// What is identified, from what.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Mode {
+    /// The 10 standard parameters per body from the joint torques.
+    #[default]
+    Standard,
+    /// `θ = (m, J1, J2, J3)` per body from the joint torques (principal regressor;
+    /// centres of mass and principal axes from the model).
+    Principal,
+    /// `θ` per body from the joint wrenches, body by body (the paper's MIM).
+    Mim,
+}
+
+/// The estimator of [`Mode::Standard`] and [`Mode::Principal`]. MIM always uses
+/// least squares weighted per body axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Estimator {
+    /// Ordinary least squares.
+    #[default]
+    Ols,
+    /// Gautier's weighted least squares, one noise variance per joint.
+    Wls,
+    /// Total least squares (noise on the regressor too).
+    Tls,
+    /// Ridge regression toward the model's own parameters with this weight (≥ 0).
+    Ridge { lambda: f64 },
+    /// Physically consistent least squares: principal form with `m > 0`, `J > 0`
+    /// and the triangle inequalities, or standard form with a positive-definite
+    /// pseudo-inertia per body.
+    Consistent,
+}
+
+/// Everything [`load`] and [`identify`] need besides the data and the robot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IdentifyOptions {
+    pub mode: Mode,
+    pub estimator: Estimator,
+    /// How the torque rows are compressed (MIM accumulates by QR).
+    pub accumulation: Accumulation,
+    /// Low-pass cutoff (Hz) for velocities and accelerations estimated from
+    /// positions; only used when the log does not measure them.
+    pub cutoff_hz: f64,
+    /// Rank and identifiability tolerances of the estimators.
+    pub tolerances: Options,
+    /// Take the model's own inertials as the truth: MIM then reports each
+    /// parameter's error in its estimate.
+    pub model_is_truth: bool,
+}
+
+impl Default for IdentifyOptions {
+    fn default() -> Self {
+        IdentifyOptions {
+            mode: Mode::Standard,
+            estimator: Estimator::Ols,
+            accumulation: Accumulation::Qr,
+            cutoff_hz: 10.0,
+            tolerances: Options::default(),
+            model_is_truth: false,
+        }
+    }
+}
+
+impl IdentifyOptions {
+    /// Refuses options that cannot work, before any data is read.
+    pub fn check(&self) -> Result<(), PipelineError> {
+        let invalid = |option, reason: String| Err(PipelineError::InvalidOption { option, reason });
+        if !(self.cutoff_hz.is_finite() && self.cutoff_hz > 0.0) {
+            return invalid(
+                "cutoff",
+                format!("must be a positive frequency in Hz, got {}", self.cutoff_hz),
+            );
+        }
+        if let Estimator::Ridge { lambda } = self.estimator {
+            if !(lambda.is_finite() && lambda >= 0.0) {
+                return invalid("lambda", format!("must be non-negative, got {lambda}"));
+            }
+        }
+        if self.mode == Mode::Mim && self.estimator != Estimator::Ols {
+            return invalid(
+                "method",
+                "applies to the standard and principal modes; MIM always uses least squares weighted per body axis"
+                    .into(),
+            );
+        }
+        if self.mode == Mode::Mim && self.accumulation != Accumulation::Qr {
+            return invalid(
+                "accumulation",
+                "applies to the standard and principal modes; MIM accumulates by QR".into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Why the pipeline stopped. Every variant names the option, file, line or body.
+#[derive(Debug)]
+pub enum PipelineError {
+    /// An option outside its domain or not valid in this mode.
+    InvalidOption { option: &'static str, reason: String },
+    /// The recipe's settings contradict each other.
+    Recipe(RecipeError),
+    /// The recording could not be read, or its derivatives not estimated.
+    Data { path: Option<PathBuf>, error: DataError },
+    /// The recording has a different number of joints than the robot.
+    DofMismatch { expected: usize, found: usize },
+    /// MIM needs the joint wrench columns, which the recording does not have.
+    MissingWrenches { dof: usize },
+    /// The estimator failed (`at`: the sample whose rows it refused).
+    Identify { at: Option<Location>, error: IdentifyError },
+    /// A fully identified body lumps links attached by fixed joints, and writing its
+    /// inertial was not allowed to move theirs ([`MergedLinks::Refuse`]).
+    MergedLinks { body: String, merged: Vec<String> },
+    /// The URDF could not be edited.
+    Report(ReportError),
+}
+
+impl fmt::Display for PipelineError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidOption { option, reason } => write!(f, "{option} {reason}"),
+            Self::Recipe(e) => write!(f, "recipe: {e}"),
+            Self::Data {
+                path: Some(path),
+                error,
+            } => write!(f, "{}: {error}", path.display()),
+            Self::Data { path: None, error } => write!(f, "{error}"),
+            Self::DofMismatch { expected, found } => {
+                write!(f, "the recording has {found} joints, the robot {expected}")
+            }
+            Self::MissingWrenches { dof } => write!(
+                f,
+                "MIM needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, …, mz{dof}, which the recording \
+                 does not have; identify from the joint torques (standard or principal mode) instead"
+            ),
+            Self::Identify { at: Some(at), error } => write!(f, "{at}: {error}"),
+            Self::Identify { at: None, error } => write!(f, "{error}"),
+            Self::MergedLinks { body, merged } => write!(
+                f,
+                "body `{body}` is fully identified, but its inertial includes the links [{}] attached by fixed \
+                 joints; lump it into `{body}` (removing their <inertial> elements) to write it",
+                merged.join(", ")
+            ),
+            Self::Report(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for PipelineError {}
+
+impl From<IdentifyError> for PipelineError {
+    fn from(error: IdentifyError) -> Self {
+        PipelineError::Identify { at: None, error }
+    }
+}
+
+/// Reads the log at `path` through `recipe` (checked), requiring `dof` joints, and
+/// estimates what it does not measure at `options.cutoff_hz`. The [`Loaded`] report
+/// says what was measured, estimated and dropped.
+pub fn load(path: &Path, recipe: &Recipe, dof: usize, options: &IdentifyOptions) -> Result<Loaded, PipelineError> {
+    options.check()?;
+    let data = |error| PipelineError::Data {
+        path: Some(path.to_path_buf()),
+        error,
+    };
+    recipe.check().map_err(PipelineError::Recipe)?;
+    recipe
+        .read(path, Some(dof))
+        .map_err(data)?
+        .with_derivatives(options.cutoff_hz)
+        .map_err(data)
+}
+
+/// How an identification predicts the joint torques.
+#[derive(Clone, Debug)]
+pub enum Prediction {
+    /// Regressor rows times the estimate's solution: exact on the identifiable
+    /// subspace, whatever the unidentifiable directions hold.
+    Regressor(Box<TorqueEstimate>),
+    /// Inverse dynamics with these standard parameters (MIM: `θ` where identified,
+    /// the model's elsewhere).
+    Parameters(Vec<f64>),
+}
+
+/// What an identification produced.
+#[derive(Clone, Debug)]
+pub struct Identification {
+    pub mode: Mode,
+    /// Names, values, σ and status of every parameter; the identifiable combinations.
+    pub report: ParameterReport,
+    /// The MIM estimate with its verdicts (and errors when the model is the truth).
+    pub mim: Option<MimEstimate>,
+    pub prediction: Prediction,
+}
+
+/// Identifies `dynamics`'s inertial parameters from `trajectory` (which must have
+/// velocities and accelerations: see [`load`]).
+pub fn identify(
+    dynamics: &dyn Dynamics,
+    trajectory: &Trajectory,
+    options: &IdentifyOptions,
+) -> Result<Identification, PipelineError> {
+    options.check()?;
+    let n = dynamics.nv();
+    if trajectory.dof() != n {
+        return Err(PipelineError::DofMismatch {
+            expected: n,
+            found: trajectory.dof(),
+        });
+    }
+    if trajectory.velocities().is_none() || trajectory.accelerations().is_none() {
+        return Err(PipelineError::Data {
+            path: None,
+            error: DataError::MissingGroup {
+                group: "velocities and accelerations",
+                columns: "v1.., a1..".into(),
+                needed_for: "the regressor (estimate them first: pipeline::load)",
+            },
+        });
+    }
+    match options.mode {
+        Mode::Standard | Mode::Principal => from_torques(dynamics, trajectory, options),
+        Mode::Mim => by_mim(dynamics, trajectory, options),
+    }
+}
+
+/// Standard or principal parameters through the stacked joint-torque regressor.
+fn from_torques(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    options: &IdentifyOptions,
+) -> Result<Identification, PipelineError> {
+    let model = dynamics.model();
+    let n = dynamics.nv();
+    let principal = options.mode == Mode::Principal;
+    let regressor = if principal {
+        TorqueRegressor::Principal
+    } else {
+        TorqueRegressor::Standard
+    };
+    let p = regressor.columns(n);
+    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
+    let mut y = vec![0.0; n * p];
+    for k in 0..traj.len() {
+        let (q, v, a) = state(traj, k);
+        regressor.eval(dynamics, q, v, a, &mut y);
+        for j in 0..n {
+            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
+                .map_err(|error| PipelineError::Identify {
+                    at: Some(traj.location(k)),
+                    error,
+                })?;
+        }
+    }
+    let opts = &options.tolerances;
+    let nominal = nominal(model, options.mode);
+    let estimate = match options.estimator {
+        Estimator::Ols => acc.ols(opts),
+        Estimator::Wls => acc.wls(opts),
+        Estimator::Tls => acc.tls(opts),
+        Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
+        Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
+        Estimator::Consistent => acc.standard_consistent(&StandardOptions::default(), opts),
+    }?;
+    let names = if principal {
+        dyngen_model::names::principal_param_names(n)
+    } else {
+        dyngen_model::names::standard_param_names(n)
+    };
+    let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let parameterisation = if principal {
+        Parameterisation::Principal
+    } else {
+        Parameterisation::Standard
+    };
+    let report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
+    Ok(Identification {
+        mode: options.mode,
+        report,
+        mim: None,
+        prediction: Prediction::Regressor(Box::new(TorqueEstimate {
+            regressor,
+            names,
+            estimate,
+            truth: options.model_is_truth.then_some(nominal),
+        })),
+    })
+}
+
+/// The paper's MIM on measured joint wrenches: every body's θ from its resultant,
+/// the whole robot as one block-diagonal least-squares problem.
+fn by_mim(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    options: &IdentifyOptions,
+) -> Result<Identification, PipelineError> {
+    let model = dynamics.model();
+    if traj.joint_wrenches().is_none() {
+        return Err(PipelineError::MissingWrenches { dof: model.dof() });
+    }
+    let reference = Reference::new(model);
+    let recording =
+        Recording::from_measurements(&reference, traj).map_err(|error| PipelineError::Data { path: None, error })?;
+    let nominal = dyngen_model::principal_params(model);
+    let truth = options.model_is_truth.then_some(nominal.as_slice());
+    let mim_options = MimOptions {
+        identify: options.tolerances.clone(),
+        ..MimOptions::default()
+    };
+    let estimate = mim::whole_robot(&recording, 0..recording.len(), truth, &mim_options)?;
+    // The torques of the identified model: θ where identified, the model's elsewhere.
+    let theta: Vec<f64> = estimate
+        .theta()
+        .iter()
+        .zip(&nominal)
+        .map(|(x, t)| x.unwrap_or(*t))
+        .collect();
+    Ok(Identification {
+        mode: Mode::Mim,
+        report: ParameterReport::from_mim(&model.name, &estimate),
+        prediction: Prediction::Parameters(principal_params_to_standard(model, &theta)),
+        mim: Some(estimate),
+    })
+}
+
+/// `(q, v, a)` of sample `k`; [`identify`] checked that `v` and `a` exist.
+fn state(traj: &Trajectory, k: usize) -> (&[f64], &[f64], &[f64]) {
+    (traj.q(k), traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]))
+}
+
+/// The model's own parameters in the parameterisation of `mode`.
+fn nominal(model: &Model, mode: Mode) -> Vec<f64> {
+    match mode {
+        Mode::Standard => model.standard_params(),
+        Mode::Principal | Mode::Mim => dyngen_model::principal_params(model),
+    }
+}
+
+/// An identified parameter against the model's value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterErrors {
+    /// `(name, relative error)`; `None` for a parameter without a value.
+    pub relative: Vec<(String, Option<f64>)>,
+    /// Identified, but zero in the model, so without a relative error.
+    pub zero_truth: Vec<String>,
+    /// The largest relative error and its parameter.
+    pub worst: Option<(f64, String)>,
+    /// Parameters with a value and a nonzero true value.
+    pub compared: usize,
+}
+
+impl Identification {
+    /// Parameters per body: 10 standard, or 4 of `θ`.
+    pub fn per_body(&self) -> usize {
+        match self.mode {
+            Mode::Standard => 10,
+            Mode::Principal | Mode::Mim => 4,
+        }
+    }
+
+    /// The model's own parameters in this identification's parameterisation.
+    pub fn nominal(&self, model: &Model) -> Vec<f64> {
+        nominal(model, self.mode)
+    }
+
+    /// The predicted joint torques of every sample of `trajectory`.
+    pub fn predict(&self, dynamics: &dyn Dynamics, trajectory: &Trajectory) -> Result<Vec<Vec<f64>>, PipelineError> {
+        let n = dynamics.nv();
+        if trajectory.dof() != n {
+            return Err(PipelineError::DofMismatch {
+                expected: n,
+                found: trajectory.dof(),
+            });
+        }
+        let mut tau = vec![0.0; n];
+        Ok((0..trajectory.len())
+            .map(|k| {
+                let (q, v, a) = state(trajectory, k);
+                match &self.prediction {
+                    Prediction::Regressor(estimate) => estimate.predict(dynamics, q, v, a),
+                    Prediction::Parameters(params) => {
+                        dynamics.rnea(q, v, a, params, &mut tau);
+                        tau.clone()
+                    }
+                }
+            })
+            .collect())
+    }
+
+    /// Every parameter's error against the model's value (relative errors only for
+    /// a nonzero true value; non-finite ones are left out).
+    pub fn errors(&self, model: &Model) -> ParameterErrors {
+        let truth = self.nominal(model);
+        let mut out = ParameterErrors {
+            relative: Vec::new(),
+            zero_truth: Vec::new(),
+            worst: None,
+            compared: 0,
+        };
+        for (p, &x) in self.report.parameters.iter().zip(&truth) {
+            match p.value {
+                None => out.relative.push((p.name.clone(), None)),
+                Some(_) if x.abs() < 1e-12 => out.zero_truth.push(p.name.clone()),
+                Some(v) => {
+                    let rel = (v - x) / x;
+                    if !rel.is_finite() {
+                        continue;
+                    }
+                    out.compared += 1;
+                    if out.worst.as_ref().is_none_or(|(w, _)| rel.abs() > *w) {
+                        out.worst = Some((rel.abs(), p.name.clone()));
+                    }
+                    out.relative.push((p.name.clone(), Some(rel)));
+                }
+            }
+        }
+        out
+    }
+
+    /// Body `body`'s identified inertial, or why it has none: all of its parameters
+    /// (10 standard, or θ with the model's centre of mass and principal axes)
+    /// identified, and the result physically valid.
+    pub fn inertial(&self, model: &Model, body: usize) -> Result<Inertial, String> {
+        let k = self.per_body();
+        let params = self
+            .report
+            .parameters
+            .get(k * body..k * (body + 1))
+            .ok_or_else(|| format!("no body {body}"))?;
+        let missing = params.iter().filter(|p| p.status != ParamStatus::Identified).count();
+        if missing > 0 {
+            return Err(format!("{missing} of its {k} parameters not identified"));
+        }
+        let values: Vec<f64> = params
+            .iter()
+            .map(|p| p.value.ok_or("a parameter has no value"))
+            .collect::<Result<_, _>>()?;
+        let mut x = [0.0; 10];
+        if k == 10 {
+            x.copy_from_slice(&values);
+        } else {
+            // θ of this body, the model's θ elsewhere (only this body's 10 are used).
+            let mut theta = dyngen_model::principal_params(model);
+            theta[4 * body..4 * body + 4].copy_from_slice(&values);
+            let standard = principal_params_to_standard(model, &theta);
+            x.copy_from_slice(&standard[10 * body..10 * body + 10]);
+        }
+        let inertial = Inertial::from_standard_params(&x).ok_or("identified mass is not positive")?;
+        dyngen_model::desc::check_inertial(&inertial).map_err(|e| match e {
+            ErrorKind::NonPositiveMass(m) => format!("identified mass {m} is not positive"),
+            ErrorKind::NotPositiveDefinite(ev) => {
+                format!("identified inertia about the centre of mass is not positive definite (moments {ev:?})")
+            }
+            ErrorKind::TriangleInequality(ev) => {
+                format!("identified principal moments {ev:?} violate the triangle inequality")
+            }
+            e => format!("identified inertial is not physical ({e:?})"),
+        })?;
+        Ok(inertial)
+    }
+
+    /// The URDF text `urdf` (the model's source) with the inertials of the fully
+    /// identified, physically valid bodies replaced; every other byte is kept.
+    pub fn rewrite_urdf(&self, urdf: &str, model: &Model, merged: MergedLinks) -> Result<UrdfRewrite, PipelineError> {
+        let mut updated: Vec<(String, Inertial)> = Vec::new();
+        let mut kept: Vec<(String, String)> = Vec::new();
+        for (i, body) in model.bodies.iter().enumerate() {
+            match self.inertial(model, i) {
+                Ok(inertial) => {
+                    if !body.merged.is_empty() && merged == MergedLinks::Refuse {
+                        return Err(PipelineError::MergedLinks {
+                            body: body.name.clone(),
+                            merged: body.merged.clone(),
+                        });
+                    }
+                    updated.push((body.name.clone(), inertial));
+                }
+                Err(why) => kept.push((body.name.clone(), why)),
+            }
+        }
+        let text = report::rewrite_urdf_inertials_with(urdf, &updated, merged).map_err(PipelineError::Report)?;
+        Ok(UrdfRewrite { text, updated, kept })
+    }
+}
+
+/// A URDF with identified inertials.
+#[derive(Clone, Debug)]
+pub struct UrdfRewrite {
+    /// The new URDF text.
+    pub text: String,
+    /// The bodies written, with their identified inertials.
+    pub updated: Vec<(String, Inertial)>,
+    /// The bodies that keep their inertials, and why.
+    pub kept: Vec<(String, String)>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::Experiment;
+    use std::sync::OnceLock;
+
+    fn ur5() -> &'static Model {
+        static MODEL: OnceLock<Model> = OnceLock::new();
+        MODEL.get_or_init(|| {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf");
+            dyngen_model::load_urdf(&path).expect("the UR5 URDF loads")
+        })
+    }
+
+    /// Noise-free UR5 data along the paper's prescribed motion, with joint wrenches.
+    fn recording() -> Trajectory {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let experiment = Experiment::paper(model);
+        let recording = crate::simulate::record(&robot, &model.standard_params(), &experiment);
+        recording
+            .to_trajectory()
+            .expect("a simulated recording is a valid trajectory")
+    }
+
+    fn options(mode: Mode, estimator: Estimator) -> IdentifyOptions {
+        IdentifyOptions {
+            mode,
+            estimator,
+            model_is_truth: true,
+            ..IdentifyOptions::default()
+        }
+    }
+
+    #[test]
+    fn a_simulated_ur5_is_identified_to_its_truth() {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let traj = recording();
+        for estimator in [
+            Estimator::Ols,
+            Estimator::Wls,
+            Estimator::Tls,
+            Estimator::Ridge { lambda: 1e-6 },
+        ] {
+            let id = identify(&robot, &traj, &options(Mode::Standard, estimator)).unwrap();
+            let errors = id.errors(model);
+            let (worst, name) = errors.worst.clone().unwrap_or((0.0, String::new()));
+            assert!(worst < 1e-6, "{estimator:?}: {name} off by {worst:e}");
+            // Joint torques never determine every standard parameter; ridge fills in
+            // the rest from the prior.
+            let without_value = errors.relative.iter().any(|(_, e)| e.is_none());
+            assert_eq!(
+                without_value,
+                !matches!(estimator, Estimator::Ridge { .. }),
+                "{estimator:?}"
+            );
+            let predicted = id.predict(&robot, &traj).unwrap();
+            for (k, tau) in predicted.iter().enumerate() {
+                for (p, m) in tau.iter().zip(traj.tau(k)) {
+                    assert!((p - m).abs() < 1e-6 * (1.0 + m.abs()), "sample {k}: {p} vs {m}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn mim_identifies_every_body_and_rewrites_the_urdf() {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let id = identify(&robot, &recording(), &options(Mode::Mim, Estimator::Ols)).unwrap();
+        let errors = id.errors(model);
+        assert!(errors.worst.as_ref().is_some_and(|(w, _)| *w < 1e-6), "{errors:?}");
+        let urdf =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf")).unwrap();
+        match id.rewrite_urdf(&urdf, model, MergedLinks::Refuse) {
+            Ok(rewrite) => assert!(!rewrite.updated.is_empty(), "{:?}", rewrite.kept),
+            Err(PipelineError::MergedLinks { body, merged }) => assert!(!merged.is_empty(), "{body}"),
+            Err(e) => panic!("{e}"),
+        }
+        let lumped = id.rewrite_urdf(&urdf, model, MergedLinks::Lump).unwrap();
+        assert_eq!(lumped.updated.len() + lumped.kept.len(), model.bodies.len());
+        assert_ne!(lumped.text, urdf);
+    }
+
+    #[test]
+    fn principal_mode_reports_theta_names() {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let id = identify(&robot, &recording(), &options(Mode::Principal, Estimator::Tls)).unwrap();
+        assert_eq!(id.report.parameters.len(), 4 * model.dof());
+        assert_eq!(id.report.parameters[1].name, "J1_1");
+        assert_eq!(id.per_body(), 4);
+    }
+
+    #[test]
+    fn invalid_options_are_refused() {
+        let bad = [
+            IdentifyOptions {
+                cutoff_hz: -1.0,
+                ..IdentifyOptions::default()
+            },
+            options(Mode::Standard, Estimator::Ridge { lambda: f64::NAN }),
+            options(Mode::Mim, Estimator::Wls),
+            IdentifyOptions {
+                mode: Mode::Mim,
+                accumulation: Accumulation::NormalEquations,
+                ..IdentifyOptions::default()
+            },
+        ];
+        for o in bad {
+            assert!(matches!(o.check(), Err(PipelineError::InvalidOption { .. })), "{o:?}");
+        }
+    }
+
+    #[test]
+    fn data_errors_name_the_file_and_line() {
+        let dir = std::env::temp_dir().join(format!("dyngen-pipeline-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("bad.csv");
+        std::fs::write(&csv, "t,q1,tau1\n0,0,0\n0.1,x,0\n0.2,0,0\n").unwrap();
+        let err = load(&csv, &Recipe::default(), 1, &IdentifyOptions::default()).unwrap_err();
+        assert!(matches!(err, PipelineError::Data { .. }));
+        let text = err.to_string();
+        assert!(text.contains("bad.csv") && text.contains("line 3"), "{text}");
+        let missing = load(
+            &dir.join("nope.csv"),
+            &Recipe::default(),
+            1,
+            &IdentifyOptions::default(),
+        )
+        .unwrap_err();
+        assert!(missing.to_string().contains("nope.csv"), "{missing}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn mismatched_or_incomplete_recordings_are_refused() {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let traj = recording();
+        // Another robot's recording.
+        let pendulum = dyngen_model::parse_urdf(
+            r#"<robot name="p"><link name="b"/><link name="l"><inertial><mass value="1"/>
+            <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+            <joint name="j" type="continuous"><parent link="b"/><child link="l"/><axis xyz="0 0 1"/></joint></robot>"#,
+        )
+        .unwrap();
+        let one = Reference::new(&pendulum);
+        assert!(matches!(
+            identify(&one, &traj, &IdentifyOptions::default()),
+            Err(PipelineError::DofMismatch { expected: 1, found: 6 })
+        ));
+        // MIM without the joint wrenches.
+        let torques_only = Trajectory::new(6, traj.t().to_vec(), traj.positions().to_vec(), traj.torques().to_vec())
+            .and_then(|t| t.with_velocities(traj.velocities().unwrap_or_default().to_vec()))
+            .and_then(|t| t.with_accelerations(traj.accelerations().unwrap_or_default().to_vec()))
+            .unwrap();
+        assert!(matches!(
+            identify(&robot, &torques_only, &options(Mode::Mim, Estimator::Ols)),
+            Err(PipelineError::MissingWrenches { dof: 6 })
+        ));
+    }
+
+    #[test]
+    fn estimator_failures_are_typed() {
+        // Held still without gravity, the robot's torques say nothing about its inertia.
+        let mut model = ur5().clone();
+        model.gravity = [0.0; 3];
+        let robot = Reference::new(&model);
+        let zeros = |len| vec![0.0; len];
+        let still = Trajectory::new(6, vec![0.0, 0.1, 0.2], zeros(18), zeros(18))
+            .and_then(|t| t.with_velocities(zeros(18)))
+            .and_then(|t| t.with_accelerations(zeros(18)))
+            .unwrap();
+        let err = identify(&robot, &still, &IdentifyOptions::default()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                PipelineError::Identify {
+                    error: IdentifyError::RankZero { .. },
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        // Without velocities and accelerations there is no regressor.
+        let positions_only = Trajectory::new(6, vec![0.0, 0.1, 0.2], zeros(18), zeros(18)).unwrap();
+        let err = identify(&robot, &positions_only, &IdentifyOptions::default()).unwrap_err();
+        assert!(matches!(err, PipelineError::Data { path: None, .. }), "{err:?}");
+    }
+}

@@ -578,7 +578,7 @@ impl Worst {
         for (j, (v, t)) in values.iter().zip(truth).enumerate() {
             match v {
                 Some(v) if expected[j] => {
-                    let rel = dyngen_identify::relative_error(v, t);
+                    let rel = dyngen_identify::relative_error(*v, *t);
                     if j % 4 == 0 {
                         self.mass = self.mass.max(rel);
                     } else {
@@ -708,7 +708,7 @@ fn side_by_side(
                 .zip(truth)
                 .zip(&paper.identifiable)
                 .filter(|(_, &ok)| ok)
-                .map(|((v, t), _)| dyngen_identify::relative_error(v, t))
+                .map(|((v, t), _)| dyngen_identify::relative_error(*v, *t))
                 .fold(0.0, f64::max)
     );
     Ok(())

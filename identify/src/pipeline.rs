@@ -10,7 +10,7 @@
 //! ```no_run
 //! use dyngen_identify::data::Recipe;
 //! use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, Mode};
-//! let model = dyngen_model::load_urdf("ur5.urdf").unwrap();
+//! let model = dyngen_model::load_urdf(std::path::Path::new("ur5.urdf")).unwrap();
 //! let robot = dyngen_reference::Reference::new(&model);
 //! let options = IdentifyOptions {
 //!     mode: Mode::Standard,

@@ -5,9 +5,12 @@
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
 use crate::error::CliError;
 use dyngen_identify::data::{Recipe, Trajectory};
-use dyngen_identify::pipeline::{self, Estimator, Identification, IdentifyOptions, PipelineError, Prediction};
+use dyngen_identify::pipeline::{
+    self, Estimator, Identification, IdentifyOptions, JointTerms, PipelineError, Prediction,
+};
 use dyngen_identify::report::{self, MergedLinks};
 use dyngen_identify::{Accumulation, Estimate};
+use dyngen_model::joint_params::Coulomb;
 use dyngen_model::Model;
 use dyngen_reference::Reference;
 use std::path::{Path, PathBuf};
@@ -22,6 +25,13 @@ Examples:
       --truth-from-urdf --urdf-out ur5-identified.urdf --force
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode principal
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \
+      --validate run2.csv
+
+A real robot's joint torques carry friction and rotor inertia: --friction auto adds
+[Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
+the Coulomb term smoothed as the data best support; --validate predicts a second
+recording with the result.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them.
@@ -63,6 +73,19 @@ pub enum Mode {
     Principal,
     /// θ per body from the joint wrenches, body by body (the paper's MIM).
     Mim,
+}
+
+/// Friction and rotor inertia per joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Friction {
+    /// Rigid bodies only.
+    None,
+    /// [Ia, Fv, Fc, F0] per joint, Coulomb term Fc·sign(q̇).
+    Sign,
+    /// The same with Fc·tanh(q̇/ε), ε from --epsilon.
+    Smooth,
+    /// The same with the ε that fits the data best (a search on the fit residual).
+    Auto,
 }
 
 /// How the rows are compressed (dyngen_identify::Accumulation).
@@ -110,6 +133,21 @@ pub struct IdentifyArgs {
     /// 1e-6 of the strongest are then reported as not identifiable).
     #[arg(long, value_enum, default_value_t = AccumulationArg::Qr)]
     pub accumulation: AccumulationArg,
+
+    /// Friction and rotor inertia per joint (--mode standard): 4 more parameters per
+    /// joint, [Ia, Fv, Fc, F0]. Real robots need them; `auto` is the choice for a
+    /// real recording.
+    #[arg(long, value_enum, default_value_t = Friction::None)]
+    pub friction: Friction,
+
+    /// --friction smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for prismatic joints).
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    pub epsilon: f64,
+
+    /// Predict the torques of this second recording (read with the same recipe)
+    /// with the identified model and print the errors per joint and overall.
+    #[arg(long, value_name = "CSV")]
+    pub validate: Option<PathBuf>,
 
     /// Ridge: weight of the pull toward the nominal parameters.
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
@@ -237,7 +275,7 @@ pub fn load_recording(path: &Path, recipe: &RecipeArgs, dof: usize, cutoff: f64)
 }
 
 /// A pipeline error as a command-line error; `data` names the recording.
-fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
+pub fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
     match e {
         PipelineError::InvalidOption { option, reason } => CliError::usage(format!("--{option} {reason}")),
         PipelineError::Recipe(_) | PipelineError::Data { path: Some(_), .. } => CliError::Input(e.to_string()),
@@ -279,6 +317,12 @@ impl IdentifyArgs {
             accumulation: match self.accumulation {
                 AccumulationArg::Qr => Accumulation::Qr,
                 AccumulationArg::NormalEquations => Accumulation::NormalEquations,
+            },
+            joints: match self.friction {
+                Friction::None => JointTerms::None,
+                Friction::Sign => JointTerms::Friction(Coulomb::Sign),
+                Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
+                Friction::Auto => JointTerms::FrictionAuto,
             },
             cutoff_hz: self.cutoff,
             model_is_truth: self.truth_from_urdf,
@@ -342,6 +386,15 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     }
     if let Some(path) = &args.urdf_out {
         write_urdf(args, path, &model, &identified)?;
+    }
+    if let Some(path) = &args.validate {
+        let other = load_recording(path, &args.recipe, n, args.cutoff)?;
+        let predicted = with_spinner(progress, "predicting the validation recording", || {
+            identified.predict(&robot, &other)
+        })
+        .map_err(|e| pipeline_error(path, e))?;
+        let validation = crate::validate::validation(&model, &other, &predicted)?;
+        println!("prediction of {}:\n{validation}", path.display());
     }
     Ok(())
 }

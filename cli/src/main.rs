@@ -23,6 +23,7 @@ mod info;
 mod nim;
 mod simulate;
 mod svg;
+mod validate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -33,6 +34,8 @@ Examples:
   dyngen generate robots/ur5/ur5.urdf --name Ur5 -o ur5.rs
   dyngen simulate robots/ur5/ur5.urdf -o ur5.csv --experiment fourier --noise 0.01
   dyngen identify robots/ur5/ur5.urdf ur5.csv --method wls
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json p.json --validate run2.csv
+  dyngen validate robots/ur5/ur5.urdf p.json run2.csv --svg run2.svg
   dyngen nim train robots/ur5/ur5.urdf ur5.csv -o ur5-nim.json
   dyngen demo
 
@@ -71,6 +74,10 @@ pub enum Command {
     /// wrenches (MIM).
     #[command(after_help = identify::EXAMPLES)]
     Identify(identify::IdentifyArgs),
+    /// Predict a recording's joint torques with identified parameters (JSON from
+    /// `identify --params-json`) and report the errors per joint and overall.
+    #[command(after_help = validate::EXAMPLES)]
+    Validate(validate::ValidateArgs),
     /// The neural-network identifier (NIM): train it for a robot and a joint motion,
     /// or identify with it.
     #[command(after_help = nim::EXAMPLES)]
@@ -100,6 +107,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(args, &progress),
         Command::Simulate(args) => simulate::run(args, &progress),
         Command::Identify(args) => identify::run(args, &progress),
+        Command::Validate(args) => validate::run(args, &progress),
         Command::Nim(args) => nim::run(args, &progress),
         Command::Demo(args) => demo::run(args, &progress),
     };

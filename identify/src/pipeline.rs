@@ -24,9 +24,12 @@
 
 use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
 use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
-use crate::report::{self, MergedLinks, ParamStatus, ParameterReport, Parameterisation, ReportError};
+use crate::report::{
+    self, CoulombReport, MergedLinks, ParamStatus, ParameterReport, Parameterisation, PredictionModel, ReportError,
+};
 use crate::simulate::Recording;
 use crate::{Accumulation, Accumulator, Channels, IdentifyError, Options, PrincipalOptions, StandardOptions};
+use dyngen_model::joint_params::Coulomb;
 use dyngen_model::{ErrorKind, Inertial, Model};
 use dyngen_reference::{principal_params_to_standard, Dynamics, Reference};
 use std::fmt;
@@ -64,11 +67,33 @@ pub enum Estimator {
     Consistent,
 }
 
+/// What the joints do besides carrying the bodies, in [`Mode::Standard`]: nothing,
+/// or per joint rotor inertia, viscous and Coulomb friction and an offset
+/// `[Ia, Fv, Fc, F0]` ([`dyngen_model::joint_params`]), which a real robot's
+/// torques always contain.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum JointTerms {
+    /// Rigid bodies only (simulated data, or torques measured after the drive).
+    #[default]
+    None,
+    /// Friction and rotor inertia with the Coulomb term as given.
+    Friction(Coulomb),
+    /// Friction and rotor inertia with `Fc·tanh(q̇/ε)`, `ε` chosen by the fit
+    /// residual ([`crate::friction::best_epsilon`], on at most
+    /// [`SMOOTHING_SAMPLES`] samples spread over the recording).
+    FrictionAuto,
+}
+
+/// Samples the search for the Coulomb smoothing fits on, at most.
+pub const SMOOTHING_SAMPLES: usize = 20_000;
+
 /// Everything [`load`] and [`identify`] need besides the data and the robot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IdentifyOptions {
     pub mode: Mode,
     pub estimator: Estimator,
+    /// Friction and rotor inertia ([`Mode::Standard`] only).
+    pub joints: JointTerms,
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
     /// Low-pass cutoff (Hz) for velocities and accelerations estimated from
@@ -86,6 +111,7 @@ impl Default for IdentifyOptions {
         IdentifyOptions {
             mode: Mode::Standard,
             estimator: Estimator::Ols,
+            joints: JointTerms::None,
             accumulation: Accumulation::Qr,
             cutoff_hz: 10.0,
             tolerances: Options::default(),
@@ -115,6 +141,23 @@ impl IdentifyOptions {
                 "applies to the standard and principal modes; MIM always uses least squares weighted per body axis"
                     .into(),
             );
+        }
+        if self.joints != JointTerms::None && self.mode != Mode::Standard {
+            return invalid(
+                "friction",
+                "applies to the standard mode (the joint terms enter the joint torques, not the body equations)".into(),
+            );
+        }
+        if self.joints != JointTerms::None && self.estimator == Estimator::Consistent {
+            return invalid(
+                "method",
+                "consistent estimation does not take friction and rotor inertia yet; use ols, wls, tls or ridge".into(),
+            );
+        }
+        if let JointTerms::Friction(Coulomb::Smooth { epsilon }) = self.joints {
+            if !(epsilon.is_finite() && epsilon > 0.0) {
+                return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
+            }
         }
         if self.mode == Mode::Mim && self.accumulation != Accumulation::Qr {
             return invalid(
@@ -266,27 +309,37 @@ fn from_torques(
     let model = dynamics.model();
     let n = dynamics.nv();
     let principal = options.mode == Mode::Principal;
-    let regressor = if principal {
-        TorqueRegressor::Principal
-    } else {
-        TorqueRegressor::Standard
-    };
-    let p = regressor.columns(n);
-    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
-    let mut y = vec![0.0; n * p];
-    for k in 0..traj.len() {
-        let (q, v, a) = state(traj, k);
-        regressor.eval(dynamics, q, v, a, &mut y);
-        for j in 0..n {
-            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
-                .map_err(|error| PipelineError::Identify {
-                    at: Some(traj.location(k)),
-                    error,
-                })?;
+    let regressor = match (principal, options.joints) {
+        (true, _) => TorqueRegressor::Principal,
+        (false, JointTerms::None) => TorqueRegressor::Standard,
+        (false, JointTerms::Friction(coulomb)) => TorqueRegressor::StandardAndJoints(coulomb),
+        (false, JointTerms::FrictionAuto) => {
+            let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
+            let mut failure = None;
+            let (epsilon, _) = crate::friction::best_epsilon(|epsilon| {
+                let r = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon });
+                match accumulate(dynamics, traj, r, stride, options.accumulation)
+                    .and_then(|acc| Ok(acc.ols(&options.tolerances)?))
+                {
+                    Ok(e) => e.residuals.rms,
+                    Err(e) => {
+                        failure.get_or_insert(e);
+                        f64::INFINITY
+                    }
+                }
+            });
+            if let Some(e) = failure {
+                return Err(e);
+            }
+            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon })
         }
-    }
+    };
+    let acc = accumulate(dynamics, traj, regressor, 1, options.accumulation)?;
     let opts = &options.tolerances;
-    let nominal = nominal(model, options.mode);
+    let mut nominal = nominal(model, options.mode);
+    if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+        nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
+    }
     let estimate = match options.estimator {
         Estimator::Ols => acc.ols(opts),
         Estimator::Wls => acc.wls(opts),
@@ -295,19 +348,33 @@ fn from_torques(
         Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
         Estimator::Consistent => acc.standard_consistent(&StandardOptions::default(), opts),
     }?;
-    let names = if principal {
+    let mut names = if principal {
         dyngen_model::names::principal_param_names(n)
     } else {
         dyngen_model::names::standard_param_names(n)
     };
+    if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+        names.extend(dyngen_model::joint_params::joint_param_names(n));
+    }
     let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    let parameterisation = if principal {
-        Parameterisation::Principal
-    } else {
-        Parameterisation::Standard
+    let (parameterisation, coulomb) = match regressor {
+        TorqueRegressor::Principal => (Parameterisation::Principal, None),
+        TorqueRegressor::StandardAndJoints(c) => (
+            Parameterisation::StandardAndJoints,
+            Some(match c {
+                Coulomb::Sign => CoulombReport::Sign,
+                Coulomb::Smooth { epsilon } => CoulombReport::Tanh { epsilon },
+            }),
+        ),
+        _ => (Parameterisation::Standard, None),
     };
-    let report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
+    let mut report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
+    report.prediction = Some(PredictionModel {
+        regressor: parameterisation,
+        coulomb,
+        solution: estimate.solution.clone(),
+    });
     Ok(Identification {
         mode: options.mode,
         report,
@@ -319,6 +386,32 @@ fn from_torques(
             truth: options.model_is_truth.then_some(nominal),
         })),
     })
+}
+
+/// The rows of `regressor` over every `stride`-th sample of `traj`, accumulated.
+fn accumulate(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    regressor: TorqueRegressor,
+    stride: usize,
+    accumulation: Accumulation,
+) -> Result<Accumulator, PipelineError> {
+    let n = dynamics.nv();
+    let p = regressor.columns(n);
+    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation)?;
+    let mut y = vec![0.0; n * p];
+    for k in (0..traj.len()).step_by(stride) {
+        let (q, v, a) = state(traj, k);
+        regressor.eval(dynamics, q, v, a, &mut y);
+        for j in 0..n {
+            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
+                .map_err(|error| PipelineError::Identify {
+                    at: Some(traj.location(k)),
+                    error,
+                })?;
+        }
+    }
+    Ok(acc)
 }
 
 /// The paper's MIM on measured joint wrenches: every body's θ from its resultant,
@@ -368,6 +461,85 @@ fn nominal(model: &Model, mode: Mode) -> Vec<f64> {
         Mode::Standard => model.standard_params(),
         Mode::Principal | Mode::Mim => dyngen_model::principal_params(model),
     }
+}
+
+/// The joint torques that the identified model `prediction` (from a parameter JSON,
+/// [`ParameterReport::prediction`]) predicts for every sample of `trajectory`.
+pub fn predict_with(
+    prediction: &PredictionModel,
+    dynamics: &dyn Dynamics,
+    trajectory: &Trajectory,
+) -> Result<Vec<Vec<f64>>, PipelineError> {
+    let n = dynamics.nv();
+    if trajectory.dof() != n {
+        return Err(PipelineError::DofMismatch {
+            expected: n,
+            found: trajectory.dof(),
+        });
+    }
+    let regressor = match (prediction.regressor, prediction.coulomb) {
+        (Parameterisation::Standard, None) => TorqueRegressor::Standard,
+        (Parameterisation::Principal, None) => TorqueRegressor::Principal,
+        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(match c {
+            CoulombReport::Sign => Coulomb::Sign,
+            CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
+            CoulombReport::Tanh { epsilon } => {
+                return Err(PipelineError::InvalidOption {
+                    option: "prediction",
+                    reason: format!("the Coulomb smoothing must be positive, got {epsilon}"),
+                })
+            }
+        }),
+        (r, c) => {
+            return Err(PipelineError::InvalidOption {
+                option: "prediction",
+                reason: format!("a {r:?} regressor with Coulomb model {c:?} is not a model dyngen predicts with"),
+            })
+        }
+    };
+    let p = regressor.columns(n);
+    if prediction.solution.len() != p {
+        return Err(PipelineError::InvalidOption {
+            option: "prediction",
+            reason: format!(
+                "the solution has {} entries; this robot's {:?} regressor has {p} columns (another robot?)",
+                prediction.solution.len(),
+                prediction.regressor
+            ),
+        });
+    }
+    if let Some(k) = prediction.solution.iter().position(|x| !x.is_finite()) {
+        return Err(PipelineError::InvalidOption {
+            option: "prediction",
+            reason: format!("entry {k} of the solution is not finite"),
+        });
+    }
+    if trajectory.velocities().is_none() || trajectory.accelerations().is_none() {
+        return Err(PipelineError::Data {
+            path: None,
+            error: DataError::MissingGroup {
+                group: "velocities and accelerations",
+                columns: "v1.., a1..".into(),
+                needed_for: "the regressor (estimate them first: pipeline::load)",
+            },
+        });
+    }
+    let mut y = vec![0.0; n * p];
+    Ok((0..trajectory.len())
+        .map(|k| {
+            let (q, v, a) = state(trajectory, k);
+            regressor.eval(dynamics, q, v, a, &mut y);
+            (0..n)
+                .map(|r| {
+                    y[r * p..(r + 1) * p]
+                        .iter()
+                        .zip(&prediction.solution)
+                        .map(|(a, x)| a * x)
+                        .sum()
+                })
+                .collect()
+        })
+        .collect())
 }
 
 /// An identified parameter against the model's value.

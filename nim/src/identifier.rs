@@ -739,6 +739,7 @@ impl NimEstimate {
             channels: Vec::new(),
             parameters,
             combinations: Vec::new(),
+            prediction: None,
         }
     }
 

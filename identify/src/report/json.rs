@@ -51,6 +51,36 @@ pub enum Parameterisation {
     Principal,
     /// The base parameters (identifiable combinations) only.
     Base,
+    /// The standard parameters, then per joint `[Ia, Fv, Fc, F0]` (rotor inertia,
+    /// viscous and Coulomb friction, offset).
+    StandardAndJoints,
+}
+
+/// How the Coulomb term `Fc·s(q̇)` was modelled.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum CoulombReport {
+    /// `sign(q̇)`.
+    Sign,
+    /// `tanh(q̇ / epsilon)`.
+    Tanh { epsilon: f64 },
+}
+
+/// Enough to predict joint torques with the identified model in any tool:
+/// `τ = Y(q, q̇, q̈) x` with `Y` the regressor named by `regressor` (Pinocchio's
+/// `computeJointTorqueRegressor` for `standard`; for `standard_and_joints` it is
+/// followed per joint by the columns `[q̈_j, q̇_j, s(q̇_j), 1]` in row `j`; for
+/// `principal` it is `Y · blkdiag(P_i)`) and `x` the full solution vector (minimum
+/// norm along the directions the data do not determine, which the prediction
+/// does not see).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PredictionModel {
+    pub regressor: Parameterisation,
+    /// For `standard_and_joints`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coulomb: Option<CoulombReport>,
+    pub solution: Vec<f64>,
 }
 
 /// [`Status`] as written in the JSON.
@@ -121,6 +151,9 @@ pub struct ParameterReport {
     pub channels: Vec<String>,
     pub parameters: Vec<ParamReport>,
     pub combinations: Vec<CombinationReport>,
+    /// How to predict with this estimate, when it predicts through a regressor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prediction: Option<PredictionModel>,
 }
 
 impl ParameterReport {
@@ -179,6 +212,7 @@ impl ParameterReport {
             channels: channels.iter().map(|s| s.to_string()).collect(),
             parameters,
             combinations,
+            prediction: None,
         }
     }
 

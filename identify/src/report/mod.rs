@@ -10,7 +10,10 @@ mod json;
 mod urdf;
 
 pub use error::ReportError;
-pub use json::{CombinationReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, Term, SCHEMA};
+pub use json::{
+    CombinationReport, CoulombReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, PredictionModel,
+    Term, SCHEMA,
+};
 pub use urdf::{rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;

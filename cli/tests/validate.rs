@@ -1,0 +1,149 @@
+//! Identify on one recording, predict another: `identify --friction --validate` and
+//! `dyngen validate` on the MuJoCo fixture (data dyngen did not simulate), against
+//! the Pinocchio + numpy/scipy pipeline with per-joint friction (3.58 % overall on the
+//! same files, `scripts/identify_pinocchio_scipy.py`).
+
+mod common;
+
+use common::{assert_exit, assert_ok, run, stdout, temp_dir, ur5};
+use std::path::PathBuf;
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/mujoco")
+        .join(name)
+}
+
+/// The overall relative error `validate` prints, as a fraction.
+fn overall(out: &str) -> f64 {
+    out.lines()
+        .find_map(|l| l.strip_prefix("overall relative error "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|x| x.parse::<f64>().ok())
+        .map(|p| p / 100.0)
+        .unwrap_or_else(|| panic!("no overall error in:\n{out}"))
+}
+
+#[test]
+fn friction_identification_predicts_the_mujoco_recording_better_than_the_baseline() {
+    let dir = temp_dir("dyngen-validate", "mujoco");
+    let params = dir.join("ur5.json");
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "auto",
+        "--cutoff",
+        "5",
+        "--params-json",
+        &params,
+        "--validate",
+        fixture("ur5_validate.csv"),
+        "--force"
+    );
+    assert_ok(&o);
+    let with_friction = overall(&stdout(&o));
+    assert!(with_friction < 0.0358, "{}", stdout(&o));
+
+    // The same through the JSON, with the SVG.
+    let svg = dir.join("validate.svg");
+    let o = run!(
+        "validate",
+        ur5(),
+        &params,
+        fixture("ur5_validate.csv"),
+        "--cutoff",
+        "5",
+        "--svg",
+        &svg,
+        "--force"
+    );
+    assert_ok(&o);
+    assert_eq!(overall(&stdout(&o)), with_friction);
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+
+    // Without friction the wrists are worse than predicting zero.
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--validate",
+        fixture("ur5_validate.csv")
+    );
+    assert_ok(&o);
+    let rigid = overall(&stdout(&o));
+    assert!(rigid > 5.0 * with_friction, "{rigid} vs {with_friction}");
+    assert!(stdout(&o).contains("(no better than zero)"), "{}", stdout(&o));
+}
+
+#[test]
+fn the_raw_logger_file_reads_through_flags() {
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify_raw.csv"),
+        "--no-header",
+        "--degrees",
+        "--gains",
+        "14,13,12,9,8.5,8",
+        "--friction",
+        "sign"
+    );
+    assert_ok(&o);
+    let out = stdout(&o);
+    assert!(
+        out.contains("1975 rows read, 1972 samples of 6 joints kept; dropped 3 repeated rows"),
+        "{out}"
+    );
+    assert!(out.contains("58 of 84 parameter directions identifiable"), "{out}");
+}
+
+#[test]
+fn validate_errors_name_the_file() {
+    let dir = temp_dir("dyngen-validate", "errors");
+    let params = dir.join("bad.json");
+    // A JSON from MIM holds no regressor model.
+    std::fs::write(
+        &params,
+        r#"{"schema":"dyngen-parameters/1","robot":"ur5","parameterisation":"principal","method":"MIM","rank":0,
+           "condition_number":null,"residual_rms":[],"parameters":[],"combinations":[]}"#,
+    )
+    .unwrap();
+    let o = run!("validate", ur5(), &params, fixture("ur5_validate.csv"));
+    assert_exit(&o, 3, "holds no prediction model");
+    // A solution of the wrong length: another robot's parameters.
+    std::fs::write(
+        &params,
+        r#"{"schema":"dyngen-parameters/1","robot":"ur5","parameterisation":"standard","method":"OLS","rank":0,
+           "condition_number":null,"residual_rms":[],"parameters":[],"combinations":[],
+           "prediction":{"regressor":"standard","solution":[1.0,2.0]}}"#,
+    )
+    .unwrap();
+    let o = run!("validate", ur5(), &params, fixture("ur5_validate.csv"));
+    assert_exit(
+        &o,
+        3,
+        "the solution has 2 entries; this robot's Standard regressor has 60 columns",
+    );
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "smooth",
+        "--epsilon",
+        "-1"
+    );
+    assert_exit(&o, 2, "the smoothing ε must be positive");
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "auto",
+        "--mode",
+        "principal"
+    );
+    assert_exit(&o, 2, "applies to the standard mode");
+}

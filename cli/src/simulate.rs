@@ -3,7 +3,10 @@
 use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
 use crate::error::CliError;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
-use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel};
+use dyngen_identify::simulate::{
+    add_joint_terms, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Logger, Motion, NoiseModel,
+};
+use dyngen_model::joint_params::Coulomb;
 use dyngen_reference::Reference;
 use std::path::PathBuf;
 
@@ -74,6 +77,53 @@ pub struct SimulateArgs {
     /// Seed of the noise and of the excitation optimisation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+
+    /// Rotor inertia Ia per joint (kg·m² or kg), one value for all joints or one per
+    /// joint: τ += Ia·q̈.
+    #[arg(long, value_name = "IA", allow_hyphen_values = true)]
+    pub armature: Option<String>,
+
+    /// Viscous friction Fv per joint (default: the URDF's <dynamics damping>): τ += Fv·q̇.
+    #[arg(long, value_name = "FV", allow_hyphen_values = true)]
+    pub damping: Option<String>,
+
+    /// Coulomb friction Fc per joint (default: the URDF's <dynamics friction>):
+    /// τ += Fc·sign(q̇).
+    #[arg(long, value_name = "FC", allow_hyphen_values = true)]
+    pub coulomb: Option<String>,
+
+    /// Torque offset F0 per joint: τ += F0.
+    #[arg(long, value_name = "F0", allow_hyphen_values = true)]
+    pub offset: Option<String>,
+
+    /// Write the recording as a robot's logger does: sampled every DT seconds with
+    /// jittered steps, some rows duplicated or stale, columns t, q, v and tau (or
+    /// motor currents with --current-gains); no accelerations or wrenches. The
+    /// experiment's --steps is then ignored.
+    #[arg(long, value_name = "DT")]
+    pub logger_period: Option<f64>,
+
+    /// Logger: each step is DT·(1 + u), u uniform within ±this fraction.
+    #[arg(long, default_value_t = 0.25)]
+    pub jitter: f64,
+
+    /// Logger: fraction of rows written twice with the same time stamp.
+    #[arg(long, default_value_t = 0.005)]
+    pub duplicates: f64,
+
+    /// Logger: fraction of rows repeating the previous row's values under a new time
+    /// stamp.
+    #[arg(long, default_value_t = 0.005)]
+    pub stale: f64,
+
+    /// Logger: write motor currents i = τ/k with these torque constants (N·m/A),
+    /// one for all joints or one per joint, as columns i1..in.
+    #[arg(long, value_name = "K1,K2,…")]
+    pub current_gains: Option<String>,
+
+    /// Logger: round the currents to multiples of this resolution (A).
+    #[arg(long, default_value_t = 0.0)]
+    pub current_quantum: f64,
 
     /// Fourier: what the coefficients are optimised for.
     #[arg(long, value_enum, default_value_t = CriterionArg::Torques)]
@@ -181,14 +231,65 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         }
     };
 
-    let clean = with_spinner(progress, "recording the experiment", || {
-        record(&robot, &params, &experiment)
+    let n = model.dof();
+    let nominal = dyngen_model::joint_params::nominal_joint_params(&model);
+    let column = |flag: &str, text: &Option<String>, k: usize| -> Result<Vec<f64>> {
+        match text {
+            Some(t) => per_joint(flag, t, n),
+            None => Ok((0..n).map(|j| nominal[4 * j + k]).collect()),
+        }
+    };
+    let [ia, fv, fc, f0] = [
+        column("--armature", &args.armature, 0)?,
+        column("--damping", &args.damping, 1)?,
+        column("--coulomb", &args.coulomb, 2)?,
+        column("--offset", &args.offset, 3)?,
+    ];
+    let joint_params: Vec<f64> = (0..n).flat_map(|j| [ia[j], fv[j], fc[j], f0[j]]).collect();
+    let logger = match args.logger_period {
+        Some(period) => Some(Logger {
+            period,
+            jitter: args.jitter,
+            duplicates: args.duplicates,
+            stale: args.stale,
+            gains: args
+                .current_gains
+                .as_ref()
+                .map(|g| per_joint("--current-gains", g, n))
+                .transpose()?,
+            current_quantum: args.current_quantum,
+            seed: args.seed,
+        }),
+        None => None,
+    };
+    if let Some(l) = &logger {
+        check_logger(l)?;
+    }
+    let mut clean = with_spinner(progress, "recording the experiment", || match &logger {
+        Some(l) => record_trajectory(&robot, &params, &experiment.motion, &l.times(experiment.duration)),
+        None => record(&robot, &params, &experiment),
     });
+    if joint_params.iter().any(|&x| x != 0.0) {
+        add_joint_terms(&mut clean, &joint_params, Coulomb::Sign);
+    }
     let recording = if args.noise > 0.0 {
         NoiseModel::relative(args.noise).apply(&clean, args.seed)
     } else {
         clean
     };
+    if let Some(l) = &logger {
+        check_overwrite(&args.output, args.force)?;
+        std::fs::write(&args.output, l.write(&recording))
+            .map_err(|e| CliError::Output(format!("{}: {e}", args.output.display())))?;
+        eprintln!(
+            "wrote {} logged samples of {n} joints ({} s, noise {}) to {}",
+            recording.len(),
+            experiment.duration,
+            args.noise,
+            args.output.display()
+        );
+        return Ok(());
+    }
     let traj = recording.to_trajectory().map_err(CliError::failed)?;
     if args.force {
         overwrite_csv(&args.output, &traj)
@@ -207,5 +308,51 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         args.noise,
         args.output.display()
     );
+    Ok(())
+}
+
+/// One value for every joint, or one per joint, comma-separated and finite.
+fn per_joint(flag: &str, text: &str, n: usize) -> Result<Vec<f64>> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| CliError::usage(format!("{flag}: `{text}` is not a list of finite numbers")))?;
+    match values.len() {
+        1 => Ok(vec![values[0]; n]),
+        k if k == n => Ok(values),
+        k => Err(CliError::usage(format!(
+            "{flag}: {k} values for {n} joints; give one for all joints or one per joint"
+        ))),
+    }
+}
+
+/// A logger that can write something sensible.
+fn check_logger(l: &Logger) -> Result<()> {
+    if !(l.period.is_finite() && l.period > 0.0) {
+        return Err(CliError::usage(format!(
+            "--logger-period must be positive, got {}",
+            l.period
+        )));
+    }
+    if !(0.0..1.0).contains(&l.jitter) {
+        return Err(CliError::usage(format!("--jitter must be in [0, 1), got {}", l.jitter)));
+    }
+    for (flag, x) in [("--duplicates", l.duplicates), ("--stale", l.stale)] {
+        if !(0.0..=1.0).contains(&x) {
+            return Err(CliError::usage(format!("{flag} must be a fraction in [0, 1], got {x}")));
+        }
+    }
+    if !(l.current_quantum.is_finite() && l.current_quantum >= 0.0) {
+        return Err(CliError::usage(format!(
+            "--current-quantum must be ≥ 0, got {}",
+            l.current_quantum
+        )));
+    }
+    if let Some(k) = &l.gains {
+        if k.iter().any(|&k| k == 0.0) {
+            return Err(CliError::usage("--current-gains must not be zero"));
+        }
+    }
     Ok(())
 }

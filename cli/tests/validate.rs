@@ -147,3 +147,80 @@ fn validate_errors_name_the_file() {
     );
     assert_exit(&o, 2, "applies to the standard mode");
 }
+
+/// `simulate` writes what a robot's logger writes (jittered stamps, duplicate and
+/// stale rows, motor currents), with friction and rotor inertia in the torques;
+/// `identify` reads it back through a recipe and finds the friction.
+#[test]
+fn simulated_logger_files_identify_their_friction() {
+    let dir = temp_dir("dyngen-validate", "logger");
+    let log = dir.join("ur5.log");
+    let o = run!(
+        "simulate",
+        ur5(),
+        "-o",
+        &log,
+        "--experiment",
+        "fourier",
+        "--duration",
+        "60",
+        "--evaluations",
+        "20",
+        "--armature",
+        "0.4,0.4,0.2,0.08,0.08,0.08",
+        "--damping",
+        "3,3,2,0.6,0.6,0.6",
+        "--coulomb",
+        "6,6,4,1.5,1.5,1.5",
+        "--logger-period",
+        "0.01",
+        "--current-gains",
+        "14,13,12,9,8.5,8",
+        "--force"
+    );
+    assert_ok(&o);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.starts_with("t,q1,"), "{}", &text[..80]);
+    assert!(text.lines().next().unwrap().contains(",i6"));
+    let recipe = dir.join("log.recipe");
+    std::fs::write(
+        &recipe,
+        "q = 2-7\nv = 8-13\ntau = 14-19\ngains = 14,13,12,9,8.5,8\nstale = drop\n",
+    )
+    .unwrap();
+    let o = run!("identify", ur5(), &log, "--recipe", &recipe, "--friction", "sign");
+    assert_ok(&o);
+    let out = stdout(&o);
+    assert!(out.contains("repeated rows") && out.contains("stale rows"), "{out}");
+    // Noise-free: the viscous friction of joint 2 to a fraction of a percent.
+    let fv2: f64 = out
+        .lines()
+        .find_map(|l| l.strip_prefix("Fv2 "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("no Fv2 in\n{out}"));
+    assert!((fv2 - 3.0).abs() < 0.03, "Fv2 = {fv2}\n{out}");
+
+    let o = run!(
+        "simulate",
+        ur5(),
+        "-o",
+        dir.join("x.csv"),
+        "--damping",
+        "1,2",
+        "--force"
+    );
+    assert_exit(&o, 2, "--damping: 2 values for 6 joints");
+    let o = run!(
+        "simulate",
+        ur5(),
+        "-o",
+        dir.join("x.csv"),
+        "--logger-period",
+        "0.01",
+        "--jitter",
+        "1.5",
+        "--force"
+    );
+    assert_exit(&o, 2, "--jitter must be in [0, 1)");
+}

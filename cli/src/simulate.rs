@@ -350,7 +350,7 @@ fn check_logger(l: &Logger) -> Result<()> {
         )));
     }
     if let Some(k) = &l.gains {
-        if k.iter().any(|&k| k == 0.0) {
+        if k.contains(&0.0) {
             return Err(CliError::usage("--current-gains must not be zero"));
         }
     }

@@ -361,6 +361,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     let robot = Reference::new(&model);
     let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
         .map_err(|e| pipeline_error(&args.data, e))?;
+    for w in &identified.warnings {
+        eprintln!("warning: {w}");
+    }
     match (&identified.prediction, &identified.mim) {
         (_, Some(mim)) => println!("{mim}"),
         (Prediction::Regressor(torque), None) => {

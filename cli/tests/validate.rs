@@ -224,3 +224,26 @@ fn simulated_logger_files_identify_their_friction() {
     );
     assert_exit(&o, 2, "--jitter must be in [0, 1)");
 }
+
+/// Total least squares on real-looking data: the fit is far worse than ordinary
+/// least squares, and `identify` says so instead of printing its numbers silently.
+#[test]
+fn tls_far_worse_than_ols_is_a_warning() {
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "sign",
+        "--method",
+        "tls"
+    );
+    assert_ok(&o);
+    let err = common::stderr(&o);
+    assert!(
+        err.contains("warning: total least squares fits the torques") && err.contains("prefer ols or wls"),
+        "{err}"
+    );
+    let o = run!("identify", ur5(), fixture("ur5_identify.csv"), "--friction", "sign");
+    assert!(!common::stderr(&o).contains("warning:"), "{}", common::stderr(&o));
+}

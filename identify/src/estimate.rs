@@ -39,6 +39,16 @@ pub struct ParamEstimate {
 }
 
 impl ParamEstimate {
+    /// Whether the value stands out of its own noise: `|value| ≥ σ`. An identifiable
+    /// parameter whose σ exceeds its value is estimated as "somewhere around zero"
+    /// and must not be read as a number. True where no σ is known.
+    pub fn is_significant(&self) -> bool {
+        match (self.value, self.sigma) {
+            (Some(v), Some(s)) => v.abs() >= s,
+            _ => true,
+        }
+    }
+
     /// `100 σ / |value|`, when both exist and the value is not zero.
     pub fn relative_sigma_percent(&self) -> Option<f64> {
         match (self.value, self.sigma) {
@@ -413,7 +423,8 @@ impl fmt::Display for Table<'_> {
                 .relative_sigma_percent()
                 .map_or_else(|| "—".to_string(), |r| format!("{r:.2}"));
             let note = match pe.status {
-                Status::Identified => String::new(),
+                Status::Identified if pe.is_significant() => String::new(),
+                Status::Identified => "not significant: σ exceeds the value".to_string(),
                 Status::InCombination => {
                     let ids: Vec<String> = groups
                         .iter()

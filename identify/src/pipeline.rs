@@ -267,7 +267,14 @@ pub struct Identification {
     /// The MIM estimate with its verdicts (and errors when the model is the truth).
     pub mim: Option<MimEstimate>,
     pub prediction: Prediction,
+    /// What the caller should know before trusting the numbers (e.g. a total least
+    /// squares fit far worse than ordinary least squares on the same data).
+    pub warnings: Vec<String>,
 }
+
+/// A TLS residual this many times the OLS residual means TLS's assumption (equal
+/// noise in every regressor column and the torques) does not hold for the data.
+pub const TLS_RESIDUAL_WARNING: f64 = 1.5;
 
 /// Identifies `dynamics`'s inertial parameters from `trajectory` (which must have
 /// velocities and accelerations: see [`load`]).
@@ -348,6 +355,19 @@ fn from_torques(
         Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
         Estimator::Consistent => acc.standard_consistent(&StandardOptions::default(), opts),
     }?;
+    let mut warnings = Vec::new();
+    if options.estimator == Estimator::Tls {
+        let ols = acc.ols(opts)?;
+        let ratio = estimate.residuals.rms / ols.residuals.rms;
+        if ratio > TLS_RESIDUAL_WARNING {
+            warnings.push(format!(
+                "total least squares fits the torques {ratio:.1}× worse than ordinary least squares (residual RMS \
+                 {:.4e} against {:.4e}): its assumption of equal noise in every regressor column and the torques \
+                 does not hold for these data, and its parameters can be far off; prefer ols or wls",
+                estimate.residuals.rms, ols.residuals.rms
+            ));
+        }
+    }
     let mut names = if principal {
         dyngen_model::names::principal_param_names(n)
     } else {
@@ -385,6 +405,7 @@ fn from_torques(
             estimate,
             truth: options.model_is_truth.then_some(nominal),
         })),
+        warnings,
     })
 }
 
@@ -447,6 +468,7 @@ fn by_mim(
         report: ParameterReport::from_mim(&model.name, &estimate),
         prediction: Prediction::Parameters(principal_params_to_standard(model, &theta)),
         mim: Some(estimate),
+        warnings: Vec::new(),
     })
 }
 
@@ -633,7 +655,12 @@ impl Identification {
             .parameters
             .get(k * body..k * (body + 1))
             .ok_or_else(|| format!("no body {body}"))?;
-        let missing = params.iter().filter(|p| p.status != ParamStatus::Identified).count();
+        // A value not out of its noise is still the data's best estimate of a
+        // parameter that is identifiable: a body with one is written.
+        let missing = params
+            .iter()
+            .filter(|p| !matches!(p.status, ParamStatus::Identified | ParamStatus::NotSignificant) || p.value.is_none())
+            .count();
         if missing > 0 {
             return Err(format!("{missing} of its {k} parameters not identified"));
         }

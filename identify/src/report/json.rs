@@ -92,8 +92,9 @@ pub enum ParamStatus {
     NoEffect,
     FromPrior,
     Constrained,
-    /// MIM: determined by the data but `|x̂| < kσ̂` ([`crate::mim::Verdict::NotSignificant`]);
-    /// no value.
+    /// Determined by the data but not out of its noise: MIM, `|x̂| < kσ̂`
+    /// ([`crate::mim::Verdict::NotSignificant`]), without a value; joint torques,
+    /// `|x̂| < σ̂`, with its value and σ for the record.
     NotSignificant,
 }
 
@@ -177,7 +178,11 @@ impl ParameterReport {
                 value: p.value.and_then(finite),
                 sigma: p.sigma.and_then(finite),
                 sigma_percent: p.relative_sigma_percent().and_then(finite),
-                status: p.status.into(),
+                status: if p.status == Status::Identified && !p.is_significant() {
+                    ParamStatus::NotSignificant
+                } else {
+                    p.status.into()
+                },
             })
             .collect();
         let combinations = estimate

@@ -232,6 +232,11 @@ pub struct RecipeArgs {
     /// Keep every N-th sample.
     #[arg(long, value_name = "N")]
     pub decimate: Option<String>,
+
+    /// Drop stale rows: rows that repeat every value of the row before under a new
+    /// time stamp (a logger that polled before the controller published).
+    #[arg(long)]
+    pub drop_stale: bool,
 }
 
 impl RecipeArgs {
@@ -249,6 +254,7 @@ impl RecipeArgs {
             ("--resample", "resample", self.resample.as_deref()),
             ("--window", "window", self.window.as_deref()),
             ("--decimate", "decimate", self.decimate.as_deref()),
+            ("--drop-stale", "stale", self.drop_stale.then_some("drop")),
         ];
         for (flag, key, value) in flags {
             if let Some(value) = value {

@@ -21,8 +21,8 @@ pub struct InfoArgs {
     #[command(flatten)]
     pub gravity: GravityArg,
 
-    /// Skip the base parameters and operation counts (they need a full code
-    /// generation, which takes a few seconds for a 6–7 DOF arm).
+    /// Skip the operation counts (they need a full code generation, which takes a
+    /// few seconds for a 6–7 DOF arm; the base parameters do not).
     #[arg(long)]
     pub no_ops: bool,
 }
@@ -45,19 +45,11 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         4 * n
     )
     .ok();
-    if args.no_ops || n == 0 {
+    if n == 0 {
         print!("{out}");
         return Ok(());
     }
-    let (bases, generated) = with_spinner(
-        progress,
-        "generating code for the base parameters and op counts",
-        || {
-            let bases = analyse_model(&model);
-            let generated = generate(&model, "Robot", &bases, &Options::default());
-            (bases, generated)
-        },
-    );
+    let bases = with_spinner(progress, "finding the base parameters", || analyse_model(&model));
     let base = &bases.standard;
     let pbase = &bases.principal;
     writeln!(
@@ -77,16 +69,23 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         ("Base parameters (principal)", pbase),
     ] {
         writeln!(out).ok();
-        let note = if b.confirmed {
-            ""
-        } else {
-            " (not confirmed by a second random seed)"
+        let note = match (b.confirmed, b.rank_check == b.count()) {
+            (true, true) => String::new(),
+            (false, _) => " (not confirmed by a second random seed)".to_string(),
+            (true, false) => format!(" (the singular values give rank {} instead)", b.rank_check),
         };
         writeln!(out, "{title}{note}").ok();
         for (k, g) in b.groupings.iter().enumerate() {
             writeln!(out, "  {:>3}  {g}", k + 1).ok();
         }
     }
+    if args.no_ops {
+        print!("{out}");
+        return Ok(());
+    }
+    let generated = with_spinner(progress, "generating code for the op counts", || {
+        generate(&model, "Robot", &bases, &Options::default())
+    });
     writeln!(out).ok();
     writeln!(out, "Generated functions (operation counts)").ok();
     for line in generated.op_report().lines() {

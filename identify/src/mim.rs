@@ -9,13 +9,15 @@
 //! * [`samples`]: every body by least squares over a range of samples;
 //! * [`whole_robot`]: the whole robot as one block-diagonal problem (the paper's
 //!   eq. 19–20);
-//! * [`torque_principal`], [`torque_principal_base`]: from joint torques alone,
-//!   `τ = Y_θ θ` (or the generated principal base regressor), saying which `θ` are
-//!   identifiable alone and which only in combinations;
-//! * [`torque_standard`]: the standard parameters from joint torques, i.e. the base
-//!   parameters, with rank handling.
+//! * [`torque`] with [`TorqueRegressor::Principal`], and [`torque_principal_base`]:
+//!   from joint torques alone, `τ = Y_θ θ` (or the generated principal base
+//!   regressor), saying which `θ` are identifiable alone and which only in
+//!   combinations;
+//! * [`torque`] with [`TorqueRegressor::Standard`] (or `StandardAndJoints`, with
+//!   friction and rotor inertia): the standard parameters from joint torques, i.e.
+//!   the base parameters, with rank handling.
 //!
-//! Rank is explicit (every solve goes through [`crate::identify`]): a parameter the
+//! Rank is explicit (every solve goes through the estimators of this crate): a parameter the
 //! data do not determine — e.g. the `J1`, `J2` of a turret that only turns about its
 //! `z` axis, which never enter `B(ω, ω̇)` — is reported as not identifiable, never as
 //! a number. On noisy data a column that carries only noise (the turret's `J1` column
@@ -555,6 +557,21 @@ impl TorqueRegressor {
         }
     }
 
+    /// The names of the parameters, `columns(n)` of them ([`dyngen_model::names`],
+    /// [`dyngen_model::joint_params`]; `β1, β2, …` for a generated base regressor).
+    pub fn names(&self, n: usize) -> Vec<String> {
+        match self {
+            TorqueRegressor::Standard => standard_param_names(n),
+            TorqueRegressor::Principal => principal_param_names(n),
+            TorqueRegressor::PrincipalBase { columns, .. } => (1..=*columns).map(|k| format!("β{k}")).collect(),
+            TorqueRegressor::StandardAndJoints(_) => {
+                let mut names = standard_param_names(n);
+                names.extend(dyngen_model::joint_params::joint_param_names(n));
+                names
+            }
+        }
+    }
+
     /// The regressor at `(q, v, a)`, row-major into `y` (`n × columns`).
     pub fn eval(&self, dynamics: &dyn Dynamics, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
         match self {
@@ -771,29 +788,25 @@ fn torque_estimate(
     })
 }
 
-/// MIM from joint torques alone through the principal regressor `τ = Y_θ θ`
-/// ([`Dynamics::principal_regressor`]): the rank and the identifiable combinations
-/// come from the data ([`Estimate::combinations`]); each `θ` is reported as
-/// identifiable alone, only in combination, or without effect. `truth`: `θ` (`4n`).
-pub fn torque_principal(
+/// Identification from joint torques through `regressor` with rank handling: the
+/// identifiable combinations come from the data ([`Estimate::combinations`]); each
+/// parameter is reported as identifiable alone, only in combination, or without
+/// effect. [`TorqueRegressor::Standard`]: `τ = Y π`, the combinations are the base
+/// parameters; [`TorqueRegressor::Principal`]: the paper's MIM from joint torques
+/// alone, `τ = Y_θ θ`; [`TorqueRegressor::StandardAndJoints`]: a real robot's
+/// torques, with rotor inertia and friction per joint. `truth`: in the regressor's
+/// parameters ([`TorqueRegressor::names`]).
+pub fn torque(
     dynamics: &dyn Dynamics,
     recording: &Recording,
     range: Range<usize>,
+    regressor: TorqueRegressor,
     truth: Option<&[f64]>,
     weighting: Weighting,
     opts: &Options,
 ) -> Result<TorqueEstimate, IdentifyError> {
-    let names = principal_param_names(dynamics.nv());
-    torque_estimate(
-        dynamics,
-        recording,
-        range,
-        TorqueRegressor::Principal,
-        names,
-        truth,
-        weighting,
-        opts,
-    )
+    let names = regressor.names(dynamics.nv());
+    torque_estimate(dynamics, recording, range, regressor, names, truth, weighting, opts)
 }
 
 /// MIM from joint torques through a generated robot's principal base regressor: the
@@ -822,59 +835,6 @@ pub fn torque_principal_base<R: Robot>(
         regressor,
         names,
         Some(&truth),
-        weighting,
-        opts,
-    )
-}
-
-/// Identification of a real robot's joint torques: the standard parameters and, per
-/// joint, rotor inertia, viscous and Coulomb friction and an offset
-/// ([`TorqueRegressor::StandardAndJoints`]), with rank handling. `truth`: `14n`
-/// (`10n` standard parameters, then `[Ia, Fv, Fc, F0]` per joint).
-#[allow(clippy::too_many_arguments)]
-pub fn torque_with_joints(
-    dynamics: &dyn Dynamics,
-    recording: &Recording,
-    range: Range<usize>,
-    coulomb: Coulomb,
-    truth: Option<&[f64]>,
-    weighting: Weighting,
-    opts: &Options,
-) -> Result<TorqueEstimate, IdentifyError> {
-    let n = dynamics.nv();
-    let mut names = standard_param_names(n);
-    names.extend(dyngen_model::joint_params::joint_param_names(n));
-    torque_estimate(
-        dynamics,
-        recording,
-        range,
-        TorqueRegressor::StandardAndJoints(coulomb),
-        names,
-        truth,
-        weighting,
-        opts,
-    )
-}
-
-/// Standard-parameter identification from joint torques (`τ = Y π`,
-/// [`Dynamics::joint_torque_regressor`]) with rank handling: the identifiable
-/// combinations are the base parameters. `truth`: `π` (`10n`).
-pub fn torque_standard(
-    dynamics: &dyn Dynamics,
-    recording: &Recording,
-    range: Range<usize>,
-    truth: Option<&[f64]>,
-    weighting: Weighting,
-    opts: &Options,
-) -> Result<TorqueEstimate, IdentifyError> {
-    let names = standard_param_names(dynamics.nv());
-    torque_estimate(
-        dynamics,
-        recording,
-        range,
-        TorqueRegressor::Standard,
-        names,
-        truth,
         weighting,
         opts,
     )

@@ -291,16 +291,7 @@ pub fn identify(
             found: trajectory.dof(),
         });
     }
-    if trajectory.velocities().is_none() || trajectory.accelerations().is_none() {
-        return Err(PipelineError::Data {
-            path: None,
-            error: DataError::MissingGroup {
-                group: "velocities and accelerations",
-                columns: "v1.., a1..".into(),
-                needed_for: "the regressor (estimate them first: pipeline::load)",
-            },
-        });
-    }
+    need_derivatives(trajectory)?;
     match options.mode {
         Mode::Standard | Mode::Principal => from_torques(dynamics, trajectory, options),
         Mode::Mim => by_mim(dynamics, trajectory, options),
@@ -472,6 +463,21 @@ fn by_mim(
     })
 }
 
+/// Refuses a trajectory without velocities or accelerations: the regressor needs them.
+fn need_derivatives(trajectory: &Trajectory) -> Result<(), PipelineError> {
+    if trajectory.velocities().is_none() || trajectory.accelerations().is_none() {
+        return Err(PipelineError::Data {
+            path: None,
+            error: DataError::MissingGroup {
+                group: "velocities and accelerations",
+                columns: "v1.., a1..".into(),
+                needed_for: "the regressor (estimate them first: pipeline::load)",
+            },
+        });
+    }
+    Ok(())
+}
+
 /// `(q, v, a)` of sample `k`; [`identify`] checked that `v` and `a` exist.
 fn state(traj: &Trajectory, k: usize) -> (&[f64], &[f64], &[f64]) {
     (traj.q(k), traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]))
@@ -536,16 +542,7 @@ pub fn predict_with(
             reason: format!("entry {k} of the solution is not finite"),
         });
     }
-    if trajectory.velocities().is_none() || trajectory.accelerations().is_none() {
-        return Err(PipelineError::Data {
-            path: None,
-            error: DataError::MissingGroup {
-                group: "velocities and accelerations",
-                columns: "v1.., a1..".into(),
-                needed_for: "the regressor (estimate them first: pipeline::load)",
-            },
-        });
-    }
+    need_derivatives(trajectory)?;
     let mut y = vec![0.0; n * p];
     Ok((0..trajectory.len())
         .map(|k| {

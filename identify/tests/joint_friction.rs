@@ -49,16 +49,49 @@ fn recording(robot: &Reference, seed: u64, times: &[f64]) -> Recording {
     rec
 }
 
+/// 1 % of each joint's RMS torque as Gaussian noise on the torques (or currents).
+fn add_torque_noise(rec: &mut Recording, noise: &mut Gaussian) -> Vec<f64> {
+    let rms: Vec<f64> = (0..6)
+        .map(|j| (rec.samples.iter().map(|s| s.tau[j] * s.tau[j]).sum::<f64>() / rec.len() as f64).sqrt())
+        .collect();
+    let sigma: Vec<f64> = rms.iter().map(|r| 0.01 * r).collect();
+    for s in &mut rec.samples {
+        for j in 0..6 {
+            s.tau[j] += noise.normal(sigma[j]);
+        }
+    }
+    sigma
+}
+
+/// A file `Logger::write` wrote, read back with velocities and accelerations;
+/// `gains` when the last columns are currents to turn into torques. Stale rows (old
+/// values under a new stamp) would put q and τ at the wrong time: they are dropped.
+fn read_log(text: &str, gains: Option<&str>) -> dyngen_identify::data::Trajectory {
+    let mut recipe = Recipe::default();
+    for (key, value) in [("q", "2-7"), ("v", "8-13"), ("tau", "14-19"), ("stale", "drop")] {
+        recipe.set(key, value).unwrap();
+    }
+    if let Some(g) = gains {
+        recipe.set("gains", g).unwrap();
+    }
+    recipe
+        .read_from(text.as_bytes(), Some(6))
+        .unwrap()
+        .with_derivatives(5.0)
+        .unwrap()
+        .trajectory
+}
+
 #[test]
 fn noise_free_identification_recovers_friction_and_rotor_inertia() {
     let robot = robot();
     let times: Vec<f64> = (0..2000).map(|k| 0.01 * k as f64).collect();
     let rec = recording(&robot, 1, &times);
-    let est = mim::torque_with_joints(
+    let est = mim::torque(
         &robot,
         &rec,
         0..rec.len(),
-        Coulomb::Sign,
+        TorqueRegressor::StandardAndJoints(Coulomb::Sign),
         None,
         Weighting::Ols,
         &Options::default(),
@@ -114,34 +147,10 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
     let times = logger.times(300.0);
     let mut rec = recording(&robot, 1, &times);
     // 1 % of each joint's RMS torque, as the noise floor.
-    let rms: Vec<f64> = (0..6)
-        .map(|j| (rec.samples.iter().map(|s| s.tau[j] * s.tau[j]).sum::<f64>() / rec.len() as f64).sqrt())
-        .collect();
-    let sigma: Vec<f64> = rms.iter().map(|r| 0.01 * r).collect();
     let mut noise = Gaussian::new(5);
-    for s in &mut rec.samples {
-        for j in 0..6 {
-            s.tau[j] += noise.normal(sigma[j]);
-        }
-    }
-    let text = logger.write(&rec);
-    let mut recipe = Recipe::default();
-    // Stale rows (old values under a new stamp) would put q and τ at the wrong time.
-    for (key, value) in [
-        ("q", "2-7"),
-        ("v", "8-13"),
-        ("tau", "14-19"),
-        ("gains", "14,13,12,9,8.5,8"),
-        ("stale", "drop"),
-    ] {
-        recipe.set(key, value).unwrap();
-    }
-    let loaded = recipe
-        .read_from(text.as_bytes(), Some(6))
-        .unwrap()
-        .with_derivatives(5.0)
-        .unwrap();
-    let traj = &loaded.trajectory;
+    let sigma = add_torque_noise(&mut rec, &mut noise);
+    let loaded = read_log(&logger.write(&rec), Some("14,13,12,9,8.5,8"));
+    let traj = &loaded;
     let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign);
     let p = regressor.columns(6);
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(6)).unwrap();
@@ -255,25 +264,9 @@ fn drive_gains_from_a_known_payload() {
         let times = logger.times(120.0);
         let mut rec = record_trajectory(&robot, params, &motion(seed), &times);
         add_joint_terms(&mut rec, &joint_truth(), Coulomb::Sign);
-        let rms: Vec<f64> = (0..6)
-            .map(|j| (rec.samples.iter().map(|s| s.tau[j] * s.tau[j]).sum::<f64>() / rec.len() as f64).sqrt())
-            .collect();
-        for s in &mut rec.samples {
-            for j in 0..6 {
-                s.tau[j] += noise.normal(0.01 * rms[j]);
-            }
-        }
-        let mut recipe = Recipe::default();
+        add_torque_noise(&mut rec, &mut noise);
         // Currents as they are: the gains are what is sought.
-        for (key, value) in [("q", "2-7"), ("v", "8-13"), ("tau", "14-19"), ("stale", "drop")] {
-            recipe.set(key, value).unwrap();
-        }
-        recipe
-            .read_from(logger.write(&rec).as_bytes(), Some(6))
-            .unwrap()
-            .with_derivatives(5.0)
-            .unwrap()
-            .trajectory
+        read_log(&logger.write(&rec), None)
     };
     let unloaded = log(&nominal, 1);
     let loaded = log(&loaded_params, 3);

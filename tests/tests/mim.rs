@@ -208,10 +208,11 @@ fn paper6_from_joint_torques_says_what_is_identifiable() {
     let (robot, recording) = paper6_recording();
     let truth = Paper6::nominal_theta();
     let all = 0..recording.len();
-    let est = mim::torque_principal(
+    let est = mim::torque(
         &robot,
         &recording,
         all.clone(),
+        mim::TorqueRegressor::Principal,
         Some(truth),
         Weighting::Ols,
         &Options::default(),
@@ -283,10 +284,11 @@ fn torque_identification<R: Robot>(evaluations: usize) {
     let clean_val = record_trajectory(&robot, params, &validation.excitation, &times(200));
     let validation_measured = noise.apply(&clean_val, 12);
 
-    let est = mim::torque_standard(
+    let est = mim::torque(
         &robot,
         &measured,
         0..measured.len(),
+        mim::TorqueRegressor::Standard,
         Some(params),
         Weighting::WlsIterated(20),
         &Options::default(),

@@ -153,16 +153,8 @@ pub struct IdentifyArgs {
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub lambda: f64,
 
-    /// Low-pass cutoff, Hz, for velocities and accelerations estimated from
-    /// positions (only used when the file has no v or a columns).
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
-    pub cutoff: f64,
-
     #[command(flatten)]
-    pub gravity: GravityArg,
-
-    #[command(flatten)]
-    pub recipe: RecipeArgs,
+    pub recording: RecordingArgs,
 
     /// Write the estimate as JSON (schema dyngen-parameters/1) to this file.
     #[arg(long, value_name = "FILE")]
@@ -191,6 +183,29 @@ pub struct IdentifyArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
+}
+
+/// The robot's gravity and how to read and differentiate a recording: shared by the
+/// commands that read one.
+#[derive(Debug, clap::Args)]
+pub struct RecordingArgs {
+    /// Low-pass cutoff, Hz, for velocities and accelerations estimated from
+    /// positions (only used when the file has no v or a columns).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub cutoff: f64,
+
+    #[command(flatten)]
+    pub gravity: GravityArg,
+
+    #[command(flatten)]
+    pub recipe: RecipeArgs,
+}
+
+impl RecordingArgs {
+    /// Loads `path` as these flags say (see [`load_recording`]).
+    pub fn load(&self, path: &Path, dof: usize) -> Result<Trajectory> {
+        load_recording(path, &self.recipe, dof, self.cutoff)
+    }
 }
 
 /// How to read a recording that is not in dyngen's own CSV schema: a recipe file,
@@ -330,7 +345,7 @@ impl IdentifyArgs {
                 Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
                 Friction::Auto => JointTerms::FrictionAuto,
             },
-            cutoff_hz: self.cutoff,
+            cutoff_hz: self.recording.cutoff,
             model_is_truth: self.truth_from_urdf,
             ..IdentifyOptions::default()
         }
@@ -357,9 +372,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     let options = args.options();
     options.check().map_err(|e| pipeline_error(&args.data, e))?;
     check_outputs(args)?;
-    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?)?;
     let n = model.dof();
-    let traj = load_recording(&args.data, &args.recipe, n, args.cutoff)?;
+    let traj = args.recording.load(&args.data, n)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
         return Err(pipeline_error(&args.data, PipelineError::MissingWrenches { dof: n }));
     }
@@ -397,7 +412,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         write_urdf(args, path, &model, &identified)?;
     }
     if let Some(path) = &args.validate {
-        let other = load_recording(path, &args.recipe, n, args.cutoff)?;
+        let other = args.recording.load(path, n)?;
         let predicted = with_spinner(progress, "predicting the validation recording", || {
             identified.predict(&robot, &other)
         })

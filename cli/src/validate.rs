@@ -2,9 +2,9 @@
 //! (the JSON `identify --params-json` writes) and reports the errors per joint and
 //! overall, optionally as an SVG of measured against predicted torque.
 
-use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, Progress, Result};
 use crate::error::CliError;
-use crate::identify::{load_recording, pipeline_error, RecipeArgs};
+use crate::identify::{pipeline_error, RecordingArgs};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::pipeline;
 use dyngen_identify::report::{self, ParameterReport};
@@ -33,16 +33,8 @@ pub struct ValidateArgs {
     /// The recording to predict.
     pub data: PathBuf,
 
-    /// Low-pass cutoff, Hz, for velocities and accelerations estimated from
-    /// positions (only used when the file has no v or a columns).
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
-    pub cutoff: f64,
-
     #[command(flatten)]
-    pub gravity: GravityArg,
-
-    #[command(flatten)]
-    pub recipe: RecipeArgs,
+    pub recording: RecordingArgs,
 
     /// Write measured against predicted torque per joint as SVG.
     #[arg(long, value_name = "FILE")]
@@ -68,7 +60,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     if let Some(svg) = &args.svg {
         check_overwrite(svg, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?)?;
     let text = std::fs::read_to_string(&args.params).map_err(|e| CliError::input(&args.params, e))?;
     let params = ParameterReport::from_json(&text).map_err(|e| CliError::input(&args.params, e))?;
     let prediction = params.prediction.as_ref().ok_or_else(|| {
@@ -84,7 +76,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
             params.robot, model.name
         );
     }
-    let data = load_recording(&args.data, &args.recipe, model.dof(), args.cutoff)?;
+    let data = args.recording.load(&args.data, model.dof())?;
     let robot = Reference::new(&model);
     let predicted = pipeline::predict_with(prediction, &robot, &data).map_err(|e| match e {
         pipeline::PipelineError::InvalidOption { reason, .. } => CliError::input(&args.params, reason),

@@ -5,7 +5,7 @@ use crate::common::{Progress, Result};
 use crate::error::CliError;
 use crate::svg;
 use clap::Args;
-use dyngen_paper::{Corner, Hooks, LineChart, PaperError};
+use dyngen_paper::{Hooks, LineChart, PaperError};
 use indicatif::ProgressBar;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -83,19 +83,7 @@ impl Hooks for Terminal<'_> {
     }
 
     fn draw(&self, chart: &LineChart<'_>) -> Option<std::result::Result<String, String>> {
-        let chart = svg::LineChart {
-            title: chart.title,
-            x_label: chart.x_label,
-            y_label: chart.y_label,
-            log_y: chart.log_y,
-            curves: chart.curves,
-            reference: chart.reference,
-            legend: match chart.legend {
-                Corner::UpperRight => svg::Corner::UpperRight,
-                Corner::LowerRight => svg::Corner::LowerRight,
-            },
-        };
-        Some(svg::svg_lines(&chart).map_err(|e| e.to_string()))
+        Some(svg::svg_lines(chart).map_err(|e| e.to_string()))
     }
 }
 

@@ -307,29 +307,7 @@ fn error_chart(area: &DrawingArea<SVGBackend<'_>, Shift>, errors: &[(String, Opt
     Ok(())
 }
 
-/// A chart of lines, for [`svg_lines`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct LineChart<'a> {
-    pub title: &'a str,
-    pub x_label: &'a str,
-    pub y_label: &'a str,
-    /// A logarithmic y axis (every y must then be > 0).
-    pub log_y: bool,
-    /// `(name, [(x, y)])` per line.
-    pub curves: &'a [(String, Vec<(f64, f64)>)],
-    /// A horizontal reference line: `(name, y)`.
-    pub reference: Option<(&'a str, f64)>,
-    /// Where the legend goes (pick the corner the lines leave free).
-    pub legend: Corner,
-}
-
-/// A corner of a chart, for its legend.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Corner {
-    #[default]
-    UpperRight,
-    LowerRight,
-}
+pub use dyngen_identify::report::{Corner, LineChart};
 
 /// Lines against a common x axis, e.g. the paper's Fig. 5 (MSE against training
 /// step, log scale) or estimates against time. Non-finite points, and points with

@@ -111,24 +111,7 @@ fn failed(e: impl fmt::Display) -> PaperError {
     PaperError::Failed(e.to_string())
 }
 
-/// Where a line chart puts its legend.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Corner {
-    UpperRight,
-    LowerRight,
-}
-
-/// A figure: curves of `(x, y)` points, optionally a horizontal reference line.
-#[derive(Clone, Debug)]
-pub struct LineChart<'a> {
-    pub title: &'a str,
-    pub x_label: &'a str,
-    pub y_label: &'a str,
-    pub log_y: bool,
-    pub curves: &'a [(String, Vec<(f64, f64)>)],
-    pub reference: Option<(&'a str, f64)>,
-    pub legend: Corner,
-}
+pub use dyngen_identify::report::{Corner, LineChart};
 
 /// What a front end supplies: progress reporting and drawing. Every method has a
 /// default that does nothing (and draws nothing: then `Options::out` is refused).

@@ -5,10 +5,12 @@
 //! Each output is built as a string with no I/O; [`write_new`] writes it and never
 //! replaces an existing file unless asked to.
 
+mod chart;
 mod error;
 mod json;
 mod urdf;
 
+pub use chart::{Corner, LineChart};
 pub use error::ReportError;
 pub use json::{
     CombinationReport, CoulombReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, PredictionModel,

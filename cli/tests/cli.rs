@@ -136,20 +136,7 @@ fn bad_inputs_name_the_file_and_line() {
     assert_error(&run!("info", missing), "missing.urdf");
 
     // A URDF with a negative mass in the link on line 3.
-    let broken = dir.join("broken.urdf");
-    std::fs::write(
-        &broken,
-        r#"<robot name="broken">
-  <link name="base"/>
-  <link name="arm"><inertial>
-    <mass value="-1"/><origin xyz="0 0 -0.5"/>
-    <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
-    <axis xyz="0 1 0"/></joint>
-</robot>
-"#,
-    )
-    .unwrap();
+    let broken = common::pendulum(&dir, "broken.urdf", "-1");
     // The error points at the link (line 3) and says what is wrong.
     let o = run!("info", broken);
     assert_error(&o, "broken.urdf:3: link `arm`: mass -1 is not positive");
@@ -159,19 +146,7 @@ fn bad_inputs_name_the_file_and_line() {
     // A CSV with a bad number on line 3.
     let csv = dir.join("bad.csv");
     std::fs::write(&csv, "t,q1,tau1\n0,0,0\n0.01,oops,0\n0.02,0,0\n").unwrap();
-    let pendulum = dir.join("pendulum.urdf");
-    std::fs::write(
-        &pendulum,
-        r#"<robot name="pendulum">
-  <link name="base"/>
-  <link name="arm"><inertial><mass value="1"/><origin xyz="0 0 -0.5"/>
-    <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
-    <axis xyz="0 1 0"/></joint>
-</robot>
-"#,
-    )
-    .unwrap();
+    let pendulum = common::pendulum(&dir, "pendulum.urdf", "1");
     assert_error(&run!("identify", pendulum, csv), "line 3, column `q1`");
     assert_error(&run!("identify", pendulum, dir.join("nope.csv")), "nope.csv");
     // The ur5 needs six joints.

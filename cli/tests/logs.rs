@@ -99,19 +99,7 @@ fn identify_reads_a_raw_log_through_flags_or_a_recipe() {
 #[test]
 fn log_errors_name_the_line_column_or_flag() {
     let dir = temp_dir("dyngen-logs", "errors");
-    let pendulum = dir.join("pendulum.urdf");
-    std::fs::write(
-        &pendulum,
-        r#"<robot name="pendulum">
-  <link name="base"/>
-  <link name="arm"><inertial><mass value="1"/><origin xyz="0 0 -0.5"/>
-    <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
-    <axis xyz="0 1 0"/></joint>
-</robot>
-"#,
-    )
-    .unwrap();
+    let pendulum = common::pendulum(&dir, "pendulum.urdf", "1");
     let log = dir.join("p.log");
     std::fs::write(&log, "0;0;0\n0.01;inf;0\n0.02;0;0\n").unwrap();
     assert_error(

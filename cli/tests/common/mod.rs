@@ -8,6 +8,29 @@ pub fn ur5() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf")
 }
 
+/// A one-link pendulum URDF of the given mass (`"1"`; `"-1"` for a broken one)
+/// written to `dir/name`; its `<link name="arm">` is on line 3.
+pub fn pendulum(dir: &Path, name: &str, mass: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(
+        &path,
+        format!(
+            r#"<robot name="{}">
+  <link name="base"/>
+  <link name="arm"><inertial>
+    <mass value="{mass}"/><origin xyz="0 0 -0.5"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>
+"#,
+            name.trim_end_matches(".urdf")
+        ),
+    )
+    .unwrap();
+    path
+}
+
 /// A fresh directory for one test, under `group`.
 pub fn temp_dir(group: &str, name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(group).join(name);

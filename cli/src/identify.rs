@@ -391,6 +391,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
             println!("{}", torque.estimate.table(&names));
             print_fit(&torque.estimate);
+            if args.mode == Mode::Standard && args.friction == Friction::None {
+                hint_friction(&torque.estimate, &traj);
+            }
             if args.truth_from_urdf {
                 print_errors(&identified, &model);
             }
@@ -555,6 +558,33 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
 }
 
 /// Torque residuals per joint and relative to the measured torques.
+/// Rigid bodies alone leave a real robot's friction in the residual: say so when the
+/// residual of a joint is a noticeable part of its torque.
+fn hint_friction(estimate: &Estimate, traj: &Trajectory) {
+    let n = traj.dof();
+    let worst = (0..n)
+        .filter_map(|j| {
+            let rms = ((0..traj.len()).map(|k| traj.tau(k)[j].powi(2)).sum::<f64>() / traj.len() as f64).sqrt();
+            let r = *estimate.residuals.per_channel_rms.get(j)?;
+            (rms > 0.0).then_some((r / rms, j))
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((ratio, j)) = worst {
+        if ratio > FRICTION_HINT {
+            println!(
+                "note: rigid bodies alone leave {:.0} % of joint {}'s torque unexplained; a real robot's joints add \
+                 friction and rotor inertia: try --friction auto",
+                100.0 * ratio,
+                j + 1
+            );
+        }
+    }
+}
+
+/// A joint's residual RMS above this fraction of its torque RMS prompts the
+/// friction hint.
+const FRICTION_HINT: f64 = 0.05;
+
 fn print_fit(estimate: &Estimate) {
     let r = &estimate.residuals;
     let per_joint: Vec<String> = r.per_channel_rms.iter().map(|x| format!("{x:.3e}")).collect();

@@ -75,6 +75,8 @@ fn friction_identification_predicts_the_mujoco_recording_better_than_the_baselin
     let rigid = overall(&stdout(&o));
     assert!(rigid > 5.0 * with_friction, "{rigid} vs {with_friction}");
     assert!(stdout(&o).contains("(no better than zero)"), "{}", stdout(&o));
+    // ...and `identify` says what to do about it.
+    assert!(stdout(&o).contains("try --friction auto"), "{}", stdout(&o));
 }
 
 #[test]

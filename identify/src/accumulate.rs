@@ -364,7 +364,7 @@ fn fold_rows(p: usize) -> usize {
 
 /// The machine's core count, asked once: `available_parallelism` reads cgroup files
 /// on every call, far too slow for a path taken once per pushed row.
-fn cores() -> usize {
+pub(crate) fn cores() -> usize {
     static CORES: OnceLock<usize> = OnceLock::new();
     *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |t| t.get()))
 }

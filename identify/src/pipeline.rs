@@ -411,16 +411,39 @@ fn accumulate(
     let n = dynamics.nv();
     let p = regressor.columns(n);
     let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation)?;
-    let mut y = vec![0.0; n * p];
-    for k in (0..traj.len()).step_by(stride) {
-        let (q, v, a) = state(traj, k);
-        regressor.eval(dynamics, q, v, a, &mut y);
-        for j in 0..n {
-            acc.push_row(&y[j * p..(j + 1) * p], traj.tau(k)[j])
-                .map_err(|error| PipelineError::Identify {
+    // The regressor rows of a batch of samples are computed on every core, then
+    // pushed in sample order (the channels interleave joint by joint).
+    let threads = crate::accumulate::cores().clamp(1, 8);
+    let samples: Vec<usize> = (0..traj.len()).step_by(stride).collect();
+    let per_thread = 256;
+    for batch in samples.chunks(threads * per_thread) {
+        let parts: Vec<Vec<f64>> = std::thread::scope(|s| {
+            let handles: Vec<_> = batch
+                .chunks(per_thread)
+                .map(|part| {
+                    s.spawn(move || {
+                        let mut rows = vec![0.0; part.len() * n * p];
+                        for (i, &k) in part.iter().enumerate() {
+                            let (q, v, a) = state(traj, k);
+                            regressor.eval(dynamics, q, v, a, &mut rows[i * n * p..(i + 1) * n * p]);
+                        }
+                        rows
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        });
+        for (part, rows) in batch.chunks(per_thread).zip(&parts) {
+            for (i, &k) in part.iter().enumerate() {
+                let y = faer::MatRef::from_row_major_slice(&rows[i * n * p..(i + 1) * n * p], n, p);
+                acc.push_rows(y, traj.tau(k)).map_err(|error| PipelineError::Identify {
                     at: Some(traj.location(k)),
                     error,
                 })?;
+            }
         }
     }
     Ok(acc)

@@ -18,7 +18,7 @@ use std::marker::PhantomData;
 /// Rigid-body algorithms over one checked [`Model`], in `f64`. Implemented by
 /// [`Reference`] (any model, allocates) and by [`Generated`] (a generated robot's
 /// unrolled code). Every method panics when a slice has the wrong length.
-pub trait Dynamics {
+pub trait Dynamics: Sync {
     /// The checked model, gravity included: the description the algorithms use.
     fn model(&self) -> &Model;
 

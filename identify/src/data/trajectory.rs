@@ -166,18 +166,19 @@ impl Trajectory {
             return Err(DataError::TooFewSamples { found: n, needed: 2 });
         }
         for k in 0..n {
-            let finite = |column: String, value: f64| {
+            // The column's name is only built for the error: checking allocates nothing.
+            let finite = |column: &dyn Fn() -> String, value: f64| {
                 if value.is_finite() {
                     Ok(())
                 } else {
                     Err(DataError::NonFinite {
                         at: self.location(k),
-                        column,
+                        column: column(),
                         value,
                     })
                 }
             };
-            finite("t".into(), self.t[k])?;
+            finite(&|| "t".into(), self.t[k])?;
             let groups = [
                 ("q", Some(&self.q)),
                 ("v", self.v.as_ref()),
@@ -187,7 +188,7 @@ impl Trajectory {
             for (name, values) in groups {
                 if let Some(values) = values {
                     for j in 0..dof {
-                        finite(format!("{name}{}", j + 1), values[k * dof + j])?;
+                        finite(&|| format!("{name}{}", j + 1), values[k * dof + j])?;
                     }
                 }
             }
@@ -195,10 +196,10 @@ impl Trajectory {
                 for j in 0..dof {
                     let w = &w[k * dof + j];
                     for (axis, x) in ["x", "y", "z"].iter().zip(w.force.iter()) {
-                        finite(format!("f{axis}{}", j + 1), *x)?;
+                        finite(&|| format!("f{axis}{}", j + 1), *x)?;
                     }
                     for (axis, x) in ["x", "y", "z"].iter().zip(w.torque.iter()) {
-                        finite(format!("m{axis}{}", j + 1), *x)?;
+                        finite(&|| format!("m{axis}{}", j + 1), *x)?;
                     }
                 }
             }

@@ -523,8 +523,9 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
     report::write_new(path, &rewrite.text, args.force).map_err(|e| CliError::report(path, e))?;
     if rewrite.updated.is_empty() {
         println!(
-            "wrote {} unchanged: no body has all its parameters identified, so every inertial is the URDF's",
-            path.display()
+            "wrote {}{}: no body has all its parameters identified, so every inertial is the URDF's",
+            path.display(),
+            if rewrite.dynamics.is_empty() { " unchanged" } else { "" }
         );
     } else {
         let names: Vec<&str> = rewrite.updated.iter().map(|(n, _)| n.as_str()).collect();
@@ -533,6 +534,17 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
             path.display(),
             names.join(", ")
         );
+    }
+    if !rewrite.dynamics.is_empty() {
+        let joints: Vec<String> = rewrite
+            .dynamics
+            .iter()
+            .map(|(j, fv, fc)| format!("{j} (Fv {fv:.4}, Fc {fc:.4})"))
+            .collect();
+        println!("with the identified <dynamics> of {}", joints.join(", "));
+    }
+    for (joint, why) in &rewrite.dynamics_kept {
+        println!("note: kept the URDF's <dynamics> of {joint}: {why}");
     }
     if !rewrite.kept.is_empty() {
         let kept: Vec<String> = rewrite

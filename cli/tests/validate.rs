@@ -28,6 +28,7 @@ fn overall(out: &str) -> f64 {
 fn friction_identification_predicts_the_mujoco_recording_better_than_the_baseline() {
     let dir = temp_dir("dyngen-validate", "mujoco");
     let params = dir.join("ur5.json");
+    let urdf_out = dir.join("ur5-identified.urdf");
     let o = run!(
         "identify",
         ur5(),
@@ -36,6 +37,8 @@ fn friction_identification_predicts_the_mujoco_recording_better_than_the_baselin
         "auto",
         "--cutoff",
         "5",
+        "--urdf-out",
+        &urdf_out,
         "--params-json",
         &params,
         "--validate",
@@ -45,6 +48,20 @@ fn friction_identification_predicts_the_mujoco_recording_better_than_the_baselin
     assert_ok(&o);
     let with_friction = overall(&stdout(&o));
     assert!(with_friction < 0.0358, "{}", stdout(&o));
+    // The identified friction is written to the joints' <dynamics>: MuJoCo's
+    // damping 3, 3, 2, 0.6, 0.6, 0.6 and frictionloss 6, 6, 4, 1.5, 1.5, 1.5.
+    let model = dyngen_model::load_urdf(&urdf_out).unwrap();
+    for (j, (fv, fc)) in [(3.0, 6.0), (3.0, 6.0), (2.0, 4.0), (0.6, 1.5), (0.6, 1.5), (0.6, 1.5)]
+        .iter()
+        .enumerate()
+    {
+        let d = model.joints[j].dynamics;
+        assert!(
+            (d.damping - fv).abs() < 0.3 * fv && (d.friction - fc).abs() < 0.1 * fc,
+            "joint {}: {d:?}",
+            j + 1
+        );
+    }
 
     // The same through the JSON, with the SVG.
     let svg = dir.join("validate.svg");

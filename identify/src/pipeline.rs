@@ -732,7 +732,36 @@ impl Identification {
             }
         }
         let text = report::rewrite_urdf_inertials_with(urdf, &updated, merged).map_err(PipelineError::Report)?;
-        Ok(UrdfRewrite { text, updated, kept })
+        // With friction identified, each joint's viscous and Coulomb friction go to
+        // its <dynamics> when both have a value and neither is negative.
+        let (mut dynamics, mut dynamics_kept) = (Vec::new(), Vec::new());
+        if self.report.parameterisation == Parameterisation::StandardAndJoints {
+            let n = model.dof();
+            for (j, joint) in model.joints.iter().enumerate() {
+                let value = |m: usize| {
+                    let p = self.report.parameters.get(10 * n + 4 * j + m)?;
+                    matches!(p.status, ParamStatus::Identified | ParamStatus::NotSignificant)
+                        .then_some(p.value)
+                        .flatten()
+                };
+                match (value(1), value(2)) {
+                    (Some(fv), Some(fc)) if fv >= 0.0 && fc >= 0.0 => dynamics.push((joint.name.clone(), fv, fc)),
+                    (Some(fv), Some(fc)) => dynamics_kept.push((
+                        joint.name.clone(),
+                        format!("identified Fv {fv:.4}, Fc {fc:.4}: negative"),
+                    )),
+                    _ => dynamics_kept.push((joint.name.clone(), "friction not identified alone".into())),
+                }
+            }
+        }
+        let text = report::rewrite_urdf_dynamics(&text, &dynamics).map_err(PipelineError::Report)?;
+        Ok(UrdfRewrite {
+            text,
+            updated,
+            kept,
+            dynamics,
+            dynamics_kept,
+        })
     }
 }
 
@@ -745,6 +774,10 @@ pub struct UrdfRewrite {
     pub updated: Vec<(String, Inertial)>,
     /// The bodies that keep their inertials, and why.
     pub kept: Vec<(String, String)>,
+    /// The joints whose `<dynamics damping friction>` were written, with `Fv`, `Fc`.
+    pub dynamics: Vec<(String, f64, f64)>,
+    /// The joints whose `<dynamics>` were kept, and why.
+    pub dynamics_kept: Vec<(String, String)>,
 }
 
 #[cfg(test)]

@@ -28,6 +28,17 @@ pub enum ReportError {
     LinkNotFound {
         link: String,
     },
+    /// No `<joint>` of that name in the URDF, or several (lines of each).
+    JointNotFound {
+        joint: String,
+        lines: Vec<usize>,
+    },
+    /// Friction to write that is negative or not finite.
+    InvalidDynamics {
+        joint: String,
+        damping: f64,
+        friction: f64,
+    },
     /// Two `<link>` elements share the name (lines of both).
     DuplicateLink {
         link: String,
@@ -84,6 +95,26 @@ impl fmt::Display for ReportError {
             Self::Json { message, line, column } => write!(f, "JSON line {line}, column {column}: {message}"),
             Self::Xml { line, message } => write!(f, "URDF line {line}: {message}"),
             Self::LinkNotFound { link } => write!(f, "no <link name=\"{link}\"> in the URDF"),
+            Self::JointNotFound { joint, lines } if lines.is_empty() => {
+                write!(f, "no <joint name=\"{joint}\"> in the URDF")
+            }
+            Self::JointNotFound { joint, lines } => {
+                let lines: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+                write!(
+                    f,
+                    "<joint name=\"{joint}\"> appears on lines {}; joint names must be unique",
+                    lines.join(", ")
+                )
+            }
+            Self::InvalidDynamics {
+                joint,
+                damping,
+                friction,
+            } => write!(
+                f,
+                "joint `{joint}`: <dynamics damping=\"{damping}\" friction=\"{friction}\"> is not a physical friction \
+                 (both must be finite and ≥ 0)"
+            ),
             Self::DuplicateLink { link, lines } => {
                 let lines: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
                 write!(

@@ -16,7 +16,7 @@ pub use json::{
     CombinationReport, CoulombReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, PredictionModel,
     Term, SCHEMA,
 };
-pub use urdf::{rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
+pub use urdf::{rewrite_urdf_dynamics, rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;
 use std::path::Path;

@@ -108,6 +108,79 @@ pub fn rewrite_urdf_inertials_with<S: AsRef<str>>(
     Ok(out)
 }
 
+/// Sets `<dynamics damping friction>` of each named joint (viscous `Fv` and Coulomb
+/// `Fc` friction, URDF's convention): an existing `<dynamics>` element is replaced,
+/// otherwise one is added as the joint's first child. Every other byte is kept.
+/// Errors: a joint not found or not unique (with its lines), a value negative or
+/// not finite.
+pub fn rewrite_urdf_dynamics<S: AsRef<str>>(
+    original_text: &str,
+    updates: &[(S, f64, f64)],
+) -> Result<String, ReportError> {
+    let doc = Document::scan(original_text)?;
+    let newline = if original_text.contains("\r\n") { "\r\n" } else { "\n" };
+    let root = doc.tags.iter().position(|t| t.parent.is_none());
+    let mut edits: Vec<(std::ops::Range<usize>, String)> = Vec::new();
+    for (k, (name, damping, friction)) in updates.iter().enumerate() {
+        let name = name.as_ref();
+        if updates[..k].iter().any(|(n, _, _)| n.as_ref() == name) {
+            return Err(ReportError::Xml {
+                line: 0,
+                message: format!("joint `{name}` is given two <dynamics>"),
+            });
+        }
+        if !(damping.is_finite() && friction.is_finite() && *damping >= 0.0 && *friction >= 0.0) {
+            return Err(ReportError::InvalidDynamics {
+                joint: name.into(),
+                damping: *damping,
+                friction: *friction,
+            });
+        }
+        let found: Vec<usize> = (0..doc.tags.len())
+            .filter(|&k| {
+                let t = &doc.tags[k];
+                t.parent == root && t.parent.is_some() && t.name == "joint" && t.attr("name") == Some(name)
+            })
+            .collect();
+        let &[j] = &found[..] else {
+            return Err(ReportError::JointNotFound {
+                joint: name.into(),
+                lines: found.iter().map(|&k| doc.tags[k].line).collect(),
+            });
+        };
+        let element = format!("<dynamics damping=\"{damping:?}\" friction=\"{friction:?}\"/>");
+        let joint = &doc.tags[j];
+        if let Some(d) = doc.child(j, "dynamics") {
+            edits.push((doc.tags[d].span.clone(), element));
+            continue;
+        }
+        let joint_indent = doc.indent_at(joint.start.start).unwrap_or("");
+        let child_indent = (0..doc.tags.len())
+            .filter(|&k| doc.tags[k].parent == Some(j))
+            .find_map(|k| doc.indent_at(doc.tags[k].start.start))
+            .map_or_else(|| format!("{joint_indent}  "), str::to_string);
+        if joint.self_closing {
+            let open = doc.text[joint.start.clone()]
+                .trim_end_matches('>')
+                .trim_end_matches('/')
+                .trim_end();
+            edits.push((
+                joint.start.clone(),
+                format!("{open}>{newline}{child_indent}{element}{newline}{joint_indent}</joint>"),
+            ));
+        } else {
+            let at = joint.start.end;
+            edits.push((at..at, format!("{newline}{child_indent}{element}")));
+        }
+    }
+    edits.sort_by_key(|(r, _)| r.start);
+    let mut out = original_text.to_string();
+    for (range, text) in edits.into_iter().rev() {
+        out.replace_range(range, &text);
+    }
+    Ok(out)
+}
+
 /// The model builder's own test for a part of a body, so the file written is one
 /// the model reads back.
 fn check_inertial(link: &str, i: &Inertial) -> Result<(), ReportError> {
@@ -291,5 +364,37 @@ impl<'a> Document<'a> {
         }
         let at = link.start.end;
         (at..at, format!("{newline}{child_indent}{}", element(&child_indent)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ARM: &str = "<robot name=\"arm\">\n  <link name=\"base\"/>\n  <link name=\"a\"/>\n  <joint name=\"j1\" type=\"continuous\">\n    <parent link=\"base\"/>\n    <child link=\"a\"/>\n  </joint>\n  <link name=\"b\"/>\n  <joint name=\"j2\" type=\"continuous\">\n    <dynamics damping=\"0.1\"/>\n    <parent link=\"a\"/>\n    <child link=\"b\"/>\n  </joint>\n</robot>\n";
+
+    #[test]
+    fn dynamics_are_added_or_replaced_and_nothing_else_changes() {
+        let out = rewrite_urdf_dynamics(ARM, &[("j1", 1.5, 2.0), ("j2", 0.25, 0.0)]).unwrap();
+        let want = ARM
+            .replace(
+                "<joint name=\"j1\" type=\"continuous\">\n",
+                "<joint name=\"j1\" type=\"continuous\">\n    <dynamics damping=\"1.5\" friction=\"2.0\"/>\n",
+            )
+            .replace(
+                "<dynamics damping=\"0.1\"/>",
+                "<dynamics damping=\"0.25\" friction=\"0.0\"/>",
+            );
+        assert_eq!(out, want);
+    }
+
+    #[test]
+    fn bad_dynamics_updates_are_errors() {
+        let e = rewrite_urdf_dynamics(ARM, &[("j3", 1.0, 1.0)]).unwrap_err();
+        assert_eq!(e.to_string(), "no <joint name=\"j3\"> in the URDF");
+        let e = rewrite_urdf_dynamics(ARM, &[("j1", -1.0, 1.0)]).unwrap_err();
+        assert!(e.to_string().contains("both must be finite and ≥ 0"), "{e}");
+        let e = rewrite_urdf_dynamics(ARM, &[("j1", 1.0, 1.0), ("j1", 2.0, 1.0)]).unwrap_err();
+        assert!(e.to_string().contains("given two <dynamics>"), "{e}");
     }
 }

@@ -278,7 +278,7 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         clean
     };
     if let Some(l) = &logger {
-        check_overwrite(&args.output, args.force)?;
+        // The output was checked before any work (`check_overwrite` above).
         std::fs::write(&args.output, l.write(&recording))
             .map_err(|e| CliError::Output(format!("{}: {e}", args.output.display())))?;
         eprintln!(

@@ -25,8 +25,9 @@
 
 use crate::data::Trajectory;
 use crate::faer::Mat;
+use crate::mim::TorqueRegressor;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options};
-use dyngen_model::joint_params::{joint_regressor_row, Coulomb, PER_JOINT};
+use dyngen_model::joint_params::{Coulomb, PER_JOINT};
 use dyngen_reference::Dynamics;
 
 /// A load of known mass properties fixed to one body.
@@ -81,7 +82,8 @@ pub fn identify_gains(
     // solution and, through its per-joint Gram matrices, the alternation.
     let p = pa + n + 1;
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n))?;
-    let mut y = vec![0.0; n * rigid];
+    let regressor = TorqueRegressor::StandardAndJoints(coulomb);
+    let mut y = vec![0.0; n * pa];
     let mut row = Mat::<f64>::zeros(n, p);
     let mut rhs = vec![0.0; n];
     for (traj, with_load) in [(unloaded, false), (loaded, true)] {
@@ -102,24 +104,17 @@ pub fn identify_gains(
                     })
                 }
             };
-            dynamics.joint_torque_regressor(s.q, v, a, &mut y);
+            regressor.eval(dynamics, s.q, v, a, &mut y);
             for j in 0..n {
+                let yj = &y[j * pa..(j + 1) * pa];
                 for c in 0..p {
-                    row[(j, c)] = 0.0;
-                }
-                for c in 0..rigid {
-                    row[(j, c)] = y[j * rigid + c];
-                }
-                let jr = joint_regressor_row(v[j], a[j], coulomb);
-                for (m, x) in jr.iter().enumerate() {
-                    row[(j, rigid + PER_JOINT * j + m)] = *x;
+                    row[(j, c)] = if c < pa { yj[c] } else { 0.0 };
                 }
                 row[(j, pa + j)] = -s.tau[j];
+                // The payload regressor: the 10 columns of the carrying body.
                 let l = if with_load {
                     let b = payload.body - 1;
-                    (0..10)
-                        .map(|m| y[j * rigid + 10 * b + m] * payload.params[m])
-                        .sum::<f64>()
+                    (0..10).map(|m| yj[10 * b + m] * payload.params[m]).sum::<f64>()
                 } else {
                     0.0
                 };

@@ -572,6 +572,22 @@ impl TorqueRegressor {
         }
     }
 
+    /// The joint torques `Y(q, v, a) x` of the parameters `x` (`columns(n)`), with
+    /// `y` (`n × columns`) as room for the regressor.
+    pub fn predict(
+        &self,
+        dynamics: &dyn Dynamics,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        x: &[f64],
+        y: &mut [f64],
+    ) -> Vec<f64> {
+        let p = x.len();
+        self.eval(dynamics, q, v, a, y);
+        y.chunks_exact(p).map(|row| crate::dense::dot(row, x)).collect()
+    }
+
     /// The regressor at `(q, v, a)`, row-major into `y` (`n × columns`).
     pub fn eval(&self, dynamics: &dyn Dynamics, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
         match self {
@@ -580,22 +596,15 @@ impl TorqueRegressor {
             TorqueRegressor::PrincipalBase { regressor, .. } => regressor(q, v, a, y),
             TorqueRegressor::StandardAndJoints(coulomb) => {
                 let n = q.len();
-                let p = (10 + PER_JOINT) * n;
-                y[..n * p].fill(0.0);
-                // The rigid-body block is computed into the first 10n columns of each
-                // row, written row by row so that one buffer serves.
-                let mut rigid = [0.0; 10 * 64];
-                let mut scratch = Vec::new();
-                let rigid: &mut [f64] = if 10 * n * n <= rigid.len() {
-                    &mut rigid[..10 * n * n]
-                } else {
-                    scratch.resize(10 * n * n, 0.0);
-                    &mut scratch
-                };
-                dynamics.joint_torque_regressor(q, v, a, rigid);
-                for j in 0..n {
-                    y[j * p..j * p + 10 * n].copy_from_slice(&rigid[j * 10 * n..(j + 1) * 10 * n]);
-                    let at = j * p + 10 * n + PER_JOINT * j;
+                let (rigid, p) = (10 * n, (10 + PER_JOINT) * n);
+                // The rigid-body rows land packed at the front of `y`; each is then
+                // moved to its place in the wider layout, last row first so that no
+                // row is overwritten before it is moved (no buffer on this hot path).
+                dynamics.joint_torque_regressor(q, v, a, &mut y[..n * rigid]);
+                for j in (0..n).rev() {
+                    y.copy_within(j * rigid..(j + 1) * rigid, j * p);
+                    y[j * p + rigid..(j + 1) * p].fill(0.0);
+                    let at = j * p + rigid + PER_JOINT * j;
                     y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], *coulomb));
                 }
             }
@@ -653,8 +662,8 @@ impl TorqueEstimate {
         let n = dynamics.nv();
         let p = self.regressor.columns(n);
         let mut y = vec![0.0; n * p];
-        self.regressor.eval(dynamics, q, v, a, &mut y);
-        y.chunks_exact(p).map(|row| self.estimate.predict(row)).collect()
+        self.regressor
+            .predict(dynamics, q, v, a, &self.estimate.solution, &mut y)
     }
 
     /// RMS per joint of `τ_measured − τ_predicted` over `recording` (a validation

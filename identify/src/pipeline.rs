@@ -570,16 +570,7 @@ pub fn predict_with(
     Ok((0..trajectory.len())
         .map(|k| {
             let (q, v, a) = state(trajectory, k);
-            regressor.eval(dynamics, q, v, a, &mut y);
-            (0..n)
-                .map(|r| {
-                    y[r * p..(r + 1) * p]
-                        .iter()
-                        .zip(&prediction.solution)
-                        .map(|(a, x)| a * x)
-                        .sum()
-                })
-                .collect()
+            regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y)
         })
         .collect())
 }

@@ -196,12 +196,7 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
     let predicted: Vec<Vec<f64>> = other
         .samples
         .iter()
-        .map(|s| {
-            regressor.eval(&robot, &s.q, &s.v, &s.a, &mut y);
-            (0..6)
-                .map(|r| (0..p).map(|c| y[r * p + c] * est.solution[c]).sum())
-                .collect()
-        })
+        .map(|s| regressor.predict(&robot, &s.q, &s.v, &s.a, &est.solution, &mut y))
         .collect();
     let v = Validation::new(
         &other.joint_names,

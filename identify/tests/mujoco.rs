@@ -47,12 +47,7 @@ fn validate(robot: &Reference, traj: &Trajectory, regressor: TorqueRegressor, es
     let mut y = vec![0.0; 6 * p];
     let predicted: Vec<Vec<f64>> = traj
         .samples()
-        .map(|s| {
-            regressor.eval(robot, s.q, s.v.unwrap(), s.a.unwrap(), &mut y);
-            (0..6)
-                .map(|r| (0..p).map(|c| y[r * p + c] * est.solution[c]).sum())
-                .collect()
-        })
+        .map(|s| regressor.predict(robot, s.q, s.v.unwrap(), s.a.unwrap(), &est.solution, &mut y))
         .collect();
     let names: Vec<String> = robot.model().joints.iter().map(|j| j.name.clone()).collect();
     Validation::new(&names, traj.samples().map(|s| s.tau), predicted.iter().map(|p| &p[..])).unwrap()

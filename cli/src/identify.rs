@@ -34,7 +34,8 @@ the Coulomb term smoothed as the data best support; --validate predicts a second
 recording with the result.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
-low-pass at --cutoff Hz, then central differences) when the file does not have them.
+low-pass at --cutoff Hz, then central differences) when the file does not have them,
+and measured q and v are low-passed at the same cutoff (--raw-states: as read).
 Other layouts (no header, other names and order, semicolons, degrees, motor
 currents, sign flips, time in ms) are read through a recipe file (--recipe) or the
 flags for the common cases; duplicate time stamps are dropped and counted, irregular
@@ -189,10 +190,16 @@ pub struct IdentifyArgs {
 /// commands that read one.
 #[derive(Debug, clap::Args)]
 pub struct RecordingArgs {
-    /// Low-pass cutoff, Hz, for velocities and accelerations estimated from
-    /// positions (only used when the file has no v or a columns).
+    /// Low-pass cutoff, Hz (zero phase): velocities and accelerations the file does
+    /// not have are estimated through it, and the measured positions and velocities
+    /// are filtered by it too (see --raw-states).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub cutoff: f64,
+
+    /// Use the measured positions and velocities as read, without the low-pass
+    /// filter (only estimated derivatives are filtered).
+    #[arg(long)]
+    pub raw_states: bool,
 
     #[command(flatten)]
     pub gravity: GravityArg,
@@ -204,7 +211,7 @@ pub struct RecordingArgs {
 impl RecordingArgs {
     /// Loads `path` as these flags say (see [`load_recording`]).
     pub fn load(&self, path: &Path, dof: usize) -> Result<Trajectory> {
-        load_recording(path, &self.recipe, dof, self.cutoff)
+        load_recording(path, &self.recipe, dof, self.cutoff, !self.raw_states)
     }
 }
 
@@ -285,9 +292,16 @@ impl RecipeArgs {
 
 /// Reads a recording through the recipe the flags describe, estimates what it does
 /// not measure, and prints what was done.
-pub fn load_recording(path: &Path, recipe: &RecipeArgs, dof: usize, cutoff: f64) -> Result<Trajectory> {
+pub fn load_recording(
+    path: &Path,
+    recipe: &RecipeArgs,
+    dof: usize,
+    cutoff: f64,
+    low_pass_states: bool,
+) -> Result<Trajectory> {
     let options = IdentifyOptions {
         cutoff_hz: cutoff,
+        low_pass_states,
         ..IdentifyOptions::default()
     };
     let loaded = pipeline::load(path, &recipe.recipe()?, dof, &options).map_err(|e| pipeline_error(path, e))?;
@@ -346,6 +360,7 @@ impl IdentifyArgs {
                 Friction::Auto => JointTerms::FrictionAuto,
             },
             cutoff_hz: self.recording.cutoff,
+            low_pass_states: !self.recording.raw_states,
             model_is_truth: self.truth_from_urdf,
             ..IdentifyOptions::default()
         }

@@ -28,6 +28,10 @@ pub enum IdentifyError {
     /// A NaN or infinity at global data row `row` (0-based, counted over all rows
     /// pushed so far) and, for the regressor, column `column`.
     NonFinite { input: Input, row: usize, column: usize },
+    /// A non-zero regressor entry at global data row `row`, column `column`,
+    /// outside the columns declared for the row's channel
+    /// ([`crate::Accumulator::with_column_support`]).
+    OutsideSupport { row: usize, column: usize, channel: usize },
     /// Every singular value of the regressor is below the rank tolerance: the data
     /// determine nothing.
     RankZero { tolerance: f64 },
@@ -57,6 +61,11 @@ impl fmt::Display for IdentifyError {
                 Input::Observation => write!(f, "non-finite observation at row {row}"),
                 Input::Prior => write!(f, "non-finite entry {column} in the prior/start vector"),
             },
+            Self::OutsideSupport { row, column, channel } => write!(
+                f,
+                "regressor row {row} (channel {channel}) is non-zero in column {column}, outside the columns \
+                 declared for its channel"
+            ),
             Self::RankZero { tolerance } => {
                 write!(
                     f,

@@ -52,6 +52,7 @@ use crate::{Accumulator, Channels, Estimate, IdentifyError, Options, ParamEstima
 use dyngen::Robot;
 use dyngen_model::joint_params::{joint_regressor_row, Coulomb, PER_JOINT};
 use dyngen_model::names::{principal_param_names, standard_param_names};
+use dyngen_model::Model;
 use dyngen_reference::Dynamics;
 use nalgebra::DMatrix;
 use std::fmt;
@@ -588,6 +589,34 @@ impl TorqueRegressor {
         y.chunks_exact(p).map(|row| crate::dense::dot(row, x)).collect()
     }
 
+    /// Per joint row, the columns it can be non-zero in (for
+    /// [`Accumulator::with_column_support`]): the parameters of the bodies the joint
+    /// supports, and its own joint terms; `None` when not known (a generated base
+    /// regressor mixes bodies).
+    pub fn row_support(&self, model: &Model) -> Option<Vec<Vec<usize>>> {
+        let n = model.dof();
+        let per_body = match self {
+            TorqueRegressor::Standard | TorqueRegressor::StandardAndJoints(_) => 10,
+            TorqueRegressor::Principal => 4,
+            TorqueRegressor::PrincipalBase { .. } => return None,
+        };
+        Some(
+            (1..=n)
+                .map(|j| {
+                    let mut cols: Vec<usize> = (1..=n)
+                        .filter(|&i| model.supports(j, i))
+                        .flat_map(|i| per_body * (i - 1)..per_body * i)
+                        .collect();
+                    if matches!(self, TorqueRegressor::StandardAndJoints(_)) {
+                        let at = 10 * n + PER_JOINT * (j - 1);
+                        cols.extend(at..at + PER_JOINT);
+                    }
+                    cols
+                })
+                .collect(),
+        )
+    }
+
     /// The regressor at `(q, v, a)`, row-major into `y` (`n × columns`).
     pub fn eval(&self, dynamics: &dyn Dynamics, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
         match self {
@@ -778,10 +807,13 @@ fn torque_estimate(
     let p = regressor.columns(n);
     check_truth(truth, p)?;
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n))?;
+    if let Some(support) = regressor.row_support(dynamics.model()) {
+        acc = acc.with_column_support(support)?;
+    }
     let mut y = vec![0.0; n * p];
     for s in &recording.samples[range] {
         regressor.eval(dynamics, &s.q, &s.v, &s.a, &mut y);
-        acc.push_rows(Mat::from_fn(n, p, |r, c| y[r * p + c]).as_ref(), &s.tau)?;
+        acc.push_rows(crate::faer::MatRef::from_row_major_slice(&y, n, p), &s.tau)?;
     }
     let estimate = match &weighting {
         Weighting::Ols => acc.ols(opts)?,

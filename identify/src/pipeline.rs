@@ -97,8 +97,12 @@ pub struct IdentifyOptions {
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
     /// Low-pass cutoff (Hz) for velocities and accelerations estimated from
-    /// positions; only used when the log does not measure them.
+    /// positions or measured velocities, and for [`IdentifyOptions::low_pass_states`].
     pub cutoff_hz: f64,
+    /// Low-pass the measured positions and velocities at `cutoff_hz` as well
+    /// ([`Loaded::with_states_low_passed`]), so that the regressor sees the same
+    /// band as the accelerations. Default `true`; `false` uses them as read.
+    pub low_pass_states: bool,
     /// Rank and identifiability tolerances of the estimators.
     pub tolerances: Options,
     /// Take the model's own inertials as the truth: MIM then reports each
@@ -114,6 +118,7 @@ impl Default for IdentifyOptions {
             joints: JointTerms::None,
             accumulation: Accumulation::Qr,
             cutoff_hz: 10.0,
+            low_pass_states: true,
             tolerances: Options::default(),
             model_is_truth: false,
         }
@@ -240,11 +245,15 @@ pub fn load(path: &Path, recipe: &Recipe, dof: usize, options: &IdentifyOptions)
         error,
     };
     recipe.check().map_err(PipelineError::Recipe)?;
-    recipe
+    let loaded = recipe
         .read(path, Some(dof))
-        .map_err(data)?
-        .with_derivatives(options.cutoff_hz)
-        .map_err(data)
+        .and_then(|loaded| loaded.with_derivatives(options.cutoff_hz))
+        .map_err(data)?;
+    if options.low_pass_states {
+        loaded.with_states_low_passed(options.cutoff_hz).map_err(data)
+    } else {
+        Ok(loaded)
+    }
 }
 
 /// How an identification predicts the joint torques.
@@ -411,43 +420,58 @@ fn accumulate(
     let n = dynamics.nv();
     let p = regressor.columns(n);
     let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation)?;
-    // The regressor rows of a batch of samples are computed on every core, then
-    // pushed in sample order (the channels interleave joint by joint).
-    let threads = crate::accumulate::cores().clamp(1, 8);
+    if let Some(support) = regressor.row_support(dynamics.model()) {
+        acc = acc.with_column_support(support)?;
+    }
+    // The samples are cut into a fixed number of contiguous parts, each accumulated
+    // on its own (regressor rows and QR folds on one core), and the parts are merged
+    // in order: every core is busy all the time, and the result does not depend on
+    // how many cores there are.
     let samples: Vec<usize> = (0..traj.len()).step_by(stride).collect();
-    let per_thread = 256;
-    for batch in samples.chunks(threads * per_thread) {
-        let parts: Vec<Vec<f64>> = std::thread::scope(|s| {
-            let handles: Vec<_> = batch
-                .chunks(per_thread)
-                .map(|part| {
-                    s.spawn(move || {
-                        let mut rows = vec![0.0; part.len() * n * p];
-                        for (i, &k) in part.iter().enumerate() {
-                            let (q, v, a) = state(traj, k);
-                            regressor.eval(dynamics, q, v, a, &mut rows[i * n * p..(i + 1) * n * p]);
-                        }
-                        rows
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .collect()
-        });
-        for (part, rows) in batch.chunks(per_thread).zip(&parts) {
-            for (i, &k) in part.iter().enumerate() {
-                let y = faer::MatRef::from_row_major_slice(&rows[i * n * p..(i + 1) * n * p], n, p);
-                acc.push_rows(y, traj.tau(k)).map_err(|error| PipelineError::Identify {
+    let parts: Vec<&[usize]> = samples.chunks(samples.len().div_ceil(PARTS).max(1)).collect();
+    let threads = crate::accumulate::cores().clamp(1, parts.len().max(1));
+    let template = &acc;
+    let fill = |part: &[usize]| -> Result<Accumulator, PipelineError> {
+        let mut acc = template.empty_part();
+        let mut y = vec![0.0; n * p];
+        for &k in part {
+            let (q, v, a) = state(traj, k);
+            regressor.eval(dynamics, q, v, a, &mut y);
+            acc.push_rows(faer::MatRef::from_row_major_slice(&y, n, p), traj.tau(k))
+                .map_err(|error| PipelineError::Identify {
                     at: Some(traj.location(k)),
                     error,
                 })?;
-            }
         }
+        Ok(acc)
+    };
+    let mut filled: Vec<(usize, Result<Accumulator, PipelineError>)> = std::thread::scope(|s| {
+        let (parts, fill) = (&parts, &fill);
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                s.spawn(move || {
+                    (t..parts.len())
+                        .step_by(threads)
+                        .map(|i| (i, fill(parts[i])))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    filled.sort_by_key(|(i, _)| *i);
+    let mut merged = acc;
+    for (_, part) in filled {
+        merged.merge(&part?)?;
     }
-    Ok(acc)
+    Ok(merged)
 }
+
+/// Contiguous parts of the samples accumulated independently ([`accumulate`]).
+const PARTS: usize = 8;
 
 /// The paper's MIM on measured joint wrenches: every body's θ from its resultant,
 /// the whole robot as one block-diagonal least-squares problem.

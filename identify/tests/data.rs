@@ -1039,3 +1039,58 @@ fn second_difference_is_exact_on_cubics() {
     assert!(matches!(e, DataError::TooFewSamples { found: 2, needed: 3 }), "{e:?}");
     assert_message(&e, &["2 sample(s); at least 3 are needed"]);
 }
+
+/// Low-passing the measured state removes noise above the cutoff from positions and
+/// measured velocities, on uniform and on jittered time stamps, and leaves the
+/// signal, the accelerations and the torques as they were.
+#[test]
+fn measured_states_low_passed_lose_their_noise_not_their_signal() {
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    for jitter in [false, true] {
+        let mut t = vec![0.0];
+        for _ in 1..2000 {
+            let step = if jitter { rng.gen_range(0.008..0.013) } else { 0.01 };
+            t.push(t[t.len() - 1] + step);
+        }
+        let (w, n) = (2.0 * PI * 0.4, t.len());
+        let q_true: Vec<f64> = t.iter().map(|t| (w * t).sin()).collect();
+        let v_true: Vec<f64> = t.iter().map(|t| w * (w * t).cos()).collect();
+        let q: Vec<f64> = q_true.iter().map(|q| q + 2e-3 * rng.gen_range(-1.0..1.0)).collect();
+        let v: Vec<f64> = v_true.iter().map(|v| v + 2e-2 * rng.gen_range(-1.0..1.0)).collect();
+        let tau: Vec<f64> = (0..n).map(|k| k as f64).collect();
+        let raw = Trajectory::new(1, t.clone(), q, tau.clone())
+            .unwrap()
+            .with_velocities(v)
+            .unwrap()
+            .with_accelerations(vec![0.5; n])
+            .unwrap();
+        let smooth = raw.with_states_low_passed(5.0, true).unwrap();
+        // Away from the ends, where the filter's padding is a guess.
+        let rms = |x: &[f64], truth: &[f64]| {
+            let inner = 50..n - 50;
+            (inner.clone().map(|k| (x[k] - truth[k]).powi(2)).sum::<f64>() / inner.len() as f64).sqrt()
+        };
+        let (q_raw, q_smooth) = (rms(raw.positions(), &q_true), rms(smooth.positions(), &q_true));
+        let (v_raw, v_smooth) = (
+            rms(raw.velocities().unwrap(), &v_true),
+            rms(smooth.velocities().unwrap(), &v_true),
+        );
+        assert!(
+            q_smooth < 0.4 * q_raw,
+            "jitter {jitter}: q RMS {q_raw:.2e} → {q_smooth:.2e}"
+        );
+        assert!(
+            v_smooth < 0.4 * v_raw,
+            "jitter {jitter}: v RMS {v_raw:.2e} → {v_smooth:.2e}"
+        );
+        assert_eq!(smooth.accelerations(), raw.accelerations());
+        assert_eq!(smooth.torques(), raw.torques());
+        assert_eq!(smooth.t(), raw.t());
+        // Velocities not asked for are kept.
+        let only_q = raw.with_states_low_passed(5.0, false).unwrap();
+        assert_eq!(only_q.velocities(), raw.velocities());
+        // A cutoff at or above Nyquist is refused.
+        let e = raw.with_states_low_passed(60.0, true).unwrap_err();
+        assert!(e.to_string().contains("cutoff_hz"), "{e}");
+    }
+}

@@ -248,6 +248,176 @@ fn normal_equations_agree_with_qr_when_well_conditioned() {
     }
 }
 
+/// Rows of 3 interleaved channels, each non-zero only in its own columns (as a joint
+/// row involves only the bodies the joint supports): columns `c ≥ channel` and the
+/// channel's own last column.
+fn sparse_channels(r: &mut ChaCha8Rng, samples: usize) -> (Mat<f64>, Vec<f64>, Vec<Vec<usize>>) {
+    let (n, p) = (3, 8);
+    let support: Vec<Vec<usize>> = (0..n).map(|c| (c..5).chain([5 + c]).collect()).collect();
+    let a = Mat::from_fn(samples * n, p, |i, j| {
+        if support[i % n].contains(&j) {
+            normal(r)
+        } else {
+            0.0
+        }
+    });
+    let x: Vec<f64> = (0..p).map(|j| 1.0 + j as f64).collect();
+    let y = mat_vec(a.as_ref(), &x).iter().map(|v| v + 0.05 * normal(r)).collect();
+    (a, y, support)
+}
+
+fn push_in_pieces(acc: &mut Accumulator, a: MatRef<'_, f64>, y: &[f64]) {
+    let m = a.nrows();
+    for (lo, hi) in [(0, 3), (3, 1500), (1500, m)] {
+        acc.push_rows(a.subrows(lo, hi - lo), &y[lo..hi]).unwrap();
+    }
+}
+
+fn assert_same_estimates(a: &Accumulator, b: &Accumulator, tol: f64) {
+    let opts = Options::default();
+    for (ea, eb) in [(a.ols(&opts), b.ols(&opts)), (a.wls(&opts), b.wls(&opts))] {
+        let (ea, eb) = (ea.unwrap(), eb.unwrap());
+        assert_eq!(ea.rank, eb.rank);
+        assert!(
+            rel_err(&values(&ea), &values(&eb)) < tol,
+            "{:?} vs {:?}",
+            values(&ea),
+            values(&eb)
+        );
+        for (sa, sb) in ea.sigmas().iter().zip(eb.sigmas()) {
+            let (sa, sb) = (sa.unwrap(), sb.unwrap());
+            assert!((sa - sb).abs() < tol * sa, "σ {sa} vs {sb}");
+        }
+        for (ra, rb) in ea.residuals.per_channel_rms.iter().zip(&eb.residuals.per_channel_rms) {
+            assert!((ra - rb).abs() < tol * ra, "channel RMS {ra} vs {rb}");
+        }
+    }
+}
+
+/// Declaring which columns each channel's rows use gives the same estimates, σ and
+/// channel residuals as folding every column (both accumulations).
+#[test]
+fn column_support_gives_the_same_estimates() {
+    let mut r = rng(91);
+    let (a, y, support) = sparse_channels(&mut r, 1400);
+    for accumulation in [Accumulation::Qr, Accumulation::NormalEquations] {
+        let mut full = Accumulator::with_accumulation(8, Channels::Interleaved(3), accumulation).unwrap();
+        let mut narrow = Accumulator::with_accumulation(8, Channels::Interleaved(3), accumulation)
+            .unwrap()
+            .with_column_support(support.clone())
+            .unwrap();
+        push_in_pieces(&mut full, a.as_ref(), &y);
+        push_in_pieces(&mut narrow, a.as_ref(), &y);
+        assert_same_estimates(&full, &narrow, 1e-9);
+    }
+}
+
+#[test]
+fn column_support_errors() {
+    let mut r = rng(92);
+    let (a, y, support) = sparse_channels(&mut r, 10);
+    let fresh = || Accumulator::with_channels(8, Channels::Interleaved(3)).unwrap();
+    // A row non-zero outside its channel's columns is refused, and nothing is taken.
+    let mut narrow = fresh().with_column_support(support.clone()).unwrap();
+    let mut bad = a.clone();
+    bad[(4, 0)] = 2.5; // row 4 is channel 1, whose columns start at 1
+    let e = narrow.push_rows(bad.as_ref(), &y).unwrap_err();
+    assert_eq!(
+        e,
+        IdentifyError::OutsideSupport {
+            row: 4,
+            column: 0,
+            channel: 1
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "regressor row 4 (channel 1) is non-zero in column 0, outside the columns declared for its channel"
+    );
+    assert_eq!(narrow.rows(), 0);
+    // Declared too late, not one list per channel, a column out of range.
+    let mut late = fresh();
+    late.push_rows(a.as_ref(), &y).unwrap();
+    assert!(matches!(
+        late.with_column_support(support.clone()),
+        Err(IdentifyError::InvalidArgument {
+            what: "column support",
+            ..
+        })
+    ));
+    assert!(matches!(
+        fresh().with_column_support(support[..2].to_vec()),
+        Err(IdentifyError::DimensionMismatch {
+            expected: 3,
+            found: 2,
+            ..
+        })
+    ));
+    let e = fresh()
+        .with_column_support(vec![vec![0], vec![8], vec![1]])
+        .unwrap_err();
+    assert_eq!(e.to_string(), "invalid column support: column 8 of 8");
+}
+
+/// Parts filled separately and merged in order hold what one accumulator fed every
+/// row holds (both accumulations, with and without column support).
+#[test]
+fn merged_parts_equal_one_accumulator() {
+    let mut r = rng(93);
+    let (a, y, support) = sparse_channels(&mut r, 1400);
+    for accumulation in [Accumulation::Qr, Accumulation::NormalEquations] {
+        for support in [None, Some(support.clone())] {
+            let mut whole = Accumulator::with_accumulation(8, Channels::Interleaved(3), accumulation).unwrap();
+            if let Some(s) = &support {
+                whole = whole.with_column_support(s.clone()).unwrap();
+            }
+            let template = whole.clone();
+            push_in_pieces(&mut whole, a.as_ref(), &y);
+            let mut merged = template.clone();
+            for (lo, hi) in [(0, 300), (300, 303), (303, 3000), (3000, 4200)] {
+                let mut part = template.empty_part();
+                part.push_rows(a.as_ref().subrows(lo, hi - lo), &y[lo..hi]).unwrap();
+                merged.merge(&part).unwrap();
+            }
+            assert_eq!(merged.rows(), whole.rows());
+            assert_eq!(merged.rows_per_channel(), whole.rows_per_channel());
+            assert_same_estimates(&whole, &merged, 1e-9);
+        }
+    }
+}
+
+#[test]
+fn merge_errors() {
+    let mut r = rng(94);
+    let (a, y, support) = sparse_channels(&mut r, 10);
+    let base = Accumulator::with_channels(8, Channels::Interleaved(3)).unwrap();
+    let reason = |e: IdentifyError| match e {
+        IdentifyError::InvalidArgument { what, reason } => format!("{what}: {reason}"),
+        other => panic!("{other:?}"),
+    };
+    let mut other = base.empty_part();
+    other.push_rows(a.as_ref().subrows(0, 4), &y[..4]).unwrap();
+    assert_eq!(
+        reason(base.clone().merge(&other).unwrap_err()),
+        "accumulator to merge: interleaved channels need whole samples in each part"
+    );
+    let narrow = base.clone().with_column_support(support).unwrap();
+    assert_eq!(
+        reason(base.clone().merge(&narrow).unwrap_err()),
+        "accumulator to merge: different column support"
+    );
+    let wider = Accumulator::with_channels(9, Channels::Interleaved(3)).unwrap();
+    assert_eq!(
+        reason(base.clone().merge(&wider).unwrap_err()),
+        "accumulator to merge: different parameters, channels or accumulation"
+    );
+    let labelled = Accumulator::with_channels(8, Channels::Labels(vec![0, 1, 0])).unwrap();
+    assert_eq!(
+        reason(labelled.clone().merge(&labelled).unwrap_err()),
+        "accumulator to merge: channels given by labels number rows globally"
+    );
+}
+
 /// The normal equations square the condition number: a direction 10⁻⁷ of the
 /// strongest, which QR resolves, is reported as unidentifiable (never given a value
 /// made of rounding errors).

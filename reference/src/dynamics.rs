@@ -152,7 +152,7 @@ impl Dynamics for Reference {
     }
 
     fn joint_torque_regressor(&self, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
-        copy_row_major("y", &Reference::joint_torque_regressor(self, q, v, a), y);
+        Reference::joint_torque_regressor_into(self, q, v, a, y);
     }
 
     fn joint_wrench_regressor(&self, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {

@@ -5,7 +5,7 @@
 //! `f_j = Σ_{i ⪰ j} ʲX*_i f_i`, so the regressors are the body regressors carried
 //! towards the base, one block per (joint, body) pair with `T_ji ≠ 0`.
 
-use super::spatial::{force_regressor, ForceRegressor};
+use super::spatial::{force_regressor, ForceRegressor, SpatialVector};
 use super::Reference;
 use dyngen_model::{Model, PrincipalFrame};
 use nalgebra::{DMatrix, DVector};
@@ -54,14 +54,44 @@ impl Reference {
     /// length differs.
     pub fn joint_torque_regressor(&self, q: &[f64], v: &[f64], a: &[f64]) -> DMatrix<f64> {
         let n = self.nq();
-        let w = self.joint_wrench_regressor(q, v, a);
-        let mut y = DMatrix::zeros(n, 10 * n);
-        for j in 1..=n {
-            let s = self.joints[j - 1].subspace;
-            let rows = w.rows(6 * (j - 1), 6);
-            y.row_mut(j - 1).copy_from(&(s.transpose() * rows));
+        let mut y = vec![0.0; 10 * n * n];
+        self.joint_torque_regressor_into(q, v, a, &mut y);
+        DMatrix::from_row_slice(n, 10 * n, &y)
+    }
+
+    /// [`Reference::joint_torque_regressor`] written row-major into `y` (`n × 10n`),
+    /// without the wrench regressor in between: with `ⁱX_j S_j` the axis of joint
+    /// `j` seen from body `i` (column `j` of body `i`'s Jacobian in its own frame,
+    /// carried outwards one joint at a time, `ⁱX_j S_j = X_i · ᵖX_j S_j` for
+    /// `p = λ(i)`), `Y_ji = S_jᵀ ʲX*_i A_i = (ⁱX_j S_j)ᵀ A_i`: one 6-vector transform
+    /// and ten 6-term dot products per (joint, body) pair instead of a 6 × 10 block
+    /// product. The loop identification runs per sample. Panics if a length differs.
+    pub fn joint_torque_regressor_into(&self, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
+        let n = self.nq();
+        self.check_len("y", y, 10 * n * n);
+        let k = self.forward_pass(q, v, a, -self.gravity);
+        y.fill(0.0);
+        // axes[n·i + j − 1]: ⁱX_j S_j for joints j on body i's path (zero elsewhere).
+        let mut axes = vec![SpatialVector::zeros(); n * (n + 1)];
+        for i in 1..=n {
+            let parent = self.joints[i - 1].parent;
+            let mut j = parent;
+            while j != 0 {
+                axes[n * i + j - 1] = k.x[i] * axes[n * parent + j - 1];
+                j = self.joints[j - 1].parent;
+            }
+            axes[n * i + i - 1] = self.joints[i - 1].subspace;
+            let body: ForceRegressor = force_regressor(&k.v[i], &k.a[i]);
+            let mut j = i;
+            while j != 0 {
+                let axis = &axes[n * i + j - 1];
+                let row = &mut y[(j - 1) * 10 * n + 10 * (i - 1)..][..10];
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x = axis.dot(&body.column(c));
+                }
+                j = self.joints[j - 1].parent;
+            }
         }
-        y
     }
 
     /// The regressor in the principal parameters `θ_i = (m, J1, J2, J3)` (`n × 4n`):

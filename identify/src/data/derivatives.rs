@@ -376,23 +376,107 @@ pub(super) fn hermite(t: &[f64], y: &[f64], at: &[(usize, f64)]) -> Result<Vec<f
         .collect())
 }
 
+/// `f(j)` for every joint column `j`, spread over the machine's cores (the columns
+/// are independent), written into a row-major `len × dof` array. The first error in
+/// column order is returned, whichever thread met it.
+fn per_column(
+    len: usize,
+    dof: usize,
+    f: impl Fn(usize) -> Result<Vec<f64>, DataError> + Sync,
+) -> Result<Vec<f64>, DataError> {
+    let threads = crate::accumulate::cores().clamp(1, dof.max(1));
+    let columns: Vec<Result<Vec<f64>, DataError>> = if threads <= 1 {
+        (0..dof).map(&f).collect()
+    } else {
+        let f = &f;
+        let mut done: Vec<(usize, Result<Vec<f64>, DataError>)> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..threads)
+                .map(|t| s.spawn(move || (t..dof).step_by(threads).map(|j| (j, f(j))).collect::<Vec<_>>()))
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        });
+        done.sort_by_key(|(j, _)| *j);
+        done.into_iter().map(|(_, c)| c).collect()
+    };
+    let mut out = vec![0.0; len * dof];
+    for (j, c) in columns.into_iter().enumerate() {
+        set_column(&mut out, dof, j, &c?);
+    }
+    Ok(out)
+}
+
 /// Per joint column of a row-major `len × dof` array: `f(F(column))`, `F` the filter.
 fn filtered(
     values: &[f64],
     dof: usize,
     dt: f64,
     cutoff_hz: f64,
-    f: impl Fn(&[f64], f64) -> Result<Vec<f64>, DataError>,
+    f: impl Fn(&[f64], f64) -> Result<Vec<f64>, DataError> + Sync,
 ) -> Result<Vec<f64>, DataError> {
-    let mut out = vec![0.0; values.len()];
-    for j in 0..dof {
-        let smooth = butterworth_filtfilt(&column(values, dof, j), dt, cutoff_hz)?;
-        set_column(&mut out, dof, j, &f(&smooth, dt)?);
+    per_column(values.len() / dof.max(1), dof, |j| {
+        f(&butterworth_filtfilt(&column(values, dof, j), dt, cutoff_hz)?, dt)
+    })
+}
+
+/// Per joint column of a row-major `len × dof` array sampled at `t`, low-passed at
+/// `cutoff_hz` with zero phase ([`butterworth_filtfilt`]): directly when `t` is
+/// uniform within [`SAMPLING_TOLERANCE`], otherwise through a uniform grid of as many
+/// samples (cubic Hermite there and back, as [`Trajectory::with_derivatives_nonuniform`]
+/// does), so that jitter is not read as motion.
+fn low_pass_columns(t: &[f64], values: &[f64], dof: usize, cutoff_hz: f64) -> Result<Vec<f64>, DataError> {
+    let n = t.len();
+    if n < 2 {
+        return Ok(values.to_vec());
     }
-    Ok(out)
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    check_cutoff(dt, cutoff_hz)?;
+    let uniform = t
+        .windows(2)
+        .all(|w| (w[1] - w[0] - dt).abs() <= SAMPLING_TOLERANCE * dt);
+    if uniform {
+        return filtered(values, dof, dt, cutoff_hz, |x, _| Ok(x.to_vec()));
+    }
+    let grid: Vec<f64> = (0..n)
+        .map(|k| if k + 1 == n { t[n - 1] } else { t[0] + k as f64 * dt })
+        .collect();
+    let (to_grid, back) = (intervals(t, &grid), intervals(&grid, t));
+    per_column(n, dof, |j| {
+        let uniform = hermite(t, &column(values, dof, j), &to_grid)?;
+        let smooth = butterworth_filtfilt(&uniform, dt, cutoff_hz)?;
+        hermite(&grid, &smooth, &back)
+    })
 }
 
 impl Trajectory {
+    /// The same trajectory with the positions and, if `velocities`, the velocities
+    /// low-passed at `cutoff_hz` with zero phase (per joint, [`butterworth_filtfilt`];
+    /// through a uniform grid when the time stamps are irregular). Accelerations and
+    /// torques are kept.
+    ///
+    /// For identification on real logs: the regressor is evaluated at the measured
+    /// state, and noise there (a velocity the drive differentiates from its encoder,
+    /// quantised positions) enters every column, biasing least squares; filtering the
+    /// state as the accelerations are filtered removes that noise above the cutoff
+    /// and keeps `q`, `q̇`, `q̈` consistent. Call it after
+    /// [`Trajectory::with_derivatives`], which differentiates the unfiltered data
+    /// (so nothing is filtered twice).
+    ///
+    /// Errors: `cutoff_hz` not in `(0, 1 / (2 Δt̄))`, a non-finite value.
+    pub fn with_states_low_passed(&self, cutoff_hz: f64, velocities: bool) -> Result<Trajectory, DataError> {
+        let dof = self.dof();
+        let q = low_pass_columns(self.t(), self.positions(), dof, cutoff_hz)?;
+        let v = match self.velocities() {
+            Some(v) if velocities => Some(low_pass_columns(self.t(), v, dof, cutoff_hz)?),
+            other => other.map(<[f64]>::to_vec),
+        };
+        let mut out = self.clone();
+        out.set_states(q, v)?;
+        Ok(out)
+    }
+
     /// The mean time step `(t[n−1] − t[0]) / (n − 1)`, after checking that every
     /// step is within 1 % of it ([`SAMPLING_TOLERANCE`]); the error names the line
     /// (or sample) that ends the first step out of tolerance.
@@ -457,18 +541,10 @@ impl Trajectory {
             ),
         };
         if let Some(d) = first {
-            let mut out = vec![0.0; source.len()];
-            for j in 0..dof {
-                set_column(&mut out, dof, j, &derive(&source, j, d)?);
-            }
-            v = Some(out);
+            v = Some(per_column(n, dof, |j| derive(&source, j, d))?);
         }
         if let Some(d) = second {
-            let mut out = vec![0.0; source.len()];
-            for j in 0..dof {
-                set_column(&mut out, dof, j, &derive(&source, j, d)?);
-            }
-            a = Some(out);
+            a = Some(per_column(n, dof, |j| derive(&source, j, d))?);
         }
         let mut out = self.clone();
         out.set_derivatives(v, a)?;
@@ -504,14 +580,15 @@ impl Trajectory {
             (Some(v), None) => (v.to_vec(), filtered(v, dof, dt, cutoff_hz, central_difference)?),
             (None, Some(a)) => (filtered(q, dof, dt, cutoff_hz, central_difference)?, a.to_vec()),
             (None, None) => {
-                let mut v = vec![0.0; q.len()];
-                let mut a = vec![0.0; q.len()];
-                for j in 0..dof {
+                // One filter pass per joint for both derivatives: [v; a] per column.
+                let both = per_column(2 * q.len() / dof.max(1), dof, |j| {
                     let smooth = butterworth_filtfilt(&column(q, dof, j), dt, cutoff_hz)?;
-                    set_column(&mut v, dof, j, &central_difference(&smooth, dt)?);
-                    set_column(&mut a, dof, j, &second_difference(&smooth, dt)?);
-                }
-                (v, a)
+                    let mut both = central_difference(&smooth, dt)?;
+                    both.extend(second_difference(&smooth, dt)?);
+                    Ok(both)
+                })?;
+                let (v, a) = both.split_at(q.len());
+                (v.to_vec(), a.to_vec())
             }
         };
         let mut out = self.clone();

@@ -81,6 +81,9 @@ pub struct LoadReport {
     pub currents: bool,
     pub velocity: Provenance,
     pub acceleration: Provenance,
+    /// The cutoff (Hz) the positions and measured velocities were low-passed at
+    /// ([`Loaded::with_states_low_passed`]); `None`: used as read.
+    pub states_low_passed: Option<f64>,
 }
 
 impl LoadReport {
@@ -171,7 +174,15 @@ impl fmt::Display for LoadReport {
         } else {
             write!(f, "; torque: measured ({})", columns_text(&self.tau_columns))?;
         }
-        write!(f, "\nvelocity: {}; acceleration: {}", self.velocity, self.acceleration)
+        write!(f, "\nvelocity: {}; acceleration: {}", self.velocity, self.acceleration)?;
+        if let Some(hz) = self.states_low_passed {
+            let what = match self.velocity {
+                Provenance::Measured { .. } => "positions and measured velocities",
+                _ => "positions",
+            };
+            write!(f, "\n{what} low-passed at {hz} Hz (zero phase)")?;
+        }
+        Ok(())
     }
 }
 
@@ -228,6 +239,19 @@ impl Loaded {
         if !has_a {
             self.report.acceleration = estimated;
         }
+        Ok(self)
+    }
+
+    /// Low-passes the positions, and the velocities where they were measured, at
+    /// `cutoff_hz` ([`Trajectory::with_states_low_passed`]); velocities estimated by
+    /// [`Loaded::with_derivatives`] are already filtered and are kept. Call it after
+    /// that. The report records the cutoff.
+    ///
+    /// Errors: `cutoff_hz` at or above the Nyquist frequency of the mean step.
+    pub fn with_states_low_passed(mut self, cutoff_hz: f64) -> Result<Loaded, DataError> {
+        let measured = matches!(self.report.velocity, Provenance::Measured { .. });
+        self.trajectory = self.trajectory.with_states_low_passed(cutoff_hz, measured)?;
+        self.report.states_low_passed = Some(cutoff_hz);
         Ok(self)
     }
 }
@@ -963,6 +987,7 @@ fn new_state(plan: &Plan) -> State {
             } else {
                 Provenance::Missing
             },
+            states_low_passed: None,
         },
     }
 }
@@ -1329,6 +1354,19 @@ mod tests {
         let text = full.report.to_string();
         assert!(
             text.contains("velocity: measured (column 3); acceleration: estimated by zero-phase differentiation"),
+            "{text}"
+        );
+        assert!(!text.contains("low-passed"), "{text}");
+        let filtered = full.with_states_low_passed(10.0).unwrap();
+        assert!(filtered
+            .trajectory
+            .velocities()
+            .unwrap()
+            .iter()
+            .all(|&v| (v - 7.0).abs() < 1e-9));
+        let text = filtered.report.to_string();
+        assert!(
+            text.ends_with("\npositions and measured velocities low-passed at 10 Hz (zero phase)"),
             "{text}"
         );
     }

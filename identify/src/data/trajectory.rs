@@ -316,6 +316,13 @@ impl Trajectory {
         })
     }
 
+    /// Replaces `q` and `v` (filtered ones), checked like the rest.
+    pub(super) fn set_states(&mut self, q: Vec<f64>, v: Option<Vec<f64>>) -> Result<(), DataError> {
+        self.q = q;
+        self.v = v;
+        self.check()
+    }
+
     /// Replaces `v` and `a` (computed ones), checked like the rest.
     pub(super) fn set_derivatives(&mut self, v: Option<Vec<f64>>, a: Option<Vec<f64>>) -> Result<(), DataError> {
         self.v = v;

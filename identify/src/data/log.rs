@@ -703,6 +703,9 @@ struct State {
     lines: Vec<u64>,
     row: Vec<f64>,
     previous: Vec<f64>,
+    /// Where each field of the current line starts and ends (reused, one split
+    /// per line).
+    fields: Vec<(usize, usize)>,
     /// The last accepted row's time and line (decimated or not).
     last: Option<(f64, u64)>,
     origin: Option<f64>,
@@ -721,7 +724,13 @@ impl State {
     /// Reads one data row into the arrays, or says why not. `Ok(false)` when the
     /// error list is full.
     fn row(&mut self, plan: &Plan, recipe: &Recipe, line: u64, bytes: &[u8], errors: &mut Errors) -> bool {
-        let found = Fields::new(bytes, recipe.delimiter).count();
+        let start = bytes.as_ptr() as usize;
+        self.fields.clear();
+        self.fields.extend(Fields::new(bytes, recipe.delimiter).map(|f| {
+            let at = f.as_ptr() as usize - start;
+            (at, at + f.len())
+        }));
+        let found = self.fields.len();
         if found != plan.width {
             return errors.push(DataError::RowWidth {
                 line,
@@ -769,9 +778,11 @@ impl State {
 
         // Time first: rows outside the window are left unread, so that a window
         // can cut away a damaged part of a log.
-        let raw_t = Fields::new(bytes, recipe.delimiter)
-            .nth(plan.time_field)
-            .map_or(Err(String::new()), parse_field);
+        let text = |(a, b): (usize, usize)| &bytes[a..b];
+        let raw_t = self
+            .fields
+            .get(plan.time_field)
+            .map_or(Err(String::new()), |&f| parse_field(text(f)));
         if recipe.time_origin == TimeOrigin::FirstRow && self.origin.is_none() {
             if let Ok(x) = raw_t {
                 self.origin = Some(x).filter(|x| x.is_finite());
@@ -790,9 +801,9 @@ impl State {
                 return true;
             }
         }
-        for (i, text) in Fields::new(bytes, recipe.delimiter).enumerate() {
+        for (i, &field) in self.fields.iter().enumerate() {
             if let Target::Value { pos, scale } = plan.targets[i] {
-                if let Some(x) = check(i, parse_field(text), scale, errors) {
+                if let Some(x) = check(i, parse_field(text(field)), scale, errors) {
                     self.row[pos] = x;
                 }
             }
@@ -951,6 +962,7 @@ fn new_state(plan: &Plan) -> State {
         lines: Vec::new(),
         row: vec![0.0; len],
         previous: vec![0.0; len],
+        fields: Vec::with_capacity(plan.width),
         last: None,
         origin: None,
         accepted: 0,

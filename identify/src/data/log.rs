@@ -84,6 +84,10 @@ pub struct LoadReport {
     /// The cutoff (Hz) the positions and measured velocities were low-passed at
     /// ([`Loaded::with_states_low_passed`]); `None`: used as read.
     pub states_low_passed: Option<f64>,
+    /// The states were to be low-passed, but the cutoff is at or above this Nyquist
+    /// frequency (Hz) of the mean step: there is nothing above the cutoff to remove,
+    /// and they are used as read.
+    pub states_above_nyquist: Option<f64>,
 }
 
 impl LoadReport {
@@ -182,6 +186,12 @@ impl fmt::Display for LoadReport {
             };
             write!(f, "\n{what} low-passed at {hz} Hz (zero phase)")?;
         }
+        if let Some(nyquist) = self.states_above_nyquist {
+            write!(
+                f,
+                "\npositions used as read: the cutoff is at or above the Nyquist frequency ({nyquist} Hz) of the samples"
+            )?;
+        }
         Ok(())
     }
 }
@@ -247,8 +257,20 @@ impl Loaded {
     /// [`Loaded::with_derivatives`] are already filtered and are kept. Call it after
     /// that. The report records the cutoff.
     ///
-    /// Errors: `cutoff_hz` at or above the Nyquist frequency of the mean step.
+    /// A finite `cutoff_hz` at or above the Nyquist frequency of the mean step leaves
+    /// the states as read (the samples hold nothing above it) and records that in
+    /// [`LoadReport::states_above_nyquist`].
+    ///
+    /// Errors: `cutoff_hz` not finite and positive, a non-finite filtered value.
     pub fn with_states_low_passed(mut self, cutoff_hz: f64) -> Result<Loaded, DataError> {
+        let t = self.trajectory.t();
+        if t.len() >= 2 && cutoff_hz.is_finite() {
+            let nyquist = 0.5 * (t.len() - 1) as f64 / (t[t.len() - 1] - t[0]);
+            if cutoff_hz >= nyquist {
+                self.report.states_above_nyquist = Some(nyquist);
+                return Ok(self);
+            }
+        }
         let measured = matches!(self.report.velocity, Provenance::Measured { .. });
         self.trajectory = self.trajectory.with_states_low_passed(cutoff_hz, measured)?;
         self.report.states_low_passed = Some(cutoff_hz);
@@ -1000,6 +1022,7 @@ fn new_state(plan: &Plan) -> State {
                 Provenance::Missing
             },
             states_low_passed: None,
+            states_above_nyquist: None,
         },
     }
 }
@@ -1369,7 +1392,7 @@ mod tests {
             "{text}"
         );
         assert!(!text.contains("low-passed"), "{text}");
-        let filtered = full.with_states_low_passed(10.0).unwrap();
+        let filtered = full.clone().with_states_low_passed(10.0).unwrap();
         assert!(filtered
             .trajectory
             .velocities()
@@ -1381,6 +1404,19 @@ mod tests {
             text.ends_with("\npositions and measured velocities low-passed at 10 Hz (zero phase)"),
             "{text}"
         );
+        // At or above the Nyquist frequency (50 Hz here) the states are kept as read.
+        let kept = full.clone().with_states_low_passed(50.0).unwrap();
+        assert_eq!(kept.report.states_low_passed, None);
+        assert_eq!(kept.report.states_above_nyquist, Some(50.0));
+        assert_eq!(kept.trajectory.positions(), full.trajectory.positions());
+        let text = kept.report.to_string();
+        assert!(
+            text.ends_with(
+                "\npositions used as read: the cutoff is at or above the Nyquist frequency (50 Hz) of the samples"
+            ),
+            "{text}"
+        );
+        assert!(full.with_states_low_passed(f64::NAN).is_err());
     }
 
     #[test]

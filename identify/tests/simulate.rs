@@ -274,6 +274,27 @@ fn optimised_excitation_is_better_conditioned_and_within_limits() {
     assert!(v.iter().chain(&a).all(|x| x.abs() < 1e-12), "{v:?} {a:?}");
 }
 
+/// An experiment of many periods is designed over one: its samples, spread over the
+/// whole duration, would otherwise alias (100 samples over 100 periods are one
+/// instant, and the regressor has rank one).
+#[test]
+fn a_long_experiment_is_designed_over_one_period() {
+    let (m, r) = reference();
+    let mut design = ExcitationDesign::new(&m);
+    design.harmonics = 3;
+    design.base_frequency = 0.2;
+    design.samples = 24;
+    design.max_evaluations = 120;
+    design.seed = 4;
+    design.duration = 5.0;
+    let one = design.optimise(&r);
+    design.duration = 24.0 * 5.0;
+    let many = design.optimise(&r);
+    assert!(many.value.is_finite() && many.value < 1e3, "{}", many.value);
+    assert_eq!(many, one);
+    assert_limits(&many.excitation, &design.limits);
+}
+
 /// Position and velocity limits on a grid 10× finer than the optimiser's, allowing
 /// the curvature between its grid points (0.5 % of the range or speed).
 fn assert_limits(e: &FourierExcitation, limits: &[JointLimits]) {

@@ -93,14 +93,14 @@ pub struct ExcitationDesign {
     pub harmonics: usize,
     /// Base frequency `f_f`, Hz; the trajectory repeats every `1/f_f` s.
     pub base_frequency: f64,
-    /// Length of the experiment the criterion is evaluated over, s (default one
-    /// period).
+    /// Length of the experiment, s (default one period); the criterion and the
+    /// limits are evaluated over `T = min(duration, 1/f_f)`, since the motion
+    /// repeats after one period.
     pub duration: f64,
-    /// Samples `t_k = k · duration / samples`, `k = 0..samples`, stacked into the
+    /// Samples `t_k = k · T / samples`, `k = 0..samples`, stacked into the
     /// regressor.
     pub samples: usize,
-    /// Per joint; checked on a grid of `max(4 · samples, 64 L)` instants over the
-    /// duration.
+    /// Per joint; checked on a grid of `max(4 · samples, 64 L)` instants over `T`.
     pub limits: Vec<JointLimits>,
     /// Objective evaluations allowed in total (each one evaluates `samples`
     /// regressors and one SVD or a few 3 × 3 inverses).
@@ -351,7 +351,11 @@ struct Objective<'a> {
 
 impl<'a> Objective<'a> {
     fn new(design: &'a ExcitationDesign, dynamics: &'a dyn Dynamics, base: &'a [usize]) -> Objective<'a> {
-        let times = |count: usize| (0..count).map(|k| k as f64 * design.duration / count as f64).collect();
+        // The motion repeats every period: a longer experiment adds nothing to either
+        // criterion or to the limits, and sampling it sparsely would alias (samples
+        // one period apart are one instant).
+        let window = design.duration.min(1.0 / design.base_frequency);
+        let times = |count: usize| (0..count).map(|k| k as f64 * window / count as f64).collect();
         let grid = (4 * design.samples).max(64 * design.harmonics);
         let moments = match design.criterion {
             Criterion::JointTorques => Vec::new(),

@@ -149,8 +149,8 @@ impl Accumulator {
     /// `noise_sigma` is the σ of the entries of `y` (`‖y‖` times the per-entry σ of
     /// the scaled problem, `√(σ²_min / m)`); the covariance is the first-order one,
     /// `σ² (1 + ‖x̃‖²) Ṽ₁ (Σ̃₁² − σ²_min I)⁻¹ Ṽ₁ᵀ` in the scaled parameters, scaled back.
-    /// A column weaker than `√ε` of the strongest is numerically zero and is
-    /// scaled as if it had that norm (never blown up to a unit column of roundoff).
+    /// A column weaker than `√ε` of the strongest is numerically zero and is divided
+    /// by the strongest's norm (never blown up to a unit column of roundoff).
     pub fn tls(&self, opts: &Options) -> Result<Estimate, IdentifyError> {
         self.total_least_squares(true, opts)
     }
@@ -250,9 +250,9 @@ impl Accumulator {
     /// toward `x₀` as hard as a thousandth of its column's own signal), and the fit
     /// does not change when a column is rescaled (a parameter given in other units).
     /// It equals [`Accumulator::ridge_unscaled`] on `A D⁻¹` in the parameters `D x`.
-    /// A column weaker than `√ε` of the strongest is numerically zero and gets that
-    /// `D` (its parameter then stays at the prior's; its roundoff is not promoted
-    /// to a signal).
+    /// A column weaker than `√ε` of the strongest is numerically zero and gets the
+    /// strongest's `D` (its parameter stays at the prior's; its roundoff is not
+    /// promoted to a signal).
     ///
     /// Every parameter gets a value; `Method::Ridge::data_weight` (diagonal of
     /// `(AᵀA + λD²)⁻¹AᵀA`) says how much of it comes from the data, and parameters
@@ -373,15 +373,17 @@ impl Accumulator {
     }
 }
 
-/// The column scales `D` of the column-scaled estimators: the column norms, floored
-/// at `√ε` of the largest (1 when every column is zero).
+/// The column scales `D` of the column-scaled estimators: the column norms, except
+/// that a column below `√ε` of the largest norm is numerically zero (roundoff of a
+/// parameter that has no effect) and is divided by the largest norm, so that it
+/// stays as negligible next to the others as it was (1 when every column is zero).
 fn column_scales(norms: &[f64]) -> Vec<f64> {
     let top = norms.iter().cloned().fold(0.0, f64::max);
     if top == 0.0 {
         return vec![1.0; norms.len()];
     }
-    let floor = f64::EPSILON.sqrt() * top;
-    norms.iter().map(|&n| n.max(floor)).collect()
+    let negligible = f64::EPSILON.sqrt() * top;
+    norms.iter().map(|&n| if n > negligible { n } else { top }).collect()
 }
 
 /// Per-channel residual variances with each channel's share of the degrees of

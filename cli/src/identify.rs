@@ -27,11 +27,15 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \
       --validate run2.csv
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --method consistent \
+      --exclude-below 0.05 --validate run2.csv
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
 the Coulomb term smoothed as the data best support; --validate predicts a second
-recording with the result.
+recording with the result. --method consistent keeps every body physical and (with
+friction) Ia, Fv, Fc >= 0; --exclude-below SPEED leaves out a joint's rows where it
+moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them,

@@ -214,8 +214,10 @@ impl fmt::Display for Method {
                     "physically consistent, pseudo-inertia barrier ({iterations} Newton steps, {} bodies at the bound",
                     bodies_at_bound.len()
                 )?;
-                if !params_at_bound.is_empty() {
-                    write!(f, ", {} parameters held at 0", params_at_bound.len())?;
+                match params_at_bound.len() {
+                    0 => {}
+                    1 => write!(f, ", 1 parameter held at 0")?,
+                    k => write!(f, ", {k} parameters held at 0")?,
                 }
                 write!(f, ")")
             }

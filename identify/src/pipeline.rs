@@ -814,16 +814,20 @@ impl Identification {
         }
         let text = report::rewrite_urdf_inertials_with(urdf, &updated, merged).map_err(PipelineError::Report)?;
         // With friction identified, each joint's viscous and Coulomb friction go to
-        // its <dynamics> when both have a value and neither is negative.
+        // its <dynamics> when both have a value and neither is negative (a value
+        // shaped by the consistency bounds is a value).
         let (mut dynamics, mut dynamics_kept) = (Vec::new(), Vec::new());
         if self.report.parameterisation == Parameterisation::StandardAndJoints {
             let n = model.dof();
             for (j, joint) in model.joints.iter().enumerate() {
                 let value = |m: usize| {
                     let p = self.report.parameters.get(10 * n + 4 * j + m)?;
-                    matches!(p.status, ParamStatus::Identified | ParamStatus::NotSignificant)
-                        .then_some(p.value)
-                        .flatten()
+                    matches!(
+                        p.status,
+                        ParamStatus::Identified | ParamStatus::NotSignificant | ParamStatus::Constrained
+                    )
+                    .then_some(p.value)
+                    .flatten()
                 };
                 match (value(1), value(2)) {
                     (Some(fv), Some(fc)) if fv >= 0.0 && fc >= 0.0 => dynamics.push((joint.name.clone(), fv, fc)),

@@ -1394,7 +1394,7 @@ fn standard_consistent_keeps_extra_parameters_nonnegative() {
     assert_eq!(est.params[10].status, Status::Identified);
     assert!(est.covariance.is_none());
     assert!(
-        est.method.to_string().contains("1 parameters held at 0"),
+        est.method.to_string().contains("1 parameter held at 0"),
         "{}",
         est.method
     );

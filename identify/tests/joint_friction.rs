@@ -8,6 +8,7 @@ use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
 use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, PipelineError, Prediction};
+use dyngen_identify::report::MergedLinks;
 use dyngen_identify::simulate::{add_joint_terms, record_trajectory, FourierExcitation, Gaussian, Logger, Recording};
 use dyngen_identify::validate::Validation;
 use dyngen_identify::{Accumulator, Channels, Method, Options, Status};
@@ -375,6 +376,11 @@ fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
     );
     println!("validation: OLS {e_ols:.5}, consistent {e_cons:.5}");
     assert!(e_cons <= 1.01 * e_ols, "consistent {e_cons} vs OLS {e_ols}");
+    // Every joint's friction goes to the URDF, those at a bound included.
+    let urdf = include_str!("../../robots/ur5/ur5.urdf");
+    let rewrite = consistent.rewrite_urdf(urdf, robot.model(), MergedLinks::Lump).unwrap();
+    assert_eq!(rewrite.dynamics.len(), 6, "{:?}", rewrite.dynamics_kept);
+    assert!(rewrite.dynamics.iter().all(|(_, fv, fc)| *fv >= 0.0 && *fc >= 0.0));
     // The smoothed Coulomb term is constrained the same way.
     let smooth = IdentifyOptions {
         joints: JointTerms::Friction(Coulomb::Smooth { epsilon: 0.01 }),

@@ -252,8 +252,9 @@ pub struct Estimate {
     /// `σ₁ / σ_rank`, the condition number of the identifiable part.
     pub condition_number: f64,
     pub residuals: Residuals,
-    /// Estimated noise σ of one row (OLS, ridge: `√(‖r‖²/dof)`; TLS: per entry of
-    /// `[A y]`); `None` without degrees of freedom or for WLS (see `Method::Wls`).
+    /// Estimated noise σ of one row (OLS, ridge: `√(‖r‖²/dof)`; TLS: of an entry
+    /// of `y`, which unscaled TLS assumes of every entry of `[A y]`); `None` without
+    /// degrees of freedom or for WLS (see `Method::Wls`).
     pub noise_sigma: Option<f64>,
     /// Covariance of `solution` (`p × p`) on the identifiable subspace, or the
     /// posterior covariance for ridge; `None` when no noise level is available.

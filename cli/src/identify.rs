@@ -27,11 +27,15 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \
       --validate run2.csv
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --method consistent \
+      --exclude-below 0.05 --validate run2.csv
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
 the Coulomb term smoothed as the data best support; --validate predicts a second
-recording with the result.
+recording with the result. --method consistent keeps every body physical and (with
+friction) Ia, Fv, Fc >= 0; --exclude-below SPEED leaves out a joint's rows where it
+moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them,
@@ -103,12 +107,17 @@ pub enum Method {
     Ols,
     /// Weighted least squares, one noise variance per joint (Gautier).
     Wls,
-    /// Total least squares (noise on the regressor too).
+    /// Total least squares (noise on the regressor too), every column of [A y]
+    /// scaled by its norm first, so that units do not matter.
     Tls,
-    /// Ridge regression toward the URDF's nominal parameters (weight --lambda).
+    /// Total least squares on [A y] as it is (equal noise in every entry assumed).
+    TlsUnscaled,
+    /// Ridge regression toward the URDF's nominal parameters (scale-free weight
+    /// --lambda).
     Ridge,
-    /// Physically consistent least squares: every body's mass and principal moments
-    /// positive and satisfying the triangle inequalities.
+    /// Physically consistent least squares: every body's mass and inertia physical
+    /// (a positive-definite pseudo-inertia; principal mode: mass and principal
+    /// moments positive, triangle inequalities); with --friction also Ia, Fv, Fc ≥ 0.
     Consistent,
 }
 
@@ -150,9 +159,17 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "CSV")]
     pub validate: Option<PathBuf>,
 
-    /// Ridge: weight of the pull toward the nominal parameters.
+    /// Ridge: weight of the pull toward the nominal parameters, dimensionless (the
+    /// penalty is λ·Σ ‖column j‖²·(x_j − x0_j)², so units do not matter).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub lambda: f64,
+
+    /// Leave a joint's rows out of its equations where its |velocity| is below
+    /// SPEED (rad/s, m/s for prismatic joints): near velocity reversals a real
+    /// joint sticks, and the Coulomb term sign(q̇) does not describe it. The number
+    /// of rows left out is printed.
+    #[arg(long, value_name = "SPEED", allow_negative_numbers = true)]
+    pub exclude_below: Option<f64>,
 
     #[command(flatten)]
     pub recording: RecordingArgs,
@@ -345,7 +362,8 @@ impl IdentifyArgs {
             estimator: match self.method.unwrap_or(Method::Ols) {
                 Method::Ols => Estimator::Ols,
                 Method::Wls => Estimator::Wls,
-                Method::Tls => Estimator::Tls,
+                Method::Tls => Estimator::Tls { column_scaling: true },
+                Method::TlsUnscaled => Estimator::Tls { column_scaling: false },
                 Method::Ridge => Estimator::Ridge { lambda: self.lambda },
                 Method::Consistent => Estimator::Consistent,
             },
@@ -359,6 +377,7 @@ impl IdentifyArgs {
                 Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
                 Friction::Auto => JointTerms::FrictionAuto,
             },
+            exclude_below: self.exclude_below,
             cutoff_hz: self.recording.cutoff,
             low_pass_states: !self.recording.raw_states,
             model_is_truth: self.truth_from_urdf,
@@ -399,6 +418,15 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         .map_err(|e| pipeline_error(&args.data, e))?;
     for w in &identified.warnings {
         eprintln!("warning: {w}");
+    }
+    if let Some(speed) = args.exclude_below {
+        let total: usize = identified.excluded_rows.iter().sum();
+        let per_joint: Vec<String> = identified.excluded_rows.iter().map(usize::to_string).collect();
+        println!(
+            "--exclude-below {speed}: left out {total} of {} torque rows (|q̇| below it; per joint: {})",
+            traj.len() * n,
+            per_joint.join(", ")
+        );
     }
     match (&identified.prediction, &identified.mim) {
         (_, Some(mim)) => println!("{mim}"),

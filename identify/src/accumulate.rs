@@ -90,6 +90,8 @@ struct Block {
     /// Rows not yet folded, row-major, `width` numbers each.
     pending: Vec<f64>,
     rows: usize,
+    /// Rows of this channel left out by [`Accumulator::push_rows_masked`].
+    excluded: usize,
     /// The columns of `A` this channel's rows may be non-zero in, increasing
     /// ([`Accumulator::with_column_support`]); `None`: all `p`. The block holds only
     /// these columns and `y`, so `work` and `pending` are `width = len + 1` wide.
@@ -259,6 +261,7 @@ impl Accumulator {
             b.k = 0;
             b.pending.clear();
             b.rows = 0;
+            b.excluded = 0;
         }
         part
     }
@@ -318,6 +321,7 @@ impl Accumulator {
             }
             mine.pending.extend_from_slice(&theirs.pending);
             mine.rows += theirs.rows;
+            mine.excluded += theirs.excluded;
             match self.accumulation {
                 Accumulation::Qr => fold(mine),
                 Accumulation::NormalEquations => add_gram(mine),
@@ -346,6 +350,7 @@ impl Accumulator {
                 k: 0,
                 pending: Vec::new(),
                 rows: 0,
+                excluded: 0,
                 support: None,
                 outside: Vec::new(),
             })
@@ -365,9 +370,14 @@ impl Accumulator {
         self.p
     }
 
-    /// Rows pushed so far.
+    /// Rows pushed so far, those [left out](Accumulator::push_rows_masked) included.
     pub fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// Rows left out by [`Accumulator::push_rows_masked`] so far, per channel.
+    pub fn excluded_per_channel(&self) -> Vec<usize> {
+        self.blocks.iter().map(|b| b.excluded).collect()
     }
 
     /// The channel grouping.
@@ -375,7 +385,7 @@ impl Accumulator {
         &self.channels
     }
 
-    /// Rows pushed so far per channel.
+    /// Rows taken so far per channel (left-out rows not counted).
     pub fn rows_per_channel(&self) -> Vec<usize> {
         self.blocks.iter().map(|b| b.rows).collect()
     }
@@ -383,6 +393,29 @@ impl Accumulator {
     /// Appends a block of rows: `a` is `k × p`, `y` has `k` entries. All rows are
     /// checked before any is taken, so on error the accumulator is unchanged.
     pub fn push_rows(&mut self, a: MatRef<'_, f64>, y: &[f64]) -> Result<(), IdentifyError> {
+        self.push(a, y, None)
+    }
+
+    /// [`Accumulator::push_rows`] taking only the rows with `keep[i]`: the others
+    /// still occupy their place (the channel of a row is that of its position, so a
+    /// joint-torque regressor keeps its joints apart) but enter no equation, and are
+    /// counted per channel ([`Accumulator::excluded_per_channel`]). Rows left out are
+    /// not checked. E.g. the rows of a joint moving too slowly for its Coulomb
+    /// friction to be `Fc·sign(q̇)`.
+    ///
+    /// Errors: those of [`Accumulator::push_rows`], and `keep` not one flag per row.
+    pub fn push_rows_masked(&mut self, a: MatRef<'_, f64>, y: &[f64], keep: &[bool]) -> Result<(), IdentifyError> {
+        if keep.len() != a.nrows() {
+            return Err(IdentifyError::DimensionMismatch {
+                what: "row mask (one flag per row)",
+                expected: a.nrows(),
+                found: keep.len(),
+            });
+        }
+        self.push(a, y, Some(keep))
+    }
+
+    fn push(&mut self, a: MatRef<'_, f64>, y: &[f64], keep: Option<&[bool]>) -> Result<(), IdentifyError> {
         let p = self.p;
         if a.ncols() != p {
             return Err(IdentifyError::DimensionMismatch {
@@ -399,7 +432,8 @@ impl Accumulator {
                 found: y.len(),
             });
         }
-        for i in 0..k {
+        let kept = |i: usize| keep.is_none_or(|keep| keep[i]);
+        for i in (0..k).filter(|&i| kept(i)) {
             if let Some(j) = a.row(i).iter().position(|x| !x.is_finite()) {
                 return Err(IdentifyError::NonFinite {
                     input: Input::Regressor,
@@ -424,7 +458,7 @@ impl Accumulator {
                 });
             }
         }
-        for i in 0..k {
+        for i in (0..k).filter(|&i| kept(i)) {
             let ch = self.channels.channel_of(self.rows + i);
             let row = a.row(i);
             if let Some(&column) = self.blocks[ch].outside.iter().find(|&&c| row[c] != 0.0) {
@@ -443,6 +477,11 @@ impl Accumulator {
             while i < k {
                 let ch = self.channels.channel_of(self.rows + i);
                 let block = &mut self.blocks[ch];
+                if !kept(i) {
+                    block.excluded += 1;
+                    i += 1;
+                    continue;
+                }
                 let row = a.row(i);
                 match &block.support {
                     None => block.pending.extend(row.iter()),
@@ -505,7 +544,7 @@ impl Accumulator {
     /// Every channel's factor with pending rows folded in (the accumulator is not
     /// changed).
     pub(crate) fn factors(&self) -> Result<Vec<Factor>, IdentifyError> {
-        if self.rows == 0 {
+        if self.blocks.iter().all(|b| b.rows == 0) {
             return Err(IdentifyError::Empty);
         }
         self.blocks

@@ -133,11 +133,18 @@ pub enum Method {
         channel_sigma: Vec<f64>,
         variance_factor: f64,
     },
-    Tls,
-    /// Ridge toward a prior; `data_weight[j]` is the diagonal of the resolution
-    /// matrix `(AᵀA + λI)⁻¹AᵀA`: 1 = fixed by the data, 0 = by the prior.
+    /// Total least squares; `column_scaling` whether the columns of `[A y]` were
+    /// divided by their norms first (the default).
+    Tls {
+        column_scaling: bool,
+    },
+    /// Ridge toward a prior, `min ‖A x − y‖² + λ ‖D (x − x₀)‖²`; `column_scaling`:
+    /// `D² = diag(AᵀA)` (the default: `λ` dimensionless), else `D = I`.
+    /// `data_weight[j]` is the diagonal of the resolution matrix
+    /// `(AᵀA + λD²)⁻¹AᵀA`: 1 = fixed by the data, 0 = by the prior.
     Ridge {
         lambda: f64,
+        column_scaling: bool,
         data_weight: Vec<f64>,
     },
     PrincipalConsistent {
@@ -157,11 +164,14 @@ pub enum Method {
     },
     /// Pseudo-inertia barrier method: `gap_bound` certifies the objective `½‖Aπ − y‖²`
     /// is within it of the consistent optimum; `bodies_at_bound` are held by the
-    /// constraint; `min_eigenvalues` per body of the pseudo-inertia (all > 0).
+    /// constraint, `params_at_bound` the parameters kept `≥ 0`
+    /// ([`super::StandardOptions::nonnegative`]) that the bound holds near zero;
+    /// `min_eigenvalues` per body of the pseudo-inertia (all > 0).
     StandardConsistent {
         iterations: usize,
         gap_bound: f64,
         bodies_at_bound: Vec<usize>,
+        params_at_bound: Vec<usize>,
         min_eigenvalues: Vec<f64>,
     },
 }
@@ -173,8 +183,14 @@ impl fmt::Display for Method {
             Method::Wls { channel_sigma, .. } => {
                 write!(f, "weighted least squares (channel σ = [{}])", list(channel_sigma))
             }
-            Method::Tls => write!(f, "total least squares"),
-            Method::Ridge { lambda, .. } => write!(f, "ridge toward prior (λ = {})", num(*lambda)),
+            Method::Tls { column_scaling: true } => write!(f, "total least squares (columns scaled)"),
+            Method::Tls { column_scaling: false } => write!(f, "total least squares (unscaled)"),
+            Method::Ridge {
+                lambda,
+                column_scaling: true,
+                ..
+            } => write!(f, "ridge toward prior (scale-free λ = {})", num(*lambda)),
+            Method::Ridge { lambda, .. } => write!(f, "ridge toward prior (unscaled λ = {})", num(*lambda)),
             Method::PrincipalConsistent { active, iterations } => write!(
                 f,
                 "physically consistent, principal form ({} active constraints, {iterations} iterations)",
@@ -190,12 +206,21 @@ impl fmt::Display for Method {
             Method::StandardConsistent {
                 iterations,
                 bodies_at_bound,
+                params_at_bound,
                 ..
-            } => write!(
-                f,
-                "physically consistent, pseudo-inertia barrier ({iterations} Newton steps, {} bodies at the bound)",
-                bodies_at_bound.len()
-            ),
+            } => {
+                write!(
+                    f,
+                    "physically consistent, pseudo-inertia barrier ({iterations} Newton steps, {} bodies at the bound",
+                    bodies_at_bound.len()
+                )?;
+                match params_at_bound.len() {
+                    0 => {}
+                    1 => write!(f, ", 1 parameter held at 0")?,
+                    k => write!(f, ", {k} parameters held at 0")?,
+                }
+                write!(f, ")")
+            }
         }
     }
 }
@@ -227,8 +252,9 @@ pub struct Estimate {
     /// `σ₁ / σ_rank`, the condition number of the identifiable part.
     pub condition_number: f64,
     pub residuals: Residuals,
-    /// Estimated noise σ of one row (OLS, ridge: `√(‖r‖²/dof)`; TLS: per entry of
-    /// `[A y]`); `None` without degrees of freedom or for WLS (see `Method::Wls`).
+    /// Estimated noise σ of one row (OLS, ridge: `√(‖r‖²/dof)`; TLS: of an entry
+    /// of `y`, which unscaled TLS assumes of every entry of `[A y]`); `None` without
+    /// degrees of freedom or for WLS (see `Method::Wls`).
     pub noise_sigma: Option<f64>,
     /// Covariance of `solution` (`p × p`) on the identifiable subspace, or the
     /// posterior covariance for ridge; `None` when no noise level is available.

@@ -189,12 +189,13 @@ pub fn wls(a: MatRef<'_, f64>, y: &[f64], channels: Channels) -> Result<Estimate
     Accumulator::from_rows(a, y, channels)?.wls(&Options::default())
 }
 
-/// TLS on in-memory data (see [`Accumulator::tls`]).
+/// Column-scaled TLS on in-memory data (see [`Accumulator::tls`]).
 pub fn tls(a: MatRef<'_, f64>, y: &[f64]) -> Result<Estimate, IdentifyError> {
     Accumulator::from_rows(a, y, Channels::Single)?.tls(&Options::default())
 }
 
-/// Ridge toward `x0` on in-memory data (see [`Accumulator::ridge`]).
+/// Ridge toward `x0` with the scale-free weight `lambda` on in-memory data (see
+/// [`Accumulator::ridge`]).
 pub fn ridge(a: MatRef<'_, f64>, y: &[f64], x0: &[f64], lambda: f64) -> Result<Estimate, IdentifyError> {
     Accumulator::from_rows(a, y, Channels::Single)?.ridge(x0, lambda, &Options::default())
 }

@@ -28,8 +28,8 @@ use crate::report::{
     self, CoulombReport, MergedLinks, ParamStatus, ParameterReport, Parameterisation, PredictionModel, ReportError,
 };
 use crate::simulate::Recording;
-use crate::{Accumulation, Accumulator, Channels, IdentifyError, Options, PrincipalOptions, StandardOptions};
-use dyngen_model::joint_params::Coulomb;
+use crate::{Accumulation, Accumulator, Channels, IdentifyError, Layout, Options, PrincipalOptions, StandardOptions};
+use dyngen_model::joint_params::{Coulomb, PER_JOINT};
 use dyngen_model::{ErrorKind, Inertial, Model};
 use dyngen_reference::{principal_params_to_standard, Dynamics, Reference};
 use std::fmt;
@@ -57,13 +57,18 @@ pub enum Estimator {
     Ols,
     /// Gautier's weighted least squares, one noise variance per joint.
     Wls,
-    /// Total least squares (noise on the regressor too).
-    Tls,
-    /// Ridge regression toward the model's own parameters with this weight (≥ 0).
+    /// Total least squares (noise on the regressor too), with every column of
+    /// `[A y]` scaled by its norm first ([`Accumulator::tls`]) or, without
+    /// `column_scaling`, as it is ([`Accumulator::tls_unscaled`]).
+    Tls { column_scaling: bool },
+    /// Ridge regression toward the model's own parameters with this scale-free
+    /// weight (≥ 0; the penalty is `λ ‖D (x − x₀)‖²`, `D² = diag(AᵀA)`, see
+    /// [`Accumulator::ridge`]).
     Ridge { lambda: f64 },
     /// Physically consistent least squares: principal form with `m > 0`, `J > 0`
     /// and the triangle inequalities, or standard form with a positive-definite
-    /// pseudo-inertia per body.
+    /// pseudo-inertia per body and, with [`JointTerms`], every joint's rotor
+    /// inertia and viscous and Coulomb friction `≥ 0` (the offset free).
     Consistent,
 }
 
@@ -96,6 +101,11 @@ pub struct IdentifyOptions {
     pub joints: JointTerms,
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
+    /// Leave a joint's torque rows out of its equations at the samples where its
+    /// `|q̇|` is below this speed (rad/s, m/s for prismatic joints): near velocity
+    /// reversals real joints stick and creep, which `Fc·sign(q̇)` does not describe.
+    /// [`Identification::excluded_rows`] counts them. `None`: every row is used.
+    pub exclude_below: Option<f64>,
     /// Low-pass cutoff (Hz) for velocities and accelerations estimated from
     /// positions or measured velocities, and for [`IdentifyOptions::low_pass_states`].
     pub cutoff_hz: f64,
@@ -117,6 +127,7 @@ impl Default for IdentifyOptions {
             estimator: Estimator::Ols,
             joints: JointTerms::None,
             accumulation: Accumulation::Qr,
+            exclude_below: None,
             cutoff_hz: 10.0,
             low_pass_states: true,
             tolerances: Options::default(),
@@ -153,15 +164,23 @@ impl IdentifyOptions {
                 "applies to the standard mode (the joint terms enter the joint torques, not the body equations)".into(),
             );
         }
-        if self.joints != JointTerms::None && self.estimator == Estimator::Consistent {
-            return invalid(
-                "method",
-                "consistent estimation does not take friction and rotor inertia yet; use ols, wls, tls or ridge".into(),
-            );
-        }
         if let JointTerms::Friction(Coulomb::Smooth { epsilon }) = self.joints {
             if !(epsilon.is_finite() && epsilon > 0.0) {
                 return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
+            }
+        }
+        if let Some(speed) = self.exclude_below {
+            if !(speed.is_finite() && speed > 0.0) {
+                return invalid(
+                    "exclude-below",
+                    format!("must be a positive speed (rad/s or m/s), got {speed}"),
+                );
+            }
+            if self.mode == Mode::Mim {
+                return invalid(
+                    "exclude-below",
+                    "applies to the standard and principal modes (joint torque rows); MIM uses every sample".into(),
+                );
             }
         }
         if self.mode == Mode::Mim && self.accumulation != Accumulation::Qr {
@@ -279,10 +298,14 @@ pub struct Identification {
     /// What the caller should know before trusting the numbers (e.g. a total least
     /// squares fit far worse than ordinary least squares on the same data).
     pub warnings: Vec<String>,
+    /// Per joint, the torque rows left out by [`IdentifyOptions::exclude_below`]
+    /// (all 0 without it, and for MIM).
+    pub excluded_rows: Vec<usize>,
 }
 
-/// A TLS residual this many times the OLS residual means TLS's assumption (equal
-/// noise in every regressor column and the torques) does not hold for the data.
+/// A TLS residual this many times the OLS residual means TLS's assumption (noise
+/// in every regressor column and the torques, equal after the column scaling) does
+/// not hold for the data.
 pub const TLS_RESIDUAL_WARNING: f64 = 1.5;
 
 /// Identifies `dynamics`'s inertial parameters from `trajectory` (which must have
@@ -325,9 +348,7 @@ fn from_torques(
             let mut failure = None;
             let (epsilon, _) = crate::friction::best_epsilon(|epsilon| {
                 let r = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon });
-                match accumulate(dynamics, traj, r, stride, options.accumulation)
-                    .and_then(|acc| Ok(acc.ols(&options.tolerances)?))
-                {
+                match accumulate(dynamics, traj, r, stride, options).and_then(|acc| Ok(acc.ols(&options.tolerances)?)) {
                     Ok(e) => e.residuals.rms,
                     Err(e) => {
                         failure.get_or_insert(e);
@@ -341,7 +362,17 @@ fn from_torques(
             TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon })
         }
     };
-    let acc = accumulate(dynamics, traj, regressor, 1, options.accumulation)?;
+    let acc = accumulate(dynamics, traj, regressor, 1, options)?;
+    let excluded_rows = acc.excluded_per_channel();
+    if acc.rows_per_channel().iter().all(|&r| r == 0) {
+        return Err(PipelineError::InvalidOption {
+            option: "exclude-below",
+            reason: format!(
+                "{} leaves no torque row: every joint moves slower than that at every sample",
+                options.exclude_below.unwrap_or(0.0)
+            ),
+        });
+    }
     let opts = &options.tolerances;
     let mut nominal = nominal(model, options.mode);
     if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
@@ -350,20 +381,26 @@ fn from_torques(
     let estimate = match options.estimator {
         Estimator::Ols => acc.ols(opts),
         Estimator::Wls => acc.wls(opts),
-        Estimator::Tls => acc.tls(opts),
+        Estimator::Tls { column_scaling: true } => acc.tls(opts),
+        Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
         Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
         Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
-        Estimator::Consistent => acc.standard_consistent(&StandardOptions::default(), opts),
+        Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
     }?;
     let mut warnings = Vec::new();
-    if options.estimator == Estimator::Tls {
+    if let Estimator::Tls { column_scaling } = options.estimator {
         let ols = acc.ols(opts)?;
         let ratio = estimate.residuals.rms / ols.residuals.rms;
         if ratio > TLS_RESIDUAL_WARNING {
+            let assumption = if column_scaling {
+                "the same relative noise in every regressor column and the torques"
+            } else {
+                "equal noise in every regressor column and the torques"
+            };
             warnings.push(format!(
                 "total least squares fits the torques {ratio:.1}× worse than ordinary least squares (residual RMS \
-                 {:.4e} against {:.4e}): its assumption of equal noise in every regressor column and the torques \
-                 does not hold for these data, and its parameters can be far off; prefer ols or wls",
+                 {:.4e} against {:.4e}): its assumption of {assumption} does not hold for these data, and its \
+                 parameters can be far off; prefer ols or wls",
                 estimate.residuals.rms, ols.residuals.rms
             ));
         }
@@ -406,20 +443,38 @@ fn from_torques(
             truth: options.model_is_truth.then_some(nominal),
         })),
         warnings,
+        excluded_rows,
     })
 }
 
-/// The rows of `regressor` over every `stride`-th sample of `traj`, accumulated.
+/// The standard-form consistent estimator's options for `regressor` on `n` joints:
+/// `n` body blocks first, then per joint `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0`.
+fn consistent_options(regressor: TorqueRegressor, n: usize) -> StandardOptions {
+    let nonnegative = match regressor {
+        TorqueRegressor::StandardAndJoints(_) => (0..n)
+            .flat_map(|j| (0..3).map(move |k| 10 * n + PER_JOINT * j + k))
+            .collect(),
+        _ => Vec::new(),
+    };
+    StandardOptions {
+        layout: Some(Layout { first: 0, bodies: n }),
+        nonnegative,
+        ..StandardOptions::default()
+    }
+}
+
+/// The rows of `regressor` over every `stride`-th sample of `traj`, accumulated
+/// as `options` say (compression, rows left out below a speed).
 fn accumulate(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
     regressor: TorqueRegressor,
     stride: usize,
-    accumulation: Accumulation,
+    options: &IdentifyOptions,
 ) -> Result<Accumulator, PipelineError> {
     let n = dynamics.nv();
     let p = regressor.columns(n);
-    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), accumulation)?;
+    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
     if let Some(support) = regressor.row_support(dynamics.model()) {
         acc = acc.with_column_support(support)?;
     }
@@ -434,14 +489,24 @@ fn accumulate(
     let fill = |part: &[usize]| -> Result<Accumulator, PipelineError> {
         let mut acc = template.empty_part();
         let mut y = vec![0.0; n * p];
+        let mut keep = vec![true; n];
         for &k in part {
             let (q, v, a) = state(traj, k);
             regressor.eval(dynamics, q, v, a, &mut y);
-            acc.push_rows(faer::MatRef::from_row_major_slice(&y, n, p), traj.tau(k))
-                .map_err(|error| PipelineError::Identify {
-                    at: Some(traj.location(k)),
-                    error,
-                })?;
+            let rows = faer::MatRef::from_row_major_slice(&y, n, p);
+            match options.exclude_below {
+                Some(speed) => {
+                    for (keep, v) in keep.iter_mut().zip(v) {
+                        *keep = v.abs() >= speed;
+                    }
+                    acc.push_rows_masked(rows, traj.tau(k), &keep)
+                }
+                None => acc.push_rows(rows, traj.tau(k)),
+            }
+            .map_err(|error| PipelineError::Identify {
+                at: Some(traj.location(k)),
+                error,
+            })?;
         }
         Ok(acc)
     };
@@ -507,6 +572,7 @@ fn by_mim(
         prediction: Prediction::Parameters(principal_params_to_standard(model, &theta)),
         mim: Some(estimate),
         warnings: Vec::new(),
+        excluded_rows: vec![0; model.dof()],
     })
 }
 
@@ -748,16 +814,20 @@ impl Identification {
         }
         let text = report::rewrite_urdf_inertials_with(urdf, &updated, merged).map_err(PipelineError::Report)?;
         // With friction identified, each joint's viscous and Coulomb friction go to
-        // its <dynamics> when both have a value and neither is negative.
+        // its <dynamics> when both have a value and neither is negative (a value
+        // shaped by the consistency bounds is a value).
         let (mut dynamics, mut dynamics_kept) = (Vec::new(), Vec::new());
         if self.report.parameterisation == Parameterisation::StandardAndJoints {
             let n = model.dof();
             for (j, joint) in model.joints.iter().enumerate() {
                 let value = |m: usize| {
                     let p = self.report.parameters.get(10 * n + 4 * j + m)?;
-                    matches!(p.status, ParamStatus::Identified | ParamStatus::NotSignificant)
-                        .then_some(p.value)
-                        .flatten()
+                    matches!(
+                        p.status,
+                        ParamStatus::Identified | ParamStatus::NotSignificant | ParamStatus::Constrained
+                    )
+                    .then_some(p.value)
+                    .flatten()
                 };
                 match (value(1), value(2)) {
                     (Some(fv), Some(fc)) if fv >= 0.0 && fc >= 0.0 => dynamics.push((joint.name.clone(), fv, fc)),
@@ -837,7 +907,8 @@ mod tests {
         for estimator in [
             Estimator::Ols,
             Estimator::Wls,
-            Estimator::Tls,
+            Estimator::Tls { column_scaling: true },
+            Estimator::Tls { column_scaling: false },
             Estimator::Ridge { lambda: 1e-6 },
         ] {
             let id = identify(&robot, &traj, &options(Mode::Standard, estimator)).unwrap();
@@ -884,7 +955,12 @@ mod tests {
     fn principal_mode_reports_theta_names() {
         let model = ur5();
         let robot = Reference::new(model);
-        let id = identify(&robot, &recording(), &options(Mode::Principal, Estimator::Tls)).unwrap();
+        let id = identify(
+            &robot,
+            &recording(),
+            &options(Mode::Principal, Estimator::Tls { column_scaling: true }),
+        )
+        .unwrap();
         assert_eq!(id.report.parameters.len(), 4 * model.dof());
         assert_eq!(id.report.parameters[1].name, "J1_1");
         assert_eq!(id.per_body(), 4);

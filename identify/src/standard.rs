@@ -3,9 +3,13 @@
 //! the log-barrier interior-point method (Boyd & Vandenberghe §11.3) with Newton
 //! steps (faer Cholesky) in `π` itself.
 //!
-//! `−log det J` is a self-concordant barrier of parameter 4 per body, so after the
-//! last centring step with weight `μ` the objective is within `4 · bodies · μ` of the
-//! optimum: the method returns that bound as a certificate. Unlike a fit in
+//! Parameters outside the bodies (a joint's rotor inertia and friction) can be kept
+//! `≥ 0` too, by `−log x_i` ([`StandardOptions::nonnegative`]).
+//!
+//! `−log det J` is a self-concordant barrier of parameter 4 per body and `−log x`
+//! one of parameter 1, so after the last centring step with weight `μ` the objective
+//! is within `ν μ`, `ν = 4 · bodies + nonnegative`, of the optimum: the method
+//! returns that bound as a certificate. Unlike a fit in
 //! log-Cholesky variables, it converges as fast to optima on the boundary of
 //! consistency (a singular pseudo-inertia, the usual case when OLS is inconsistent)
 //! as to interior ones.
@@ -31,8 +35,12 @@ pub struct StandardOptions {
     /// `p`, e.g. nominal parameters; default zero) as far as consistency allows.
     /// Pass nominal parameters for rank-deficient regressors.
     pub prior: Option<Vec<f64>>,
-    /// Stop when the certified suboptimality `4 · bodies · μ` is below this fraction
-    /// of the objective. Default `1e-12`.
+    /// Parameters outside the body blocks kept `≥ 0` (strictly positive at the
+    /// returned point), e.g. the rotor inertia and the viscous and Coulomb friction
+    /// of every joint (an offset stays free). Default none.
+    pub nonnegative: Vec<usize>,
+    /// Stop when the certified suboptimality `ν μ` (`ν = 4 · bodies +
+    /// nonnegative.len()`) is below this fraction of the objective. Default `1e-12`.
     pub gap_tolerance: f64,
     /// Newton steps in all, before [`IdentifyError::NotConverged`]. Default 500.
     pub max_iterations: usize,
@@ -43,6 +51,7 @@ impl Default for StandardOptions {
         Self {
             layout: None,
             prior: None,
+            nonnegative: Vec::new(),
             gap_tolerance: 1e-12,
             max_iterations: 500,
         }
@@ -85,6 +94,8 @@ struct Problem<'a> {
     v2: Mat<f64>,
     prior: Vec<f64>,
     layout: Layout,
+    /// Parameters kept positive by `−log x_i`.
+    nonnegative: Vec<usize>,
 }
 
 impl Problem<'_> {
@@ -120,7 +131,24 @@ impl Problem<'_> {
         for b in 0..self.layout.bodies {
             v += mu * barrier(&pi[self.body(b)])?.0;
         }
+        for &i in &self.nonnegative {
+            if pi[i] <= 0.0 {
+                return None;
+            }
+            v -= mu * pi[i].ln();
+        }
         Some(v)
+    }
+
+    /// Whether `pi` is strictly inside every constraint.
+    fn interior(&self, pi: &[f64]) -> bool {
+        (0..self.layout.bodies).all(|b| barrier(&pi[self.body(b)]).is_some())
+            && self.nonnegative.iter().all(|&i| pi[i] > 0.0)
+    }
+
+    /// The barrier parameter `ν`: 4 per body, 1 per nonnegative parameter.
+    fn nu(&self) -> f64 {
+        (4 * self.layout.bodies + self.nonnegative.len()) as f64
     }
 }
 
@@ -130,12 +158,18 @@ impl Accumulator {
     /// definite at the returned point), the convex form of the problem
     /// [`Accumulator::log_cholesky`] parameterises.
     ///
+    /// With [`StandardOptions::nonnegative`], those parameters (outside the body
+    /// blocks) are kept `≥ 0` as well.
+    ///
     /// Returns OLS unchanged when OLS is strictly consistent. Otherwise runs the
     /// barrier method from the projected OLS solution, `μ ← μ/10` per centring,
-    /// until `4 · bodies · μ ≤ gap_tolerance · f`; the final bound is in
-    /// [`Method::StandardConsistent`]. Bodies held by the constraint are listed
-    /// there; their identifiable parameters are [`Status::Constrained`], and the
-    /// covariance is withheld (`σ = None`) since the fit is no longer linear.
+    /// until `ν μ ≤ gap_tolerance · f`; the final bound is in
+    /// [`Method::StandardConsistent`]. Bodies and parameters held by a constraint
+    /// are listed there; their identifiable parameters are [`Status::Constrained`],
+    /// and the covariance is withheld (`σ = None`) since the fit is no longer linear.
+    ///
+    /// Errors: a nonnegative index `≥ p` or inside a body block, besides those of
+    /// the estimate itself.
     pub fn standard_consistent(&self, sopts: &StandardOptions, opts: &Options) -> Result<Estimate, IdentifyError> {
         let p = self.n_params();
         let layout = Layout::resolve(sopts.layout, p, 10)?;
@@ -146,6 +180,23 @@ impl Accumulator {
             });
         }
         let prior = prior_or_zero(sopts.prior.as_ref(), p)?;
+        let mut nonnegative = sopts.nonnegative.clone();
+        nonnegative.sort_unstable();
+        nonnegative.dedup();
+        let bodies = layout.first..layout.first + 10 * layout.bodies;
+        if let Some(&i) = nonnegative.iter().find(|&&i| i >= p || bodies.contains(&i)) {
+            return Err(IdentifyError::InvalidArgument {
+                what: "nonnegative parameters",
+                reason: if i >= p {
+                    format!("index {i} of {p} parameters")
+                } else {
+                    format!(
+                        "index {i} lies in the body blocks {}..{}, which the pseudo-inertia constrains",
+                        bodies.start, bodies.end
+                    )
+                },
+            });
+        }
         let ols = self.ols_start(opts)?;
         let (factors, tri, sub, x_ols, dof, noise) = (ols.factors, ols.tri, ols.sub, ols.x_ols, ols.dof, ols.noise);
         let q = p - sub.rank;
@@ -156,6 +207,7 @@ impl Accumulator {
             v2: sub.v.as_ref().subcols(sub.rank, q).to_owned(),
             prior: prior.clone(),
             layout,
+            nonnegative,
         };
         // The unconstrained minimiser: OLS with the null-space part at the prior's.
         let mut x_free = x_ols.clone();
@@ -163,18 +215,19 @@ impl Accumulator {
         for (x, b) in x_free.iter_mut().zip(&back) {
             *x += b;
         }
-        let interior = (0..layout.bodies).all(|b| barrier(&x_free[problem.body(b)]).is_some());
         let BarrierSolution {
             x,
             iterations,
             gap,
             active,
-        } = if interior {
+            params_at_bound,
+        } = if problem.interior(&x_free) {
             BarrierSolution {
                 x: x_free,
                 iterations: 0,
                 gap: 0.0,
                 active: vec![false; layout.bodies],
+                params_at_bound: Vec::new(),
             }
         } else {
             solve_barrier(&problem, &x_free, sopts)?
@@ -194,7 +247,12 @@ impl Accumulator {
                 }
             }
         }
-        let any_active = active.iter().any(|&a| a);
+        for &j in &params_at_bound {
+            if status[j] == Status::Identified {
+                status[j] = Status::Constrained;
+            }
+        }
+        let any_active = active.iter().any(|&a| a) || !params_at_bound.is_empty();
         let cov = if any_active {
             None
         } else {
@@ -206,6 +264,7 @@ impl Accumulator {
             iterations,
             gap_bound: gap,
             bodies_at_bound,
+            params_at_bound,
             min_eigenvalues,
         };
         Ok(Estimate::assemble(
@@ -225,10 +284,12 @@ impl Accumulator {
 struct BarrierSolution {
     x: Vec<f64>,
     iterations: usize,
-    /// Certified suboptimality `4 · bodies · μ`.
+    /// Certified suboptimality `ν μ`.
     gap: f64,
     /// Bodies the barrier holds (their constraint is active).
     active: Vec<bool>,
+    /// Nonnegative parameters the barrier holds at their bound, increasing.
+    params_at_bound: Vec<usize>,
 }
 
 /// Path-following barrier method from the projected unconstrained minimiser.
@@ -239,7 +300,7 @@ fn solve_barrier(
 ) -> Result<BarrierSolution, IdentifyError> {
     let p = x_free.len();
     let layout = problem.layout;
-    let nu = 4.0 * layout.bodies as f64;
+    let nu = problem.nu();
     // Strictly feasible start: each body's pseudo-inertia with eigenvalues raised.
     let mut x = x_free.to_vec();
     for b in 0..layout.bodies {
@@ -251,6 +312,21 @@ fn solve_barrier(
         x[range].copy_from_slice(&super::log_cholesky::standard_from_pseudo_inertia(
             &(0.5 * (j + j.transpose())),
         ));
+    }
+    // Nonnegative parameters start well inside: at least 10⁻³ of the value that
+    // would explain the data alone (`‖z‖ / ‖column‖`, in the parameter's units).
+    let z_norm = dot(problem.z, problem.z).sqrt();
+    for &i in &problem.nonnegative {
+        let column = (0..problem.r.nrows())
+            .map(|k| problem.r[(k, i)].powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let floor = if column > 0.0 && z_norm > 0.0 {
+            1e-3 * z_norm / column
+        } else {
+            1e-3
+        };
+        x[i] = x[i].max(floor);
     }
     let (f0, _) = problem.fit(&x);
     let mut mu = f0.max(f64::MIN_POSITIVE) / nu;
@@ -286,6 +362,11 @@ fn solve_barrier(
                         h[(o + k, o + l)] += mu * bh[k][l];
                     }
                 }
+            }
+            for &i in &problem.nonnegative {
+                value -= mu * x[i].ln();
+                g[i] -= mu / x[i];
+                h[(i, i)] += mu / (x[i] * x[i]);
             }
             let llt = h
                 .llt(Side::Lower)
@@ -332,10 +413,17 @@ fn solve_barrier(
             bg.iter().fold(0.0f64, |a, v| a.max((mu * v).abs())) > 1e-6 * scale
         })
         .collect();
+    let params_at_bound = problem
+        .nonnegative
+        .iter()
+        .copied()
+        .filter(|&i| mu / x[i] > 1e-6 * scale)
+        .collect();
     Ok(BarrierSolution {
         x,
         iterations,
         gap: nu * mu,
         active,
+        params_at_bound,
     })
 }

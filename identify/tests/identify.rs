@@ -608,7 +608,7 @@ fn tls_is_exact_on_noise_free_data() {
     let y = mat_vec(a.as_ref(), &x);
     let est = identify::tls(a.as_ref(), &y).unwrap();
     assert!(rel_err(&values(&est), &x) < 1e-10);
-    assert_eq!(est.method, Method::Tls);
+    assert_eq!(est.method, Method::Tls { column_scaling: true });
 }
 
 #[test]
@@ -626,7 +626,11 @@ fn tls_beats_ols_when_the_regressor_is_noisy() {
             .collect();
         let a = Mat::from_fn(m, 3, |i, j| a_true[(i, j)] + sigma * normal(&mut r));
         let ols = rel_err(&values(&identify::ols(a.as_ref(), &y).unwrap()), &x);
-        let tls_est = identify::tls(a.as_ref(), &y).unwrap();
+        // Equal noise in every entry: the unscaled assumption.
+        let tls_est = Accumulator::from_rows(a.as_ref(), &y, Channels::Single)
+            .unwrap()
+            .tls_unscaled(&Options::default())
+            .unwrap();
         let tls = rel_err(&values(&tls_est), &x);
         e_ols += ols / trials as f64;
         e_tls += tls / trials as f64;
@@ -649,7 +653,210 @@ fn tls_keeps_unidentifiable_directions_unassigned() {
     assert!((est.combinations[1].value - 1.0).abs() < 1e-9);
 }
 
+/// Worst relative error over the components: every parameter counts, whatever its
+/// magnitude.
+fn worst_rel(a: &[f64], truth: &[f64]) -> f64 {
+    a.iter()
+        .zip(truth)
+        .map(|(x, t)| identify::relative_error(*x, *t))
+        .fold(0.0, f64::max)
+}
+
+/// Columns spanning 10⁻³..10³, each with noise of 20 % of its scale, as the
+/// observations: TLS with the columns scaled to unit norm is near the truth (the
+/// noise is then equal in every column, its assumption); unscaled TLS reads the
+/// large column's noise as the small ones' and is far off; OLS is biased toward zero
+/// by the noise in the regressor.
+#[test]
+fn column_scaled_tls_is_far_closer_on_badly_scaled_columns() {
+    let mut r = rng(41);
+    let (m, level) = (20000, 0.2);
+    let scales = [1e-3, 1e-1, 1e1, 1e3];
+    // Each column contributes about equally to y.
+    let x = [1.5e3, -20.0, 0.3, 1.2e-3];
+    let a_true = Mat::from_fn(m, 4, |_, j| scales[j] * normal(&mut r));
+    let y_true = mat_vec(a_true.as_ref(), &x);
+    let y_scale = (y_true.iter().map(|v| v * v).sum::<f64>() / m as f64).sqrt();
+    let y: Vec<f64> = y_true.iter().map(|v| v + level * y_scale * normal(&mut r)).collect();
+    let a = Mat::from_fn(m, 4, |i, j| a_true[(i, j)] + level * scales[j] * normal(&mut r));
+    let acc = Accumulator::from_rows(a.as_ref(), &y, Channels::Single).unwrap();
+    let opts = Options::default();
+    let scaled = acc.tls(&opts).unwrap();
+    let unscaled = acc.tls_unscaled(&opts).unwrap();
+    let ols = acc.ols(&opts).unwrap();
+    let (e_scaled, e_unscaled, e_ols) = (
+        worst_rel(&scaled.solution, &x),
+        worst_rel(&unscaled.solution, &x),
+        worst_rel(&ols.solution, &x),
+    );
+    println!("worst relative error: scaled TLS {e_scaled:.4}, unscaled TLS {e_unscaled:.4}, OLS {e_ols:.4}");
+    assert!(e_scaled < 0.25 * e_ols, "scaled {e_scaled} vs OLS {e_ols}");
+    assert!(
+        e_scaled < 0.1 * e_unscaled,
+        "scaled {e_scaled} vs unscaled {e_unscaled}"
+    );
+    assert_eq!(scaled.method, Method::Tls { column_scaling: true });
+    assert_eq!(unscaled.method, Method::Tls { column_scaling: false });
+    assert!(scaled.method.to_string().contains("columns scaled"));
+    // The σ of the observations' noise, in their units.
+    let sigma = scaled.noise_sigma.unwrap();
+    assert!((sigma / (level * y_scale) - 1.0).abs() < 0.2, "{sigma}");
+    // Rescaling a column (a parameter in other units) rescales its value only.
+    let a2 = Mat::from_fn(m, 4, |i, j| if j == 0 { 1e6 * a[(i, j)] } else { a[(i, j)] });
+    let again = Accumulator::from_rows(a2.as_ref(), &y, Channels::Single)
+        .unwrap()
+        .tls(&opts)
+        .unwrap();
+    assert!((again.solution[0] * 1e6 / scaled.solution[0] - 1.0).abs() < 1e-8);
+    assert!(rel_err(&again.solution[1..], &scaled.solution[1..]) < 1e-8);
+}
+
 // ---------------------------------------------------------------- ridge
+/// The scale-free ridge weight: a column in other units (and the prior in the same
+/// units) gives the same fit for the same λ, where the plain penalty does not; λ → 0
+/// is OLS.
+#[test]
+fn scale_free_ridge_does_not_depend_on_units_and_tends_to_ols() {
+    let mut r = rng(42);
+    let m = 60;
+    let a = random_matrix(&mut r, m, 4);
+    let x = [1.0, -2.0, 0.5, 3.0];
+    let y: Vec<f64> = mat_vec(a.as_ref(), &x)
+        .iter()
+        .map(|v| v + 0.3 * normal(&mut r))
+        .collect();
+    let x0 = [0.5, 0.5, -1.0, 0.5];
+    let c = 1e3;
+    let a2 = Mat::from_fn(m, 4, |i, j| if j == 2 { c * a[(i, j)] } else { a[(i, j)] });
+    let mut x02 = x0;
+    x02[2] /= c;
+    let fit = |a: &Mat<f64>, x0: &[f64], lambda: f64, scaled: bool| {
+        let acc = Accumulator::from_rows(a.as_ref(), &y, Channels::Single).unwrap();
+        let est = if scaled {
+            acc.ridge(x0, lambda, &Options::default())
+        } else {
+            acc.ridge_unscaled(x0, lambda, &Options::default())
+        }
+        .unwrap();
+        (mat_vec(a.as_ref(), &est.solution), est)
+    };
+    for lambda in [1e-3, 0.1, 1.0, 30.0] {
+        let (pred, est) = fit(&a, &x0, lambda, true);
+        let (pred2, est2) = fit(&a2, &x02, lambda, true);
+        assert!(
+            rel_err(&pred2, &pred) < 1e-10,
+            "λ = {lambda}: {}",
+            rel_err(&pred2, &pred)
+        );
+        assert!((est2.solution[2] * c / est.solution[2] - 1.0).abs() < 1e-10);
+        // The data weights and σ follow the units too.
+        let (Method::Ridge { data_weight: w, .. }, Method::Ridge { data_weight: w2, .. }) = (&est.method, &est2.method)
+        else {
+            panic!()
+        };
+        assert!(rel_err(w2, w) < 1e-10);
+        let (s, s2) = (est.params[2].sigma.unwrap(), est2.params[2].sigma.unwrap());
+        assert!((s2 * c / s - 1.0).abs() < 1e-8, "{s} vs {s2}");
+    }
+    // The plain penalty pulls the rescaled parameter a million times harder.
+    let (pred, _) = fit(&a, &x0, 10.0, false);
+    let (pred2, _) = fit(&a2, &x02, 10.0, false);
+    assert!(rel_err(&pred2, &pred) > 1e-3, "{}", rel_err(&pred2, &pred));
+    // λ → 0 is OLS, monotonically.
+    let ols = identify::ols(a.as_ref(), &y).unwrap().solution;
+    let mut last = f64::INFINITY;
+    for lambda in [1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10] {
+        let e = rel_err(&fit(&a, &x0, lambda, true).1.solution, &ols);
+        assert!(e < last, "λ = {lambda}: {e}");
+        last = e;
+    }
+    assert!(last < 1e-9, "{last}");
+    assert!(rel_err(&fit(&a, &x0, 0.0, true).1.solution, &ols) < 1e-12);
+    let est = fit(&a, &x0, 1.0, true).1;
+    assert!(est.method.to_string().contains("scale-free λ = 1"), "{}", est.method);
+}
+
+// ---------------------------------------------------------------- masked rows
+
+/// Rows left out by a mask: the estimates are those of the kept rows alone, each in
+/// the channel of its position; the left-out rows are counted per channel and not
+/// checked.
+#[test]
+fn masked_rows_are_left_out_of_their_channel_and_counted() {
+    let mut r = rng(43);
+    let (samples, n, p) = (300, 3, 5);
+    let a = random_matrix(&mut r, samples * n, p);
+    let mut y: Vec<f64> = mat_vec(a.as_ref(), &[1.0, 2.0, -1.0, 0.5, 0.25])
+        .iter()
+        .map(|v| v + 0.1 * normal(&mut r))
+        .collect();
+    let keep: Vec<bool> = (0..samples * n).map(|_| r.gen::<f64>() > 0.3).collect();
+    // A left-out row may hold anything.
+    let first_out = keep.iter().position(|k| !k).unwrap();
+    y[first_out] = f64::NAN;
+    let mut masked = Accumulator::with_channels(p, Channels::Interleaved(n)).unwrap();
+    for s in 0..samples {
+        let rows = s * n..(s + 1) * n;
+        masked
+            .push_rows_masked(a.as_ref().subrows(s * n, n), &y[rows.clone()], &keep[rows])
+            .unwrap();
+    }
+    let kept: Vec<usize> = (0..samples * n).filter(|&i| keep[i]).collect();
+    let a_kept = Mat::from_fn(kept.len(), p, |i, j| a[(kept[i], j)]);
+    let y_kept: Vec<f64> = kept.iter().map(|&i| y[i]).collect();
+    let labels: Vec<usize> = kept.iter().map(|&i| i % n).collect();
+    let direct = Accumulator::from_rows(a_kept.as_ref(), &y_kept, Channels::Labels(labels)).unwrap();
+    let (e1, e2) = (
+        masked.ols(&Options::default()).unwrap(),
+        direct.ols(&Options::default()).unwrap(),
+    );
+    assert!(rel_err(&e1.solution, &e2.solution) < 1e-12);
+    assert_eq!(e1.residuals.per_channel_rows, e2.residuals.per_channel_rows);
+    assert!(rel_err(&e1.residuals.per_channel_rms, &e2.residuals.per_channel_rms) < 1e-12);
+    let excluded: Vec<usize> = (0..n)
+        .map(|c| (0..samples * n).filter(|&i| i % n == c && !keep[i]).count())
+        .collect();
+    assert_eq!(masked.excluded_per_channel(), excluded);
+    assert_eq!(masked.rows(), samples * n);
+    assert_eq!(
+        masked.rows_per_channel().iter().sum::<usize>() + excluded.iter().sum::<usize>(),
+        samples * n
+    );
+    // Filled in two parts and merged: the same, counts included.
+    let mut first = masked.empty_part();
+    let mut second = masked.empty_part();
+    let half = samples / 2 * n;
+    first
+        .push_rows_masked(a.as_ref().subrows(0, half), &y[..half], &keep[..half])
+        .unwrap();
+    second
+        .push_rows_masked(a.as_ref().subrows(half, samples * n - half), &y[half..], &keep[half..])
+        .unwrap();
+    first.merge(&second).unwrap();
+    assert_eq!(first.excluded_per_channel(), excluded);
+    assert!(rel_err(&first.ols(&Options::default()).unwrap().solution, &e1.solution) < 1e-12);
+    // A mask of the wrong length; a kept row with NaN; nothing kept at all.
+    assert!(matches!(
+        masked.push_rows_masked(a.as_ref().subrows(0, 3), &y[3..6], &[true, false]),
+        Err(IdentifyError::DimensionMismatch {
+            expected: 3,
+            found: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        masked.push_rows_masked(a.as_ref().subrows(0, 3), &[0.0, f64::NAN, 0.0], &[true; 3]),
+        Err(IdentifyError::NonFinite {
+            input: Input::Observation,
+            ..
+        })
+    ));
+    let mut none = Accumulator::with_channels(p, Channels::Interleaved(n)).unwrap();
+    none.push_rows_masked(a.as_ref().subrows(0, 3), &y[..3], &[false; 3])
+        .unwrap();
+    assert!(matches!(none.finish(), Err(IdentifyError::Empty)));
+    assert_eq!(none.excluded_per_channel(), vec![1, 1, 1]);
+}
 
 #[test]
 fn ridge_tends_to_ols_and_to_the_prior() {
@@ -662,7 +869,7 @@ fn ridge_tends_to_ols_and_to_the_prior() {
         .collect();
     let x0 = [10.0, 10.0, 10.0, 10.0, 10.0];
     let ols = values(&identify::ols(a.as_ref(), &y).unwrap());
-    let small = identify::ridge(a.as_ref(), &y, &x0, 1e-10).unwrap();
+    let small = identify::ridge(a.as_ref(), &y, &x0, 1e-12).unwrap();
     assert!(rel_err(&values(&small), &ols) < 1e-10);
     assert!(small.params.iter().all(|q| q.status == Status::Identified));
     let big = identify::ridge(a.as_ref(), &y, &x0, 1e14).unwrap();
@@ -1144,6 +1351,90 @@ fn standard_consistent_is_certified_optimal_when_ols_is_not() {
     }
 }
 
+/// One body and three extra parameters (say a rotor inertia, a viscous friction
+/// truly zero, and an offset): OLS makes the friction negative; kept `≥ 0`, it ends
+/// at the bound, reported, and the rest is the least-squares fit with it at zero.
+#[test]
+fn standard_consistent_keeps_extra_parameters_nonnegative() {
+    let mut r = rng(44);
+    let mut truth = random_body(&mut r).to_vec();
+    truth.extend([0.4, 0.0, -0.2]);
+    let a = random_matrix(&mut r, 80, 13);
+    let (y, ols, acc) = (0..50)
+        .find_map(|_| {
+            let y: Vec<f64> = mat_vec(a.as_ref(), &truth)
+                .iter()
+                .map(|v| v + 0.05 * normal(&mut r))
+                .collect();
+            let acc = Accumulator::from_rows(a.as_ref(), &y, Channels::Single).unwrap();
+            let ols = acc.ols(&Options::default()).unwrap();
+            (ols.solution[11] < 0.0 && min_eig(&ols.solution[..10]) > 0.0).then_some((y, ols, acc))
+        })
+        .expect("a noise draw where OLS makes the friction negative");
+    let sopts = StandardOptions {
+        layout: Some(Layout { first: 0, bodies: 1 }),
+        nonnegative: vec![10, 11],
+        ..StandardOptions::default()
+    };
+    let est = acc.standard_consistent(&sopts, &Options::default()).unwrap();
+    let x = &est.solution;
+    assert!(x[10] > 0.0 && x[11] > 0.0 && min_eig(&x[..10]) > 0.0, "{x:?}");
+    let Method::StandardConsistent {
+        gap_bound,
+        bodies_at_bound,
+        params_at_bound,
+        ..
+    } = &est.method
+    else {
+        panic!()
+    };
+    assert_eq!(params_at_bound, &vec![11]);
+    assert!(bodies_at_bound.is_empty());
+    assert_eq!(est.params[11].status, Status::Constrained);
+    assert_eq!(est.params[10].status, Status::Identified);
+    assert!(est.covariance.is_none());
+    assert!(
+        est.method.to_string().contains("1 parameter held at 0"),
+        "{}",
+        est.method
+    );
+    let f = rss(a.as_ref(), &y, x);
+    assert!(*gap_bound <= 1e-12 * 0.5 * f);
+    assert!(f >= rss(a.as_ref(), &y, &ols.solution));
+    // The optimum: least squares without column 11 (the bound active, nothing else).
+    let without = Mat::from_fn(80, 12, |i, j| a[(i, if j < 11 { j } else { j + 1 })]);
+    let mut fixed = identify::ols(without.as_ref(), &y).unwrap().solution;
+    fixed.insert(11, 0.0);
+    assert!(rel_err(x, &fixed) < 1e-6, "{}", rel_err(x, &fixed));
+    assert!(x[11] < 1e-6, "{}", x[11]);
+    // Where OLS is already nonnegative nothing changes.
+    let free = StandardOptions {
+        nonnegative: vec![10],
+        ..sopts.clone()
+    };
+    assert_eq!(
+        acc.standard_consistent(&free, &Options::default()).unwrap().solution,
+        ols.solution
+    );
+    // Indices in a body block or past the end are refused, by name.
+    for (bad, needle) in [
+        (vec![3], "index 3 lies in the body blocks 0..10"),
+        (vec![13], "index 13 of 13"),
+    ] {
+        let e = acc
+            .standard_consistent(
+                &StandardOptions {
+                    nonnegative: bad,
+                    ..sopts.clone()
+                },
+                &Options::default(),
+            )
+            .unwrap_err();
+        assert!(matches!(e, IdentifyError::InvalidArgument { .. }));
+        assert!(e.to_string().contains(needle), "{e}");
+    }
+}
+
 #[test]
 fn standard_consistent_equals_ols_when_ols_is_consistent() {
     let mut r = rng(25);
@@ -1210,7 +1501,10 @@ fn rls_with_unit_forgetting_converges_to_batch_least_squares() {
     rls.update_block(a.as_ref(), &y).unwrap();
     assert_eq!(rls.updates(), m);
     // Exactly ridge toward 0 with weight 1/δ …
-    let ridge = identify::ridge(a.as_ref(), &y, &[0.0; 5], 1.0 / delta).unwrap();
+    let ridge = Accumulator::from_rows(a.as_ref(), &y, Channels::Single)
+        .unwrap()
+        .ridge_unscaled(&[0.0; 5], 1.0 / delta, &Options::default())
+        .unwrap();
     assert!(
         rel_err(rls.estimate(), &ridge.solution) < 1e-9,
         "{}",
@@ -1427,9 +1721,17 @@ fn tls_reports_the_nongeneric_case() {
         (1, 1) => 1e-3,
         _ => 0.0,
     });
-    let e = identify::tls(a.as_ref(), &[1.0, 0.0, 1.0]).unwrap_err();
+    let e = Accumulator::from_rows(a.as_ref(), &[1.0, 0.0, 1.0], Channels::Single)
+        .unwrap()
+        .tls_unscaled(&Options::default())
+        .unwrap_err();
     assert_eq!(e, IdentifyError::TlsNongeneric);
     assert!(e.to_string().starts_with("total least squares has no solution"));
+    // Scaled, that column is as strong as the others; y orthogonal to every column
+    // makes the scaled [A y] a tie with no smallest direction.
+    let a = Mat::from_fn(3, 2, |i, j| if i == j { 1.0 } else { 0.0 });
+    let e = identify::tls(a.as_ref(), &[0.0, 0.0, 2.0]).unwrap_err();
+    assert_eq!(e, IdentifyError::TlsNongeneric);
 }
 
 #[test]

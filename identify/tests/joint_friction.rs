@@ -4,12 +4,14 @@
 //! stamps, duplicate rows, motor currents, 1 % torque noise), validated on a second
 //! recording it was not identified on.
 
-use dyngen_identify::data::Recipe;
+use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
+use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, PipelineError, Prediction};
+use dyngen_identify::report::MergedLinks;
 use dyngen_identify::simulate::{add_joint_terms, record_trajectory, FourierExcitation, Gaussian, Logger, Recording};
 use dyngen_identify::validate::Validation;
-use dyngen_identify::{Accumulator, Channels, Options};
+use dyngen_identify::{Accumulator, Channels, Method, Options, Status};
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::sample::SplitMix64;
 use dyngen_reference::Reference;
@@ -288,4 +290,182 @@ fn drive_gains_from_a_known_payload() {
             GAINS[j]
         );
     }
+}
+
+/// A simulated recording with joint terms `joints` (`[Ia, Fv, Fc, F0]` per joint)
+/// and 1 % torque noise, as a trajectory with exact velocities and accelerations.
+fn noisy_trajectory(robot: &Reference, joints: &[f64], motion_seed: u64, noise_seed: u64) -> Trajectory {
+    let times: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64).collect();
+    let mut rec = record_trajectory(robot, &robot.model().standard_params(), &motion(motion_seed), &times);
+    add_joint_terms(&mut rec, joints, Coulomb::Sign);
+    add_torque_noise(&mut rec, &mut Gaussian::new(noise_seed));
+    rec.to_trajectory().unwrap()
+}
+
+fn with_friction(estimator: Estimator) -> IdentifyOptions {
+    IdentifyOptions {
+        estimator,
+        joints: JointTerms::Friction(Coulomb::Sign),
+        ..IdentifyOptions::default()
+    }
+}
+
+fn overall_error(robot: &Reference, id: &pipeline::Identification, traj: &Trajectory) -> f64 {
+    let predicted = id.predict(robot, traj).unwrap();
+    let names: Vec<String> = robot.model().joints.iter().map(|j| j.name.clone()).collect();
+    Validation::new(
+        &names,
+        (0..traj.len()).map(|k| traj.tau(k)),
+        predicted.iter().map(|p| &p[..]),
+    )
+    .unwrap()
+    .overall
+}
+
+/// Joint 4 without viscous friction: with 1 % torque noise OLS makes its Fv
+/// negative; the consistent estimator keeps every Ia, Fv, Fc ≥ 0 (Fv4 held at the
+/// bound) and predicts another recording as well as OLS.
+#[test]
+fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
+    let robot = robot();
+    let mut joints = joint_truth();
+    joints[4 * 3 + 1] = 0.0;
+    let traj = noisy_trajectory(&robot, &joints, 1, 3);
+    let check = noisy_trajectory(&robot, &joints, 2, 4);
+    let ols = pipeline::identify(&robot, &traj, &with_friction(Estimator::Ols)).unwrap();
+    let consistent = pipeline::identify(&robot, &traj, &with_friction(Estimator::Consistent)).unwrap();
+    let fv4 = 60 + 4 * 3 + 1;
+    let solution = |id: &pipeline::Identification| match &id.prediction {
+        Prediction::Regressor(t) => t.estimate.clone(),
+        Prediction::Parameters(_) => panic!("a torque estimate"),
+    };
+    let (ols_est, est) = (solution(&ols), solution(&consistent));
+    println!(
+        "Fv4: OLS {:.4}, consistent {:.3e}",
+        ols_est.solution[fv4], est.solution[fv4]
+    );
+    assert!(ols_est.solution[fv4] < 0.0, "OLS Fv4 {}", ols_est.solution[fv4]);
+    for j in 0..6 {
+        for k in 0..3 {
+            let i = 60 + 4 * j + k;
+            assert!(est.solution[i] >= 0.0, "joint {} [{k}]: {}", j + 1, est.solution[i]);
+        }
+    }
+    // Truly zero, estimated near it: the bodies held at their bounds move it off
+    // zero a little (7e-4 here).
+    assert!(est.solution[fv4] < 0.01, "{}", est.solution[fv4]);
+    let Method::StandardConsistent { params_at_bound, .. } = &est.method else {
+        panic!("{}", est.method)
+    };
+    println!("{}; at the bound: {params_at_bound:?}", est.method);
+    assert!(!params_at_bound.is_empty());
+    for &i in params_at_bound {
+        assert!(matches!(
+            est.params[i].status,
+            Status::Constrained | Status::InCombination
+        ));
+    }
+    let param = &consistent.report.parameters[fv4];
+    assert_eq!(param.name, "Fv4");
+    assert!(param.value.is_some_and(|v| v >= 0.0), "{param:?}");
+    // The fit and the prediction of an unseen recording: within 1 % of OLS's.
+    assert!(est.residuals.rms <= 1.01 * ols_est.residuals.rms);
+    let (e_ols, e_cons) = (
+        overall_error(&robot, &ols, &check),
+        overall_error(&robot, &consistent, &check),
+    );
+    println!("validation: OLS {e_ols:.5}, consistent {e_cons:.5}");
+    assert!(e_cons <= 1.01 * e_ols, "consistent {e_cons} vs OLS {e_ols}");
+    // Every joint's friction goes to the URDF, those at a bound included.
+    let urdf = include_str!("../../robots/ur5/ur5.urdf");
+    let rewrite = consistent.rewrite_urdf(urdf, robot.model(), MergedLinks::Lump).unwrap();
+    assert_eq!(rewrite.dynamics.len(), 6, "{:?}", rewrite.dynamics_kept);
+    assert!(rewrite.dynamics.iter().all(|(_, fv, fc)| *fv >= 0.0 && *fc >= 0.0));
+    // The smoothed Coulomb term is constrained the same way.
+    let smooth = IdentifyOptions {
+        joints: JointTerms::Friction(Coulomb::Smooth { epsilon: 0.01 }),
+        ..with_friction(Estimator::Consistent)
+    };
+    let id = pipeline::identify(&robot, &traj, &smooth).unwrap();
+    let est = solution(&id);
+    assert!((0..6).all(|j| (0..3).all(|k| est.solution[60 + 4 * j + k] >= 0.0)));
+    // The principal form takes no joint terms: refused, by name.
+    let principal = IdentifyOptions {
+        mode: pipeline::Mode::Principal,
+        ..with_friction(Estimator::Consistent)
+    };
+    let e = pipeline::identify(&robot, &traj, &principal).unwrap_err();
+    assert!(
+        e.to_string().starts_with("friction applies to the standard mode"),
+        "{e}"
+    );
+}
+
+/// Rows of a joint slower than the threshold are left out of its equations and
+/// counted; the identification still recovers the friction; bad thresholds are
+/// refused by name.
+#[test]
+fn rows_below_a_speed_are_left_out_and_counted() {
+    let robot = robot();
+    let traj = noisy_trajectory(&robot, &joint_truth(), 1, 3);
+    let speed = 0.05;
+    let options = IdentifyOptions {
+        exclude_below: Some(speed),
+        ..with_friction(Estimator::Ols)
+    };
+    let id = pipeline::identify(&robot, &traj, &options).unwrap();
+    let expected: Vec<usize> = (0..6)
+        .map(|j| (0..traj.len()).filter(|&k| traj.v(k).unwrap()[j].abs() < speed).count())
+        .collect();
+    println!("left out per joint: {expected:?} of {}", traj.len());
+    assert_eq!(id.excluded_rows, expected);
+    assert!(expected.iter().all(|&c| c > 0 && c < traj.len() / 4), "{expected:?}");
+    let Prediction::Regressor(t) = &id.prediction else {
+        panic!()
+    };
+    assert_eq!(
+        t.estimate.residuals.rows,
+        6 * traj.len() - expected.iter().sum::<usize>()
+    );
+    for j in 0..6 {
+        let (fv, fc) = (t.estimate.solution[60 + 4 * j + 1], t.estimate.solution[60 + 4 * j + 2]);
+        assert!((fv - FV[j]).abs() < 0.05 * FV[j], "Fv{}: {fv}", j + 1);
+        assert!((fc - FC[j]).abs() < 0.05 * FC[j], "Fc{}: {fc}", j + 1);
+    }
+    let all = pipeline::identify(&robot, &traj, &with_friction(Estimator::Ols)).unwrap();
+    assert_eq!(all.excluded_rows, vec![0; 6]);
+    for bad in [-0.1, 0.0, f64::NAN, f64::INFINITY] {
+        let o = IdentifyOptions {
+            exclude_below: Some(bad),
+            ..options.clone()
+        };
+        let e = pipeline::identify(&robot, &traj, &o).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                PipelineError::InvalidOption {
+                    option: "exclude-below",
+                    ..
+                }
+            ),
+            "{bad}: {e:?}"
+        );
+        assert!(e.to_string().contains("must be a positive speed"), "{e}");
+    }
+    let e = pipeline::identify(
+        &robot,
+        &traj,
+        &IdentifyOptions {
+            exclude_below: Some(1e6),
+            ..options.clone()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("leaves no torque row"), "{e}");
+    let mim = IdentifyOptions {
+        mode: pipeline::Mode::Mim,
+        exclude_below: Some(speed),
+        ..IdentifyOptions::default()
+    };
+    assert!(mim.check().unwrap_err().to_string().contains("MIM uses every sample"));
 }

@@ -12,8 +12,9 @@
 //!
 //! ```
 //! use dyngen::{Coulomb, JointParams};
-//! let p = JointParams::from_array([0.2, 1.5, 3.0, -0.1]); // Ia, Fv, Fc, F0
-//! assert_eq!(p.torque(0.5, 2.0, Coulomb::Sign), 0.2 * 2.0 + 1.5 * 0.5 + 3.0 - 0.1);
+//! let p = JointParams::<f64>::from_array([0.2, 1.5, 3.0, -0.1]); // Ia, Fv, Fc, F0
+//! let tau = p.torque(0.5, 2.0, Coulomb::Sign);
+//! assert!((tau - (0.2 * 2.0 + 1.5 * 0.5 + 3.0 - 0.1)).abs() < 1e-12);
 //! let row = JointParams::regressor_row(0.5, 2.0, Coulomb::Sign);
 //! assert_eq!(row, [2.0, 0.5, 1.0, 1.0]);
 //! ```

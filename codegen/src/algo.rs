@@ -3,7 +3,7 @@
 //! independently of the runtime's 6D spatial reference so the two check each other.
 //!
 //! Function arguments are numbered: `q` = 0, `v` = 1, `a` = 2 (or `tau` for `aba`),
-//! `params` = 3.
+//! `params` = 3, `joint_params` = 4.
 
 use crate::sym::{Expr, Graph};
 use dyngen_model::{JointKind, Model};
@@ -15,6 +15,8 @@ pub const ARG_A: u8 = 2;
 pub const ARG_PARAMS: u8 = 3;
 /// `aba` reads joint torques in the slot of `a`.
 pub const ARG_TAU: u8 = ARG_A;
+/// The joint parameters `[Ia, Fv, Fc, F0]`, 4 per joint.
+pub const ARG_JOINT_PARAMS: u8 = 4;
 
 /// A 3-vector of expressions.
 #[derive(Clone, Copy, Debug)]
@@ -726,9 +728,20 @@ impl<'g> Inertia6<'g> {
     }
 }
 
+/// Whether [`aba`] adds rotor inertias to the joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Armature {
+    /// Rigid bodies only.
+    None,
+    /// Joint `j`'s rotor inertia `Ia` read from `joint_params[4(j−1)]`, added to the
+    /// articulated inertia seen along the joint axis (`D_j = Sᵀ Iᴬ S + Ia`), as
+    /// Pinocchio's `armature`: `a = (M(q) + diag(Ia))⁻¹ (tau − h(q, v))`.
+    Input,
+}
+
 /// Featherstone's articulated-body algorithm: `a = M(q)⁻¹ (tau − h(q, v))`, with
 /// `tau` read from the `a` argument slot. One division per joint.
-pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
+pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>> {
     let n = model.dof();
     g.mark("joint transforms");
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
@@ -760,7 +773,10 @@ pub fn aba<'g>(g: &'g Graph, model: &Model) -> Vec<Expr<'g>> {
     for i in (1..=n).rev() {
         mark_body(g, model, i, "articulated inertia");
         let ui = ia[i].apply(s[i - 1]);
-        let d = ui.dot(s[i - 1]);
+        let d = match armature {
+            Armature::None => ui.dot(s[i - 1]),
+            Armature::Input => ui.dot(s[i - 1]) + g.input(ARG_JOINT_PARAMS, (4 * (i - 1)) as u32),
+        };
         let id = g.one() / d;
         let tau = g.input(ARG_TAU, (i - 1) as u32);
         let ui_scalar = tau - pa[i].dot(s[i - 1]);

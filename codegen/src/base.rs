@@ -1,13 +1,13 @@
 //! Base parameters, the analysis pass between the checked model and generation. The
 //! analysis itself is `dyngen_model::base` (one home, shared with the command line
-//! and identification); this module only asks it for both parameterisations.
+//! and identification); this module only asks it for all three parameterisations.
 
 use dyngen_model::base::{analyse, Parameterisation};
 use dyngen_model::Model;
 
 pub use dyngen_model::base::{BaseParams, RANK_TOLERANCE};
 
-/// The base parameters of both parameterisations of one model: what
+/// The base parameters of every parameterisation of one model: what
 /// [`crate::generate`] needs besides the model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bases {
@@ -15,15 +15,19 @@ pub struct Bases {
     pub standard: BaseParams,
     /// Of the principal parameters `θ = (m, J1, J2, J3)`, 4 per body.
     pub principal: BaseParams,
+    /// Of the standard parameters followed by the joint parameters `[Ia, Fv, Fc, F0]`
+    /// of every joint (`14n` columns, Coulomb friction as `sign(q̇)`).
+    pub joints: BaseParams,
 }
 
-/// The base-parameter analysis of `model` in both parameterisations
+/// The base-parameter analysis of `model` in the three parameterisations
 /// (`dyngen_model::base::analyse`: ordered QR on stacked random regressors, with a
 /// second seed and a singular-value count as checks).
 pub fn analyse_model(model: &Model) -> Bases {
     Bases {
         standard: analyse(model, Parameterisation::Standard),
         principal: analyse(model, Parameterisation::Principal),
+        joints: analyse(model, Parameterisation::StandardAndJoints),
     }
 }
 

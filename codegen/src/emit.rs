@@ -40,6 +40,8 @@ pub enum Output<'a> {
 /// A function to emit: its signature pieces and symbolic outputs.
 pub struct FnSpec<'a> {
     pub name: &'a str,
+    /// `pub fn`, or a private helper of the type's other functions.
+    pub public: bool,
     pub doc: String,
     /// Arguments in signature order.
     pub args: Vec<Arg>,
@@ -140,6 +142,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         .collect();
     let ops = OpCount::of(graph, &spec.outputs);
     let fname = format_ident!("{}", spec.name);
+    let vis = if spec.public { quote!(pub) } else { quote!() };
     // One attribute per line, so that prettyplease prints `///` lines.
     let doc: Vec<String> = spec
         .doc
@@ -273,7 +276,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             #[doc = ""]
             #[doc = #op_doc]
             #[inline]
-            pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+            #vis fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
                 #(#early_stores)*
                 #(#body)*
                 #value
@@ -396,7 +399,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         #(#[doc = #doc])*
         #[doc = ""]
         #[doc = #op_doc]
-        pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+        #vis fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
             let mut w = [<S as ::dyngen::Scalar>::ZERO; #width];
             #(#early_stores)*
             #(#calls)*

@@ -5,7 +5,7 @@
 //! Every generated algorithm is one entry of [`ALGORITHMS`]: its inherent function,
 //! its `Robot` method and its line in `OP_COUNTS` are all made from that entry.
 
-use crate::algo::{self, Force, Inputs, ARG_A, ARG_PARAMS, ARG_Q, ARG_TAU, ARG_V};
+use crate::algo::{self, Force, Inputs, ARG_A, ARG_JOINT_PARAMS, ARG_PARAMS, ARG_Q, ARG_TAU, ARG_V};
 use crate::base::{BaseParams, Bases};
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
 use crate::sym::{Expr, Graph, NodeId};
@@ -111,28 +111,33 @@ fn force_ids(forces: &[Force<'_>]) -> Vec<NodeId> {
         .collect()
 }
 
-/// `β = K · x` as straight-line code over the argument `x`.
-fn base_params_ids(g: &Graph, bp: &BaseParams) -> Vec<NodeId> {
+/// `β = K · x` as straight-line code over the argument `x`; with `joints`, columns
+/// from `joints` on are read from `joint_params` (`x = [params; joint_params]`).
+fn base_params_ids(g: &Graph, bp: &BaseParams, joints: Option<usize>) -> Vec<NodeId> {
+    let input = |c: usize| match joints {
+        Some(first) if c >= first => g.input(ARG_JOINT_PARAMS, (c - first) as u32),
+        _ => g.input(ARG_PARAMS, c as u32),
+    };
     bp.k.iter()
         .map(|row| {
             row.iter()
                 .enumerate()
                 .filter(|(_, &x)| x != 0.0)
-                .fold(g.zero(), |acc, (c, &x)| {
-                    acc + g.constant(x) * g.input(ARG_PARAMS, c as u32)
-                })
+                .fold(g.zero(), |acc, (c, &x)| acc + g.constant(x) * input(c))
                 .id()
         })
         .collect()
 }
 
 /// The sizes a generated robot's signatures and docs are written with.
-struct Sizes {
+pub(crate) struct Sizes {
     /// Joints = moving bodies = degrees of freedom.
-    n: usize,
-    /// Base parameters of the standard and the principal parameterisation.
-    nb: usize,
-    nbt: usize,
+    pub(crate) n: usize,
+    /// Base parameters of the standard and the principal parameterisation, and of
+    /// the standard and joint parameters together.
+    pub(crate) nb: usize,
+    pub(crate) nbt: usize,
+    pub(crate) nbj: usize,
 }
 
 impl Sizes {
@@ -144,20 +149,29 @@ impl Sizes {
             Len::Base => self.nb,
             Len::PrincipalBase => self.nbt,
             Len::WrenchRows => 6 * self.n,
+            Len::JointParams => 4 * self.n,
+            Len::BaseJoints => self.nbj,
         }
     }
 
-    fn state(&self) -> String {
+    pub(crate) fn state(&self) -> String {
         format!(
             "`q, v, a`: {} joint positions (rad or m), velocities, accelerations",
             self.n
         )
     }
 
-    fn params(&self) -> String {
+    pub(crate) fn params(&self) -> String {
         format!(
             "`params`: {} standard parameters, 10 per body (`Self::NOMINAL_PARAMS` for the description's)",
             10 * self.n
+        )
+    }
+
+    pub(crate) fn joint_params(&self) -> String {
+        format!(
+            "`joint_params`: {} joint parameters `[Ia, Fv, Fc, F0]`, 4 per joint (`Self::NOMINAL_JOINT_PARAMS` for the description's)",
+            4 * self.n
         )
     }
 }
@@ -172,6 +186,9 @@ enum Len {
     PrincipalBase,
     /// `6 n`: a `[force; moment]` row block per joint.
     WrenchRows,
+    /// `4 n`: `[Ia, Fv, Fc, F0]` per joint.
+    JointParams,
+    BaseJoints,
 }
 
 /// An argument of a generated function (`&[S; len]` in the inherent function, `&[S]`
@@ -184,6 +201,7 @@ enum In {
     Tau,
     Params,
     Theta,
+    JointParams,
 }
 
 impl In {
@@ -195,6 +213,7 @@ impl In {
             In::Tau => (ARG_TAU, "tau", Len::Dof),
             In::Params => (ARG_PARAMS, "params", Len::Params),
             In::Theta => (ARG_PARAMS, "theta", Len::Theta),
+            In::JointParams => (ARG_JOINT_PARAMS, "joint_params", Len::JointParams),
         };
         Arg {
             id,
@@ -398,7 +417,12 @@ const ALGORITHMS: &[Algorithm] = &[
                 n = s.n
             )
         },
-        build: |g, model, _| algo::aba(g, model).iter().map(|x| x.id()).collect(),
+        build: |g, model, _| {
+            algo::aba(g, model, algo::Armature::None)
+                .iter()
+                .map(|x| x.id())
+                .collect()
+        },
     },
     Algorithm {
         name: "joint_torque_regressor",
@@ -540,7 +564,7 @@ const ALGORITHMS: &[Algorithm] = &[
                 10 * s.n
             )
         },
-        build: |g, _, bases| base_params_ids(g, &bases.standard),
+        build: |g, _, bases| base_params_ids(g, &bases.standard, None),
     },
     Algorithm {
         name: "principal_base_params",
@@ -554,7 +578,22 @@ const ALGORITHMS: &[Algorithm] = &[
                 4 * s.n
             )
         },
-        build: |g, _, bases| base_params_ids(g, &bases.principal),
+        build: |g, _, bases| base_params_ids(g, &bases.principal, None),
+    },
+    Algorithm {
+        name: "base_params_joints",
+        args: &[In::Params, In::JointParams],
+        out: "beta",
+        shape: Shape::Vector(Len::BaseJoints),
+        doc: |s| {
+            format!(
+                "The {} base parameters of the standard and joint parameters together:\n`β_j = K_j · [params; joint_params]` (`Self::BASE_JOINTS_K`), groupings in\n`Self::BASE_JOINTS_GROUPINGS`. {}; {}.",
+                s.nbj,
+                s.params(),
+                s.joint_params()
+            )
+        },
+        build: |g, model, bases| base_params_ids(g, &bases.joints, Some(10 * model.dof())),
     },
 ];
 
@@ -595,6 +634,7 @@ impl Algorithm {
         };
         FnSpec {
             name: self.name,
+            public: true,
             doc: (self.doc)(sizes),
             args: self.args.iter().map(|a| a.arg(sizes)).collect(),
             ret,
@@ -664,6 +704,7 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
         n: model.dof(),
         nb: bases.standard.count(),
         nbt: bases.principal.count(),
+        nbj: bases.joints.count(),
     };
     let mut functions = Vec::new();
     let mut items = Vec::new();
@@ -676,6 +717,10 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
         functions.push(report);
         methods.push(algorithm.trait_method(&format_ident!("{}", name), &sizes));
     }
+    let joints = crate::joints::generate(model, bases, &sizes, options.max_statements);
+    functions.extend(joints.reports);
+    items.extend(joints.items);
+    methods.extend(joints.methods);
     let tokens = robot_type(model, &format_ident!("{}", name), bases, &functions, &items, &methods);
     GeneratedCode {
         tokens,
@@ -838,6 +883,23 @@ fn robot_type(
         "The {nbt} base parameters of the principal parameterisation, found the same way:\n{}",
         grouping_list(pbase)
     ));
+    let jbase = &bases.joints;
+    let nbj = jbase.count();
+    let (nbj_lit, nj_lit) = (emit::usize_lit(nbj), emit::usize_lit(4 * n));
+    let jgroupings = &jbase.groupings;
+    let jbase_index = jbase.independent.iter().map(|&c| emit::usize_lit(c));
+    let jbase_k = sparse_rows(&jbase.k);
+    let nbjk = emit::usize_lit(nbj * 14 * n);
+    let nominal_joints = f64_array(&dyngen_model::joint_params::nominal_joint_params(model));
+    let jbase_doc = doc_attrs(&format!(
+        "The {nbj} base parameters of the standard and joint parameters together\n(`[params; joint_params]`, {} columns, Coulomb friction as `sign(v)`), found the same way:\n{}",
+        14 * n,
+        grouping_list(jbase)
+    ));
+    let jbase_k_doc = doc_attrs(&format!(
+        "`K_j` ({nbj} × {}, row-major): `β_j = K_j · [params; joint_params]`.",
+        14 * n
+    ));
     let base_k_doc = doc_attrs(&format!("`K` ({nb} × {}, row-major): `β = K · params`.", 10 * n));
     let pbase_k_doc = doc_attrs(&format!("`K_θ` ({nbt} × {}, row-major): `β_θ = K_θ · theta`.", 4 * n));
     let doc = doc_attrs(&format!(
@@ -869,6 +931,10 @@ fn robot_type(
             pub const NBASE: usize = #nb_lit;
             /// Number of base parameters of the principal parameterisation.
             pub const NBASE_PRINCIPAL: usize = #nbt_lit;
+            /// Number of joint parameters (4 per joint: `Ia, Fv, Fc, F0`).
+            pub const NJOINT_PARAMS: usize = #nj_lit;
+            /// Number of base parameters of the standard and joint parameters together.
+            pub const NBASE_JOINTS: usize = #nbj_lit;
             /// Joint names, joint 1 first.
             pub const JOINT_NAMES: [&'static str; #n_lit] = [#(#joint_names),*];
             /// Moving body names, body 1 first.
@@ -882,6 +948,9 @@ fn robot_type(
             pub const NOMINAL_PARAMS: [f64; #np_lit] = #nominal;
             /// The description's principal parameters `theta = (m, J1, J2, J3)`, 4 per body.
             pub const NOMINAL_THETA: [f64; #nt_lit] = #theta;
+            /// The description's joint parameters, 4 per joint `[Ia, Fv, Fc, F0]`: viscous and
+            /// Coulomb friction from URDF `<dynamics damping friction>`, rotor inertia and offset 0.
+            pub const NOMINAL_JOINT_PARAMS: [f64; #nj_lit] = #nominal_joints;
             #base_doc
             pub const BASE_GROUPINGS: [&'static str; #nb_lit] = [#(#groupings),*];
             /// Which standard parameters the base parameters are built on (`Y_b` = these columns of `Y`).
@@ -894,6 +963,12 @@ fn robot_type(
             pub const PRINCIPAL_BASE_INDEX: [usize; #nbt_lit] = [#(#pbase_index),*];
             #pbase_k_doc
             pub const PRINCIPAL_BASE_K: [f64; #nbtk] = #pbase_k;
+            #jbase_doc
+            pub const BASE_JOINTS_GROUPINGS: [&'static str; #nbj_lit] = [#(#jgroupings),*];
+            /// Which columns of `[params; joint_params]` the joint base parameters are built on.
+            pub const BASE_JOINTS_INDEX: [usize; #nbj_lit] = [#(#jbase_index),*];
+            #jbase_k_doc
+            pub const BASE_JOINTS_K: [f64; #nbjk] = #jbase_k;
             /// The checked model the code was generated from (fixed joints merged), in
             /// the generated numbering: joint and body `j` are `joints[j - 1]` and
             /// `bodies[j - 1]`.
@@ -915,6 +990,8 @@ fn robot_type(
             const NTHETA: usize = #nt_lit;
             const NBASE: usize = #nb_lit;
             const NBASE_PRINCIPAL: usize = #nbt_lit;
+            const NJOINT_PARAMS: usize = #nj_lit;
+            const NBASE_JOINTS: usize = #nbj_lit;
             const MODEL: ::dyngen::RobotModel = <#ty>::MODEL;
             fn joint_names() -> &'static [&'static str] { &Self::JOINT_NAMES }
             fn body_names() -> &'static [&'static str] { &Self::BODY_NAMES }
@@ -927,6 +1004,10 @@ fn robot_type(
             fn principal_base_groupings() -> &'static [&'static str] { &Self::PRINCIPAL_BASE_GROUPINGS }
             fn principal_base_index() -> &'static [usize] { &Self::PRINCIPAL_BASE_INDEX }
             fn principal_base_k() -> &'static [f64] { &Self::PRINCIPAL_BASE_K }
+            fn nominal_joint_params() -> &'static [f64] { &Self::NOMINAL_JOINT_PARAMS }
+            fn base_joints_groupings() -> &'static [&'static str] { &Self::BASE_JOINTS_GROUPINGS }
+            fn base_joints_index() -> &'static [usize] { &Self::BASE_JOINTS_INDEX }
+            fn base_joints_k() -> &'static [f64] { &Self::BASE_JOINTS_K }
             fn gravity() -> [f64; 3] { Self::GRAVITY }
             fn op_counts() -> &'static [(&'static str, ::dyngen::OpCount)] { &Self::OP_COUNTS }
 

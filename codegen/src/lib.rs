@@ -18,6 +18,7 @@ mod build;
 pub mod dsl;
 pub mod emit;
 mod generate;
+mod joints;
 pub mod sym;
 
 pub use base::{analyse_model, BaseParams, Bases};

@@ -2,9 +2,10 @@
 //!
 //! What generated robot code needs, and nothing more: the [`Robot`] trait, the
 //! [`Scalar`] trait, the small spatial value types of the API ([`Pose`], [`Wrench`],
-//! [`BodyRegressor`]), the model a generated robot carries ([`RobotModel`]), and the
-//! [`robot!`] macro. `no_std`: maths come from the standard library (feature `std`,
-//! the default) or from `libm` (feature `libm`).
+//! [`BodyRegressor`]), the model a generated robot carries ([`RobotModel`]), the joint
+//! models beyond rigid bodies ([`JointParams`], [`Coulomb`]), and the [`robot!`]
+//! macro. `no_std`: maths come from the standard library (feature `std`, the default)
+//! or from `libm` (feature `libm`).
 //!
 //! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a
 //! URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
@@ -18,13 +19,15 @@
 extern crate std;
 
 #[cfg(not(any(feature = "std", feature = "libm")))]
-compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos and sqrt");
+compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos, sqrt and tanh");
 
+mod joints;
 mod robot;
 mod robot_model;
 mod scalar;
 
 pub use dyngen_macros::robot;
+pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
 pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
 pub use robot_model::{BodyModel, JointLimits, JointModel, JointType, RobotModel};
@@ -55,6 +58,14 @@ pub mod __private {
             (true, Ok(m)) => m,
             _ => panic!("dyngen: `{what}` has length {len}, expected {} ({R} × {C})", R * C),
         }
+    }
+
+    /// Joint `j`'s (0-based) parameters in `joint_params` (`[Ia, Fv, Fc, F0]` per joint);
+    /// generated code passes arrays of `4n`.
+    #[inline(always)]
+    pub fn joint_at<S: crate::Scalar>(joint_params: &[S], j: usize) -> crate::JointParams<S> {
+        let p = &joint_params[4 * j..4 * j + 4];
+        crate::JointParams::from_array([p[0], p[1], p[2], p[3]])
     }
 
     /// Mutable variant of [`as_array`].

@@ -1,7 +1,7 @@
 //! The [`Robot`] trait every generated robot type implements, and the small spatial
 //! types of its API.
 
-use crate::{RobotModel, Scalar};
+use crate::{Coulomb, RobotModel, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// A body's pose in the base frame: `x_base = rotation · x_body + translation`.
@@ -88,6 +88,10 @@ pub trait Robot {
     const NBASE: usize;
     /// Base parameters of the principal parameterisation.
     const NBASE_PRINCIPAL: usize;
+    /// Joint parameters `[Ia, Fv, Fc, F0]`, 4 per joint ([`crate::JointParams`]).
+    const NJOINT_PARAMS: usize;
+    /// Base parameters of the standard and joint parameters together.
+    const NBASE_JOINTS: usize;
     /// The checked model the code was generated from (fixed joints merged), in the
     /// generated numbering: `MODEL.joints[j - 1]` carries `MODEL.bodies[j - 1]`.
     const MODEL: RobotModel;
@@ -114,6 +118,16 @@ pub trait Robot {
     fn principal_base_index() -> &'static [usize];
     /// `K_θ` (`NBASE_PRINCIPAL × NTHETA`, row-major): `β_θ = K_θ θ`.
     fn principal_base_k() -> &'static [f64];
+    /// The nominal joint parameters, length `NJOINT_PARAMS`: `Fv`, `Fc` from the
+    /// description (URDF `<dynamics damping friction>`), `Ia` and `F0` zero.
+    fn nominal_joint_params() -> &'static [f64];
+    /// Readable formulas of the base parameters of `[params; joint_params]`.
+    fn base_joints_groupings() -> &'static [&'static str];
+    /// The columns of `[params; joint_params]` those base parameters are built on.
+    fn base_joints_index() -> &'static [usize];
+    /// `K_j` (`NBASE_JOINTS × (NPARAMS + NJOINT_PARAMS)`, row-major):
+    /// `β_j = K_j [params; joint_params]`.
+    fn base_joints_k() -> &'static [f64];
     /// Gravity in the base frame the generated code was specialised for, m/s².
     fn gravity() -> [f64; 3];
     /// Operation counts of each generated function, by function name.
@@ -159,6 +173,42 @@ pub trait Robot {
     fn base_params<S: Scalar>(params: &[S], beta: &mut [S]);
     /// `β_θ = K_θ θ`. `theta`: `NTHETA`; `beta`: `NBASE_PRINCIPAL`.
     fn principal_base_params<S: Scalar>(theta: &[S], beta: &mut [S]);
+
+    /// Inverse dynamics with the joint models:
+    /// `tau = rnea(q, v, a) + Ia·a + Fv·v + Fc·c(v) + F0` per joint.
+    /// `joint_params`: `NJOINT_PARAMS`; the rest as for [`Robot::rnea`].
+    fn rnea_joints<S: Scalar>(
+        q: &[S],
+        v: &[S],
+        a: &[S],
+        params: &[S],
+        joint_params: &[S],
+        coulomb: Coulomb<S>,
+        tau: &mut [S],
+    );
+    /// `M(q) + diag(Ia)`, row-major into `m` (`NV × NV`).
+    fn crba_joints<S: Scalar>(q: &[S], params: &[S], joint_params: &[S], m: &mut [S]);
+    /// Forward dynamics with the joint models:
+    /// `a = (M + diag(Ia))⁻¹ (tau − h − Fv·v − Fc·c(v) − F0)`, inverting
+    /// [`Robot::rnea_joints`].
+    fn aba_joints<S: Scalar>(
+        q: &[S],
+        v: &[S],
+        tau: &[S],
+        params: &[S],
+        joint_params: &[S],
+        coulomb: Coulomb<S>,
+        a: &mut [S],
+    );
+    /// `[Y | Y_j]` with `tau = [Y | Y_j] · [params; joint_params]` ([`Robot::rnea_joints`]),
+    /// row-major into `y` (`NV × (NPARAMS + NJOINT_PARAMS)`): row `j` has
+    /// `[a_j, v_j, c(v_j), 1]` at columns `NPARAMS + 4j ..`.
+    fn torque_regressor_joints<S: Scalar>(q: &[S], v: &[S], a: &[S], coulomb: Coulomb<S>, y: &mut [S]);
+    /// The base regressor of `[params; joint_params]`, row-major into `y`
+    /// (`NV × NBASE_JOINTS`): `tau = Y_bj · base_params_joints(params, joint_params)`.
+    fn base_regressor_joints<S: Scalar>(q: &[S], v: &[S], a: &[S], coulomb: Coulomb<S>, y: &mut [S]);
+    /// `β_j = K_j [params; joint_params]`. `beta`: `NBASE_JOINTS`.
+    fn base_params_joints<S: Scalar>(params: &[S], joint_params: &[S], beta: &mut [S]);
 }
 
 /// Operation counts of one generated function, as the generator measured them.

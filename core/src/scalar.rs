@@ -35,6 +35,9 @@ pub trait Scalar:
     /// Both at once: one call where the platform computes them together.
     fn sin_cos(self) -> (Self, Self);
     fn sqrt(self) -> Self;
+    /// The hyperbolic tangent: the smooth Coulomb friction `tanh(q̇/ε)`
+    /// ([`crate::Coulomb::Smooth`]).
+    fn tanh(self) -> Self;
 }
 
 macro_rules! impl_scalar {
@@ -65,6 +68,10 @@ macro_rules! impl_scalar {
             #[inline(always)]
             fn sqrt(self) -> Self {
                 num_traits::Float::sqrt(self)
+            }
+            #[inline(always)]
+            fn tanh(self) -> Self {
+                num_traits::Float::tanh(self)
             }
         }
     };

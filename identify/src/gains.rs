@@ -30,15 +30,7 @@ use crate::{Accumulator, Channels, Estimate, IdentifyError, Options};
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
 use dyngen_reference::Dynamics;
 
-/// A load of known mass properties fixed to one body.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Payload {
-    /// The carrying body, `1..=n`.
-    pub body: usize,
-    /// Its standard parameters in that body's frame (`[m, m·c, I about the body
-    /// origin]`, 10, the order of the standard parameters).
-    pub params: [f64; 10],
-}
+use crate::payload::Payload;
 
 /// The outcome.
 #[derive(Clone, Debug)]
@@ -69,12 +61,7 @@ pub fn identify_gains(
     opts: &Options,
 ) -> Result<GainEstimate, IdentifyError> {
     let n = dynamics.nv();
-    if payload.body == 0 || payload.body > n {
-        return Err(IdentifyError::InvalidArgument {
-            what: "payload body",
-            reason: format!("{} is not a moving body (1..={n})", payload.body),
-        });
-    }
+    Payload::check_body(payload.body, n)?;
     let rigid = 10 * n;
     let pa = rigid + PER_JOINT * n;
     // Columns: A (π, φ), then −i_j of each joint (the stacked problem's k), then the
@@ -112,12 +99,7 @@ pub fn identify_gains(
                 }
                 row[(j, pa + j)] = -s.tau[j];
                 // The payload regressor: the 10 columns of the carrying body.
-                let l = if with_load {
-                    let b = payload.body - 1;
-                    (0..10).map(|m| yj[10 * b + m] * payload.params[m]).sum::<f64>()
-                } else {
-                    0.0
-                };
+                let l = if with_load { payload.torque(yj) } else { 0.0 };
                 row[(j, p - 1)] = l;
                 rhs[j] = -l;
             }

@@ -32,6 +32,7 @@ pub mod data;
 pub mod friction;
 pub mod gains;
 pub mod mim;
+pub mod payload;
 pub mod pipeline;
 pub mod report;
 pub mod simulate;

@@ -222,7 +222,8 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
 /// currents, one without and one with the load, 1 % current noise.
 #[test]
 fn drive_gains_from_a_known_payload() {
-    use dyngen_identify::gains::{identify_gains, Payload};
+    use dyngen_identify::gains::identify_gains;
+    use dyngen_identify::payload::Payload;
     let robot = robot();
     let nominal = robot.model().standard_params();
     // 5 kg, centre of mass 10 cm off the flange's axis and 5 cm beyond it, a

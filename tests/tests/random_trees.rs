@@ -343,7 +343,7 @@ impl Symbolic {
                 .collect(),
             wrenches: force_ids(&rnea.wrenches),
             crba: algo::crba(g, model).iter().flatten().map(|x| x.id()).collect(),
-            aba: ids(&algo::aba(g, model)),
+            aba: ids(&algo::aba(g, model, algo::Armature::None)),
             torque_regressor: regressor_ids(&algo::torque_regressor(g, model, algo::standard_columns(g))),
             wrench_regressor: regressor_ids(&algo::wrench_regressor(g, model)),
             principal_regressor: regressor_ids(&algo::torque_regressor(g, model, algo::principal_columns(g, model))),

@@ -16,6 +16,7 @@ fn the_functions_compared_are_split() {
             "crba",
             "aba",
             "joint_torque_regressor",
+            "aba_joints",
         ]
         .contains(&name)
         {
@@ -54,5 +55,11 @@ fn split_code_is_bit_identical_to_unsplit() {
         Ur5Split::joint_torque_regressor(&q, &v, &a, &mut y1);
         Ur5::joint_torque_regressor(&q, &v, &a, &mut y2);
         assert_eq!(y1, y2);
+        let jp: [f64; 24] = std::array::from_fn(|k| 0.05 * (k % 4 + 1) as f64);
+        let c = dyngen::Coulomb::Sign;
+        assert_eq!(
+            Ur5Split::aba_joints(&q, &v, &a, p, &jp, c),
+            Ur5::aba_joints(&q, &v, &a, p, &jp, c)
+        );
     }
 }

@@ -1,0 +1,186 @@
+//! Joint models beyond rigid bodies, as the generated `*_joints` functions take them:
+//! rotor inertia and friction, 4 parameters per joint in joint order,
+//! `[Ia, Fv, Fc, F0]`, after the `10n` standard parameters:
+//!
+//! ```text
+//! τ_j = rnea_j(q, q̇, q̈) + Ia_j·q̈_j + Fv_j·q̇_j + Fc_j·c(q̇_j) + F0_j
+//! ```
+//!
+//! `Ia` is the rotor inertia reflected to the joint (Pinocchio's `armature`), `Fv`
+//! viscous and `Fc` Coulomb friction, `F0` an offset; `c` is `sign` or `tanh(q̇/ε)`
+//! ([`Coulomb`]).
+//!
+//! ```
+//! use dyngen::{Coulomb, JointParams};
+//! let p = JointParams::<f64>::from_array([0.2, 1.5, 3.0, -0.1]); // Ia, Fv, Fc, F0
+//! let tau = p.torque(0.5, 2.0, Coulomb::Sign);
+//! assert!((tau - (0.2 * 2.0 + 1.5 * 0.5 + 3.0 - 0.1)).abs() < 1e-12);
+//! let row = JointParams::regressor_row(0.5, 2.0, Coulomb::Sign);
+//! assert_eq!(row, [2.0, 0.5, 1.0, 1.0]);
+//! ```
+
+use crate::Scalar;
+
+/// Joint parameters per joint: `[Ia, Fv, Fc, F0]`.
+pub const JOINT_PARAMS_PER_JOINT: usize = 4;
+
+/// How the Coulomb friction depends on the joint velocity `q̇`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Coulomb<S> {
+    /// `sign(q̇)`, 0 at exactly zero velocity.
+    #[default]
+    Sign,
+    /// `tanh(q̇/ε)`: the same away from rest, continuous through it. Build it with
+    /// [`Coulomb::smooth`], which rejects an `ε` that is not positive and finite; a
+    /// `Smooth` whose `ε` is not positive evaluates as its limit `ε → 0⁺`, the sign.
+    Smooth { epsilon: S },
+}
+
+/// A smoothing `ε` of [`Coulomb::Smooth`] that is not a positive finite number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InvalidEpsilon(pub f64);
+
+impl core::fmt::Display for InvalidEpsilon {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "Coulomb smoothing epsilon {} is not a positive finite velocity",
+            self.0
+        )
+    }
+}
+
+impl<S: Scalar> Coulomb<S> {
+    /// `Coulomb::Smooth { epsilon }`, or an error naming `epsilon` when it is not
+    /// positive and finite.
+    pub fn smooth(epsilon: S) -> Result<Coulomb<S>, InvalidEpsilon> {
+        let e = epsilon.to_f64();
+        if e.is_finite() && e > 0.0 {
+            Ok(Coulomb::Smooth { epsilon })
+        } else {
+            Err(InvalidEpsilon(e))
+        }
+    }
+
+    /// `c(q̇)`: `sign(q̇)` or `tanh(q̇/ε)`.
+    #[inline]
+    pub fn eval(self, v: S) -> S {
+        match self {
+            Coulomb::Smooth { epsilon } if epsilon > S::ZERO => (v / epsilon).tanh(),
+            _ => {
+                if v > S::ZERO {
+                    S::ONE
+                } else if v < S::ZERO {
+                    -S::ONE
+                } else {
+                    S::ZERO
+                }
+            }
+        }
+    }
+}
+
+/// One joint's parameters beyond the rigid bodies.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointParams<S> {
+    /// `Ia`: rotor inertia reflected to the joint, kg·m² (or kg): `τ += Ia·q̈`.
+    pub armature: S,
+    /// `Fv`: viscous friction, N·m·s/rad (or N·s/m): `τ += Fv·q̇`.
+    pub viscous: S,
+    /// `Fc`: Coulomb friction, N·m (or N): `τ += Fc·c(q̇)`.
+    pub coulomb: S,
+    /// `F0`: a constant offset, N·m (or N).
+    pub offset: S,
+}
+
+impl<S: Scalar> JointParams<S> {
+    /// From `[Ia, Fv, Fc, F0]`.
+    #[inline]
+    pub fn from_array(p: [S; JOINT_PARAMS_PER_JOINT]) -> JointParams<S> {
+        let [armature, viscous, coulomb, offset] = p;
+        JointParams {
+            armature,
+            viscous,
+            coulomb,
+            offset,
+        }
+    }
+
+    /// `[Ia, Fv, Fc, F0]`.
+    #[inline]
+    pub fn to_array(self) -> [S; JOINT_PARAMS_PER_JOINT] {
+        [self.armature, self.viscous, self.coulomb, self.offset]
+    }
+
+    /// Joint `j`'s (0-based) parameters in a vector of `4n`, `None` when it is too short.
+    #[inline]
+    pub fn of(joint_params: &[S], j: usize) -> Option<JointParams<S>> {
+        let p = joint_params.get(JOINT_PARAMS_PER_JOINT * j..JOINT_PARAMS_PER_JOINT * (j + 1))?;
+        Some(JointParams::from_array([p[0], p[1], p[2], p[3]]))
+    }
+
+    /// The friction torque `Fv·q̇ + Fc·c(q̇) + F0`.
+    #[inline]
+    pub fn friction(&self, v: S, coulomb: Coulomb<S>) -> S {
+        self.viscous * v + self.coulomb * coulomb.eval(v) + self.offset
+    }
+
+    /// The whole joint torque `Ia·q̈ + Fv·q̇ + Fc·c(q̇) + F0`.
+    #[inline]
+    pub fn torque(&self, v: S, a: S, coulomb: Coulomb<S>) -> S {
+        self.armature * a + self.friction(v, coulomb)
+    }
+
+    /// The regressor entries of `[Ia, Fv, Fc, F0]`: `[q̈, q̇, c(q̇), 1]`, so that
+    /// `regressor_row(v, a, c) · p.to_array() == p.torque(v, a, c)`.
+    #[inline]
+    pub fn regressor_row(v: S, a: S, coulomb: Coulomb<S>) -> [S; JOINT_PARAMS_PER_JOINT] {
+        [a, v, coulomb.eval(v), S::ONE]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coulomb_sign_and_smooth() {
+        assert_eq!(Coulomb::Sign.eval(-1e-300), -1.0);
+        assert_eq!(Coulomb::Sign.eval(0.0), 0.0);
+        assert_eq!(Coulomb::<f64>::Sign.eval(2.0), 1.0);
+        let smooth = Coulomb::smooth(0.01).unwrap();
+        assert!((smooth.eval(0.005) - 0.5f64.tanh()).abs() < 1e-15);
+        assert!((smooth.eval(-0.2) + 1.0).abs() < 1e-15);
+        assert_eq!(Coulomb::smooth(0.01f32).unwrap().eval(0.0), 0.0);
+    }
+
+    #[test]
+    fn a_bad_epsilon_is_an_error_and_never_a_nan() {
+        for e in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+            let err = Coulomb::smooth(e).unwrap_err();
+            let mut s = std::string::String::new();
+            core::fmt::write(&mut s, format_args!("{err}")).unwrap();
+            assert!(s.contains("epsilon"), "{s}");
+        }
+        // Built by hand: the ε → 0⁺ limit, not 0/0.
+        assert_eq!(Coulomb::Smooth { epsilon: 0.0 }.eval(0.0), 0.0);
+        assert_eq!(Coulomb::Smooth { epsilon: 0.0 }.eval(-3.0), -1.0);
+    }
+
+    #[test]
+    fn torque_is_the_regressor_row_times_the_parameters() {
+        let p = JointParams::from_array([0.2, 1.5, 3.0, -0.1]);
+        for c in [Coulomb::Sign, Coulomb::Smooth { epsilon: 0.3 }] {
+            for (v, a) in [(0.5, 2.0), (-0.1, 0.3), (0.0, -1.0)] {
+                let row = JointParams::regressor_row(v, a, c);
+                let y: f64 = row.iter().zip(p.to_array()).map(|(r, p)| r * p).sum();
+                assert!((y - p.torque(v, a, c)).abs() < 1e-15);
+            }
+        }
+        assert_eq!(
+            JointParams::of(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0], 1),
+            Some(JointParams::from_array([5.0, 6.0, 7.0, 8.0]))
+        );
+        assert_eq!(JointParams::<f64>::of(&[1.0; 7], 1), None);
+    }
+}

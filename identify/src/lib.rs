@@ -35,6 +35,7 @@ pub mod mim;
 pub mod pipeline;
 pub mod report;
 pub mod simulate;
+pub mod stribeck;
 pub mod validate;
 
 mod accumulate;

@@ -1,0 +1,620 @@
+//! Stribeck friction, identified by nonlinear least squares from the linear fit.
+//!
+//! Each joint's friction becomes
+//!
+//! ```text
+//! τ_f = (Fc + (Fs − Fc)·exp(−(q̇/vs)²))·s(q̇) + Fv·q̇ + F0
+//! ```
+//!
+//! (plus the rotor inertia `Ia·q̈`), with `s` the sign or `tanh(q̇/ε)`
+//! ([`Coulomb`]): the friction at rest is the static `Fs`, falling (or rising) to the
+//! Coulomb `Fc` as the speed passes the Stribeck velocity `vs > 0`. With `Fs = Fc` it
+//! is the linear model of [`dyngen_model::joint_params`]; the extra torque is
+//! [`excess_torque`].
+//!
+//! For fixed `vs` the model is linear in every other parameter; only `vs` is
+//! nonlinear, and it acts on its own joint. [`refine`] therefore alternates, from the
+//! linear fit: (1) with the rigid-body torques of the current fit fixed, every
+//! joint's `[Ia, Fv, Fc, Fs, F0, ln vs]` by Levenberg–Marquardt on that joint's rows
+//! alone ([`fit_joint`]; the first time from the best `vs` of a grid, each point a
+//! linear fit); (2) with every joint's `Fs − Fc` and `vs` fixed, the whole linear fit
+//! again on the torques without the Stribeck term. Both steps only accept what lowers
+//! the sum of squared torque residuals, so the fit never gets worse than the linear
+//! start; the loop stops when a round gains less than [`REFINE_TOLERANCE`].
+
+use crate::data::Trajectory;
+use crate::Estimate;
+use dyngen_model::joint_params::{Coulomb, PER_JOINT};
+use dyngen_reference::Dynamics;
+use nalgebra::{SMatrix, SVector};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// One joint's Stribeck parameters (the rest, `[Ia, Fv, Fc, F0]`, are the linear
+/// model's): static friction `fs` (N·m or N) and Stribeck velocity `vs` (rad/s or
+/// m/s, positive).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stribeck {
+    pub fs: f64,
+    pub vs: f64,
+}
+
+/// A Stribeck parameter that cannot describe a joint.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StribeckError {
+    /// `vs` must be positive and finite (joint numbered from 1).
+    Velocity { joint: usize, vs: f64 },
+    /// `fs` must be finite.
+    StaticFriction { joint: usize, fs: f64 },
+    /// One entry per joint is needed.
+    Joints { expected: usize, found: usize },
+}
+
+impl fmt::Display for StribeckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Velocity { joint, vs } => {
+                write!(
+                    f,
+                    "joint {joint}: the Stribeck velocity must be positive and finite, got {vs}"
+                )
+            }
+            Self::StaticFriction { joint, fs } => {
+                write!(f, "joint {joint}: the static friction must be finite, got {fs}")
+            }
+            Self::Joints { expected, found } => {
+                write!(f, "{found} Stribeck parameter sets for {expected} joints")
+            }
+        }
+    }
+}
+
+impl std::error::Error for StribeckError {}
+
+/// Checks one set per joint, each with a finite `fs` and a positive, finite `vs`.
+pub fn check(stribeck: &[Stribeck], joints: usize) -> Result<(), StribeckError> {
+    if stribeck.len() != joints {
+        return Err(StribeckError::Joints {
+            expected: joints,
+            found: stribeck.len(),
+        });
+    }
+    for (j, s) in stribeck.iter().enumerate() {
+        if !(s.vs.is_finite() && s.vs > 0.0) {
+            return Err(StribeckError::Velocity { joint: j + 1, vs: s.vs });
+        }
+        if !s.fs.is_finite() {
+            return Err(StribeckError::StaticFriction { joint: j + 1, fs: s.fs });
+        }
+    }
+    Ok(())
+}
+
+/// `exp(−(v/vs)²)`: 1 at rest, 0 well above `vs`.
+pub fn stribeck_factor(v: f64, vs: f64) -> f64 {
+    (-(v / vs).powi(2)).exp()
+}
+
+/// What the Stribeck model adds to the linear model's `Fc·s(q̇)` at velocity `v`:
+/// `(Fs − Fc)·exp(−(v/vs)²)·s(v)`.
+pub fn excess_torque(fc: f64, stribeck: Stribeck, v: f64, coulomb: Coulomb) -> f64 {
+    (stribeck.fs - fc) * stribeck_factor(v, stribeck.vs) * coulomb.eval(v)
+}
+
+/// Every joint's [`excess_torque`] added to `tau` (`n`), with the linear joint
+/// parameters `joint_params` (`4n`, `[Ia, Fv, Fc, F0]` per joint) giving `Fc`.
+pub fn add_excess(tau: &mut [f64], v: &[f64], joint_params: &[f64], stribeck: &[Stribeck], coulomb: Coulomb) {
+    for (j, (t, s)) in tau.iter_mut().zip(stribeck).enumerate() {
+        *t += excess_torque(joint_params[PER_JOINT * j + 2], *s, v[j], coulomb);
+    }
+}
+
+/// Iteration limits of [`fit_joint`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LmOptions {
+    /// Levenberg–Marquardt iterations (accepted or rejected steps), at most.
+    pub max_iterations: usize,
+    /// Stop when an accepted step lowers the cost by less than this fraction.
+    pub tolerance: f64,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        LmOptions {
+            max_iterations: 200,
+            tolerance: 1e-12,
+        }
+    }
+}
+
+/// One joint's Stribeck fit: `[Ia, Fv, Fc, F0]`, `Fs`, `vs`, and how it went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointFit {
+    pub linear: [f64; PER_JOINT],
+    pub stribeck: Stribeck,
+    /// Standard deviations of `Fs` and `vs` from the Gauss–Newton curvature at the
+    /// solution, the rigid bodies taken as known; `None` where not determined.
+    pub sigma: [Option<f64>; 2],
+    /// Sum of squared residuals at the start and at the end.
+    pub initial_cost: f64,
+    pub cost: f64,
+    pub iterations: usize,
+}
+
+/// The bounds of `vs` for a joint whose largest speed is `v_max`: `vs` below
+/// `1e-4·v_max` acts on no sample, above `v_max` the term is a second Coulomb
+/// friction.
+pub fn velocity_bounds(v_max: f64) -> (f64, f64) {
+    (1e-4 * v_max, v_max)
+}
+
+/// One joint's `[Ia, Fv, Fc, Fs, F0]` and `vs` fitted by Levenberg–Marquardt to
+/// `target` (the joint's torque without its rigid-body part) at velocities `v` and
+/// accelerations `a`, from `start` (`[Ia, Fv, Fc, F0]`, Stribeck). `vs` is searched
+/// as `ln vs` within [`velocity_bounds`]; only steps that lower the sum of squared
+/// residuals are taken, so the result is never worse than the start. With
+/// `grid` the start's `Fs` and `vs` are replaced first by the best of a grid of
+/// `vs` (each point a linear fit of the other five), when that is better.
+pub fn fit_joint(
+    v: &[f64],
+    a: &[f64],
+    target: &[f64],
+    start: ([f64; PER_JOINT], Stribeck),
+    coulomb: Coulomb,
+    grid: bool,
+    options: &LmOptions,
+) -> JointFit {
+    let v_max = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (lo, hi) = velocity_bounds(v_max);
+    let (linear, s) = start;
+    let mut p = SVector::<f64, 6>::from([linear[0], linear[1], linear[2], s.fs, linear[3], s.vs.ln()]);
+    let mut cost = joint_cost(v, a, target, &p, coulomb);
+    let initial_cost = cost;
+    let out = |p: &SVector<f64, 6>, cost: f64, iterations: usize, sigma: [Option<f64>; 2]| JointFit {
+        linear: [p[0], p[1], p[2], p[4]],
+        stribeck: Stribeck {
+            fs: p[3],
+            vs: p[5].exp(),
+        },
+        sigma,
+        initial_cost,
+        cost,
+        iterations,
+    };
+    // A joint that never moves (or too few samples) says nothing about vs.
+    if !(v_max > 0.0 && v_max.is_finite()) || v.len() <= 6 {
+        return JointFit {
+            stribeck: s,
+            ..out(&p, cost, 0, [None, None])
+        };
+    }
+    if grid {
+        for k in 0..=GRID {
+            let vs = lo * (hi / lo).powf(k as f64 / GRID as f64);
+            if let Some(q) = linear_at(v, a, target, vs, coulomb) {
+                let c = joint_cost(v, a, target, &q, coulomb);
+                if c < cost {
+                    (p, cost) = (q, c);
+                }
+            }
+        }
+    }
+    let (u_lo, u_hi) = (lo.ln(), hi.ln());
+    p[5] = p[5].clamp(u_lo, u_hi);
+    cost = cost.min(joint_cost(v, a, target, &p, coulomb));
+    let mut lambda = 1e-3;
+    let mut iterations = 0;
+    while iterations < options.max_iterations {
+        iterations += 1;
+        let (h, g) = normal_equations(v, a, target, &p, coulomb);
+        let scale = h.diagonal().max().max(f64::MIN_POSITIVE);
+        let mut damped = h;
+        for i in 0..6 {
+            damped[(i, i)] += lambda * h[(i, i)].max(1e-12 * scale);
+        }
+        let Some(step) = damped.cholesky().map(|c| c.solve(&g)) else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+            continue;
+        };
+        let mut trial = p + step;
+        trial[5] = trial[5].clamp(u_lo, u_hi);
+        let c = joint_cost(v, a, target, &trial, coulomb);
+        if c < cost {
+            let gain = (cost - c) / cost.max(f64::MIN_POSITIVE);
+            (p, cost) = (trial, c);
+            lambda = (lambda / 10.0).max(1e-12);
+            if gain < options.tolerance {
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+        }
+    }
+    // σ of Fs and vs = vs·σ(ln vs) from σ²·H⁻¹, σ² = cost / (rows − 6).
+    let (h, _) = normal_equations(v, a, target, &p, coulomb);
+    let dof = (v.len() - 6) as f64;
+    let sigma = match h.try_inverse() {
+        Some(inv) if inv[(3, 3)] >= 0.0 && inv[(5, 5)] >= 0.0 => {
+            let s2 = cost / dof;
+            let finite = |x: f64| x.is_finite().then_some(x);
+            [
+                finite((s2 * inv[(3, 3)]).sqrt()),
+                finite(p[5].exp() * (s2 * inv[(5, 5)]).sqrt()),
+            ]
+        }
+        _ => [None, None],
+    };
+    out(&p, cost, iterations, sigma)
+}
+
+/// Points of the `vs` grid in [`fit_joint`], minus one (log-spaced over [`velocity_bounds`]).
+const GRID: usize = 16;
+
+/// The model `[a, v, s(1−g), s·g, 1]·[Ia, Fv, Fc, Fs, F0]` with `g` the Stribeck
+/// factor of `vs = exp(p[5])`, and its derivative along `ln vs`.
+fn model(v: f64, a: f64, p: &SVector<f64, 6>, coulomb: Coulomb) -> (f64, [f64; 6]) {
+    let vs = p[5].exp();
+    let s = coulomb.eval(v);
+    let g = stribeck_factor(v, vs);
+    let row = [
+        a,
+        v,
+        s * (1.0 - g),
+        s * g,
+        1.0,
+        (p[3] - p[2]) * s * 2.0 * g * (v / vs).powi(2),
+    ];
+    let m = row[..5].iter().zip(p.iter()).map(|(r, x)| r * x).sum();
+    (m, row)
+}
+
+fn joint_cost(v: &[f64], a: &[f64], target: &[f64], p: &SVector<f64, 6>, coulomb: Coulomb) -> f64 {
+    (0..v.len())
+        .map(|k| (target[k] - model(v[k], a[k], p, coulomb).0).powi(2))
+        .sum()
+}
+
+/// `JᵀJ` and `Jᵀr` of the residual `target − model` at `p`.
+fn normal_equations(
+    v: &[f64],
+    a: &[f64],
+    target: &[f64],
+    p: &SVector<f64, 6>,
+    coulomb: Coulomb,
+) -> (SMatrix<f64, 6, 6>, SVector<f64, 6>) {
+    let mut h = SMatrix::<f64, 6, 6>::zeros();
+    let mut g = SVector::<f64, 6>::zeros();
+    for k in 0..v.len() {
+        let (m, row) = model(v[k], a[k], p, coulomb);
+        let r = target[k] - m;
+        for i in 0..6 {
+            g[i] += row[i] * r;
+            for j in i..6 {
+                h[(i, j)] += row[i] * row[j];
+            }
+        }
+    }
+    for i in 0..6 {
+        for j in 0..i {
+            h[(i, j)] = h[(j, i)];
+        }
+    }
+    (h, g)
+}
+
+/// The best `[Ia, Fv, Fc, Fs, F0]` for a fixed `vs` (a linear least-squares fit;
+/// minimum norm where the columns are dependent), with `ln vs` as sixth entry.
+fn linear_at(v: &[f64], a: &[f64], target: &[f64], vs: f64, coulomb: Coulomb) -> Option<SVector<f64, 6>> {
+    let probe = SVector::<f64, 6>::from([0.0, 0.0, 0.0, 0.0, 0.0, vs.ln()]);
+    let mut h = SMatrix::<f64, 5, 5>::zeros();
+    let mut g = SVector::<f64, 5>::zeros();
+    for k in 0..v.len() {
+        let (_, row) = model(v[k], a[k], &probe, coulomb);
+        for i in 0..5 {
+            g[i] += row[i] * target[k];
+            for j in 0..5 {
+                h[(i, j)] += row[i] * row[j];
+            }
+        }
+    }
+    let eps = 1e-12 * h.diagonal().max();
+    let x = h.svd(true, true).solve(&g, eps).ok()?;
+    x.iter()
+        .all(|x| x.is_finite())
+        .then(|| SVector::<f64, 6>::from([x[0], x[1], x[2], x[3], x[4], vs.ln()]))
+}
+
+/// Rounds of [`refine`], at most.
+pub const MAX_ROUNDS: usize = 20;
+
+/// [`refine`] stops when a round lowers the cost by less than this fraction.
+pub const REFINE_TOLERANCE: f64 = 1e-6;
+
+/// What [`refine`] found: per joint the Stribeck parameters and their fits, and the
+/// sum of squared torque residuals (all joints, N²·m²) of the linear start and of
+/// the result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StribeckFit {
+    pub coulomb: Coulomb,
+    pub joints: Vec<Stribeck>,
+    /// Per joint, σ of `Fs` and `vs` (see [`JointFit::sigma`]).
+    pub sigma: Vec<[Option<f64>; 2]>,
+    /// Per joint, Levenberg–Marquardt iterations over all rounds.
+    pub iterations: Vec<usize>,
+    /// Alternating rounds run (each: the joints' nonlinear fits, then one linear fit).
+    pub rounds: usize,
+    pub initial_cost: f64,
+    pub cost: f64,
+    /// Torque rows (samples × joints) the costs sum over.
+    pub rows: usize,
+}
+
+impl StribeckFit {
+    /// RMS torque residual of the linear start and of the result.
+    pub fn rms(&self) -> (f64, f64) {
+        let rows = self.rows.max(1) as f64;
+        ((self.initial_cost / rows).sqrt(), (self.cost / rows).sqrt())
+    }
+}
+
+/// The Stribeck model fitted from the linear fit `start` (whose solution is the
+/// `10n` standard parameters then `[Ia, Fv, Fc, F0]` per joint, Coulomb term
+/// `coulomb`) of `traj`'s torques; `linear_fit` redoes that linear fit on a
+/// trajectory whose torques have the Stribeck term taken out. Returns the final
+/// linear fit (its solution holds the rigid-body parameters and `[Ia, Fv, Fc, F0]`;
+/// its residuals are those of the whole model) and the Stribeck parameters.
+/// `traj` must have velocities and accelerations.
+pub fn refine<E>(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    coulomb: Coulomb,
+    start: Estimate,
+    mut linear_fit: impl FnMut(&Trajectory) -> Result<Estimate, E>,
+) -> Result<(Estimate, StribeckFit), E> {
+    let n = dynamics.nv();
+    let len = traj.len();
+    let column = |data: &[f64], j: usize| -> Vec<f64> { (0..len).map(|k| data[k * n + j]).collect() };
+    let empty = Vec::new();
+    let (vel, acc) = (
+        traj.velocities().unwrap_or(&empty),
+        traj.accelerations().unwrap_or(&empty),
+    );
+    let v: Vec<Vec<f64>> = (0..n).map(|j| column(vel, j)).collect();
+    let a: Vec<Vec<f64>> = (0..n).map(|j| column(acc, j)).collect();
+    let tau: Vec<Vec<f64>> = (0..n).map(|j| column(traj.torques(), j)).collect();
+    let rigid_len = 10 * n;
+    let linear_of = |x: &[f64], j: usize| -> [f64; PER_JOINT] {
+        let at = rigid_len + PER_JOINT * j;
+        [x[at], x[at + 1], x[at + 2], x[at + 3]]
+    };
+    // The start: Fs = Fc, vs a tenth of the joint's largest speed.
+    let mut stribeck: Vec<Stribeck> = (0..n)
+        .map(|j| {
+            let v_max = v[j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            Stribeck {
+                fs: linear_of(&start.solution, j)[2],
+                vs: if v_max > 0.0 && v_max.is_finite() {
+                    0.1 * v_max
+                } else {
+                    1.0
+                },
+            }
+        })
+        .collect();
+    let mut sigma = vec![[None, None]; n];
+    let mut iterations = vec![0; n];
+    let mut estimate = start;
+    let mut cost = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
+    let initial_cost = cost;
+    let mut rounds = 0;
+    while rounds < MAX_ROUNDS {
+        rounds += 1;
+        let before = cost;
+        // (1) Every joint on its own, the rigid-body torques held.
+        let rigid = rigid_torques(dynamics, traj, &estimate.solution[..rigid_len]);
+        let mut trial = stribeck.clone();
+        let mut lm_cost = 0.0;
+        let mut fits = Vec::with_capacity(n);
+        for j in 0..n {
+            let target: Vec<f64> = (0..len).map(|k| tau[j][k] - rigid[k * n + j]).collect();
+            let linear = linear_of(&estimate.solution, j);
+            let fit = fit_joint(
+                &v[j],
+                &a[j],
+                &target,
+                (linear, stribeck[j]),
+                coulomb,
+                rounds == 1,
+                &LmOptions::default(),
+            );
+            iterations[j] += fit.iterations;
+            lm_cost += fit.cost;
+            trial[j] = fit.stribeck;
+            fits.push(fit);
+        }
+        if lm_cost.is_nan() || lm_cost >= cost {
+            break;
+        }
+        // (2) The whole linear fit with each joint's Fs − Fc and vs held: Fc moves,
+        // and Fs with it.
+        let excess: Vec<f64> = fits.iter().map(|f| f.stribeck.fs - f.linear[2]).collect();
+        let mut without = traj.torques().to_vec();
+        for k in 0..len {
+            for j in 0..n {
+                without[k * n + j] -= excess[j] * stribeck_factor(v[j][k], trial[j].vs) * coulomb.eval(v[j][k]);
+            }
+        }
+        let Ok(shifted) = traj.clone().with_torques(without) else {
+            break;
+        };
+        let refit = linear_fit(&shifted)?;
+        let moved: Vec<Stribeck> = (0..n)
+            .map(|j| Stribeck {
+                fs: linear_of(&refit.solution, j)[2] + excess[j],
+                vs: trial[j].vs,
+            })
+            .collect();
+        let refit_cost = total_cost(dynamics, traj, &refit.solution, &moved, coulomb);
+        if refit_cost.is_nan() || refit_cost >= cost {
+            break;
+        }
+        (estimate, stribeck, cost) = (refit, moved, refit_cost);
+        for (s, f) in sigma.iter_mut().zip(&fits) {
+            *s = f.sigma;
+        }
+        if before - cost < REFINE_TOLERANCE * before {
+            break;
+        }
+    }
+    Ok((
+        estimate,
+        StribeckFit {
+            coulomb,
+            joints: stribeck,
+            sigma,
+            iterations,
+            rounds,
+            initial_cost,
+            cost,
+            rows: len * n,
+        },
+    ))
+}
+
+/// `rnea(q, v, a)` with the standard parameters `params` at every sample
+/// (row-major, `len × n`): the regressor times `params`, without forming it.
+fn rigid_torques(dynamics: &dyn Dynamics, traj: &Trajectory, params: &[f64]) -> Vec<f64> {
+    let n = dynamics.nv();
+    let mut out = vec![0.0; traj.len() * n];
+    for (k, tau) in out.chunks_exact_mut(n).enumerate() {
+        let (q, v, a) = (traj.q(k), traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]));
+        dynamics.rnea(q, v, a, params, tau);
+    }
+    out
+}
+
+/// The sum of squared torque residuals of the whole model: rigid bodies
+/// `x[..10n]`, linear joint terms `x[10n..]`, and the Stribeck terms.
+fn total_cost(dynamics: &dyn Dynamics, traj: &Trajectory, x: &[f64], stribeck: &[Stribeck], coulomb: Coulomb) -> f64 {
+    let n = dynamics.nv();
+    let rigid = rigid_torques(dynamics, traj, &x[..10 * n]);
+    let joints = &x[10 * n..];
+    let mut cost = 0.0;
+    for k in 0..traj.len() {
+        let (v, a, tau) = (traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]), traj.tau(k));
+        for j in 0..n {
+            let p: &[f64; PER_JOINT] = joints[PER_JOINT * j..PER_JOINT * (j + 1)]
+                .try_into()
+                .expect("4 joint parameters per joint");
+            let predicted = rigid[k * n + j]
+                + dyngen_model::joint_params::joint_torque(p, v[j], a[j], coulomb)
+                + excess_torque(p[2], stribeck[j], v[j], coulomb);
+            cost += (tau[j] - predicted).powi(2);
+        }
+    }
+    cost
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dyngen_model::sample::SplitMix64;
+
+    /// One joint's friction torque with noise, along a slow sine sweep.
+    fn joint_data(truth: ([f64; 4], Stribeck), noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let mut rng = SplitMix64::new(seed);
+        let (mut v, mut a, mut tau) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..20_000 {
+            let t = k as f64 * 1e-3;
+            let (vk, ak) = (
+                0.8 * (0.7 * t).sin() + 0.2 * (2.3 * t).cos(),
+                0.56 * (0.7 * t).cos() - 0.46 * (2.3 * t).sin(),
+            );
+            let [ia, fv, fc, f0] = truth.0;
+            let clean = ia * ak + fv * vk + fc * vk.signum() + f0 + excess_torque(fc, truth.1, vk, Coulomb::Sign);
+            v.push(vk);
+            a.push(ak);
+            tau.push(clean + noise * rng.uniform(-1.0, 1.0));
+        }
+        (v, a, tau)
+    }
+
+    #[test]
+    fn recovers_a_joint_from_the_linear_start() {
+        let truth = ([0.3, 2.0, 4.0, 0.1], Stribeck { fs: 6.0, vs: 0.05 });
+        let (v, a, tau) = joint_data(truth, 0.02, 3);
+        let start = ([0.0, 0.0, 0.0, 0.0], Stribeck { fs: 0.0, vs: 0.08 });
+        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, true, &LmOptions::default());
+        assert!(fit.cost < fit.initial_cost);
+        assert!((fit.stribeck.fs / 6.0 - 1.0).abs() < 0.01, "{fit:?}");
+        assert!((fit.stribeck.vs / 0.05 - 1.0).abs() < 0.02, "{fit:?}");
+        for (x, t) in fit.linear.iter().zip(truth.0) {
+            assert!((x - t).abs() < 0.01 * (1.0 + t.abs()), "{fit:?}");
+        }
+        let [sf, sv] = fit.sigma;
+        assert!(
+            sf.is_some_and(|s| s > 0.0 && s < 0.05) && sv.is_some_and(|s| s > 0.0 && s < 1e-3),
+            "{fit:?}"
+        );
+    }
+
+    #[test]
+    fn never_worse_than_the_start_and_vs_stays_in_bounds() {
+        // No Stribeck effect at all: Fs stays near Fc, the cost does not grow.
+        let truth = ([0.0, 1.0, 2.0, 0.0], Stribeck { fs: 2.0, vs: 0.1 });
+        let (v, a, tau) = joint_data(truth, 0.05, 5);
+        let start = (truth.0, truth.1);
+        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, true, &LmOptions::default());
+        assert!(fit.cost <= fit.initial_cost);
+        let (lo, hi) = velocity_bounds(v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        assert!(
+            fit.stribeck.vs >= lo * (1.0 - 1e-12) && fit.stribeck.vs <= hi * (1.0 + 1e-12),
+            "{fit:?}"
+        );
+        assert!(fit.stribeck.fs.is_finite());
+        // A joint that never moves keeps its start.
+        let fit = fit_joint(
+            &[0.0; 10],
+            &[0.0; 10],
+            &[1.0; 10],
+            start,
+            Coulomb::Sign,
+            true,
+            &LmOptions::default(),
+        );
+        assert_eq!((fit.stribeck, fit.iterations), (truth.1, 0));
+    }
+
+    #[test]
+    fn excess_vanishes_when_static_equals_coulomb_and_far_from_rest() {
+        let s = Stribeck { fs: 3.0, vs: 0.1 };
+        assert_eq!(excess_torque(3.0, s, 0.05, Coulomb::Sign), 0.0);
+        assert!((excess_torque(2.0, s, 0.0001, Coulomb::Sign) - 1.0).abs() < 1e-5);
+        assert!((excess_torque(2.0, s, -0.0001, Coulomb::Sign) + 1.0).abs() < 1e-5);
+        assert!(excess_torque(2.0, s, 1.0, Coulomb::Sign).abs() < 1e-40);
+        let smooth = Coulomb::Smooth { epsilon: 0.01 };
+        assert_eq!(excess_torque(2.0, s, 0.0, smooth), 0.0);
+    }
+
+    #[test]
+    fn bad_parameters_name_the_joint() {
+        let good = Stribeck { fs: 1.0, vs: 0.1 };
+        let e = check(&[good, Stribeck { fs: 1.0, vs: 0.0 }], 2).unwrap_err();
+        assert_eq!(e, StribeckError::Velocity { joint: 2, vs: 0.0 });
+        assert!(
+            e.to_string().contains("joint 2") && e.to_string().contains("positive"),
+            "{e}"
+        );
+        let e = check(&[Stribeck { fs: f64::NAN, vs: 0.1 }], 1).unwrap_err();
+        assert!(e.to_string().contains("joint 1: the static friction"), "{e}");
+        assert_eq!(check(&[good], 2), Err(StribeckError::Joints { expected: 2, found: 1 }));
+        assert_eq!(check(&[good, good], 2), Ok(()));
+    }
+}

@@ -87,6 +87,11 @@ pub enum Friction {
     Smooth,
     /// The same with the ε that fits the data best (a search on the fit residual).
     Auto,
+    /// Sign, plus per joint a Stribeck term: static friction Fs at rest falling to
+    /// Fc above the Stribeck velocity vs, fitted by nonlinear least squares.
+    Stribeck,
+    /// Stribeck with the Coulomb term Fc·tanh(q̇/ε), ε from --epsilon.
+    StribeckSmooth,
 }
 
 /// How the rows are compressed (dyngen_identify::Accumulation).
@@ -358,6 +363,8 @@ impl IdentifyArgs {
                 Friction::Sign => JointTerms::Friction(Coulomb::Sign),
                 Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
                 Friction::Auto => JointTerms::FrictionAuto,
+                Friction::Stribeck => JointTerms::Stribeck(Coulomb::Sign),
+                Friction::StribeckSmooth => JointTerms::Stribeck(Coulomb::Smooth { epsilon: self.epsilon }),
             },
             cutoff_hz: self.recording.cutoff,
             low_pass_states: !self.recording.raw_states,
@@ -406,6 +413,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
             println!("{}", torque.estimate.table(&names));
             print_fit(&torque.estimate);
+            if let Some(fit) = &identified.stribeck {
+                print!("{fit}");
+            }
             if args.mode == Mode::Standard && args.friction == Friction::None {
                 hint_friction(&torque.estimate, &traj);
             }

@@ -28,6 +28,7 @@ use crate::report::{
     self, CoulombReport, MergedLinks, ParamStatus, ParameterReport, Parameterisation, PredictionModel, ReportError,
 };
 use crate::simulate::Recording;
+use crate::stribeck::StribeckFit;
 use crate::{Accumulation, Accumulator, Channels, IdentifyError, Options, PrincipalOptions, StandardOptions};
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::{ErrorKind, Inertial, Model};
@@ -82,6 +83,10 @@ pub enum JointTerms {
     /// residual ([`crate::friction::best_epsilon`], on at most
     /// [`SMOOTHING_SAMPLES`] samples spread over the recording).
     FrictionAuto,
+    /// Friction and rotor inertia with the Coulomb term as given, and per joint a
+    /// Stribeck term: static friction `Fs` and Stribeck velocity `vs`
+    /// ([`crate::stribeck`]), fitted by nonlinear least squares from the linear fit.
+    Stribeck(Coulomb),
 }
 
 /// Samples the search for the Coulomb smoothing fits on, at most.
@@ -159,7 +164,9 @@ impl IdentifyOptions {
                 "consistent estimation does not take friction and rotor inertia yet; use ols, wls, tls or ridge".into(),
             );
         }
-        if let JointTerms::Friction(Coulomb::Smooth { epsilon }) = self.joints {
+        if let JointTerms::Friction(Coulomb::Smooth { epsilon }) | JointTerms::Stribeck(Coulomb::Smooth { epsilon }) =
+            self.joints
+        {
             if !(epsilon.is_finite() && epsilon > 0.0) {
                 return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
             }
@@ -279,6 +286,8 @@ pub struct Identification {
     /// What the caller should know before trusting the numbers (e.g. a total least
     /// squares fit far worse than ordinary least squares on the same data).
     pub warnings: Vec<String>,
+    /// The Stribeck terms, with [`JointTerms::Stribeck`].
+    pub stribeck: Option<StribeckFit>,
 }
 
 /// A TLS residual this many times the OLS residual means TLS's assumption (equal
@@ -319,7 +328,9 @@ fn from_torques(
     let regressor = match (principal, options.joints) {
         (true, _) => TorqueRegressor::Principal,
         (false, JointTerms::None) => TorqueRegressor::Standard,
-        (false, JointTerms::Friction(coulomb)) => TorqueRegressor::StandardAndJoints(coulomb),
+        (false, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
+            TorqueRegressor::StandardAndJoints(coulomb)
+        }
         (false, JointTerms::FrictionAuto) => {
             let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
             let mut failure = None;
@@ -347,14 +358,15 @@ fn from_torques(
     if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
         nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
     }
-    let estimate = match options.estimator {
+    let solve = |acc: &Accumulator| match options.estimator {
         Estimator::Ols => acc.ols(opts),
         Estimator::Wls => acc.wls(opts),
         Estimator::Tls => acc.tls(opts),
         Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
         Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
         Estimator::Consistent => acc.standard_consistent(&StandardOptions::default(), opts),
-    }?;
+    };
+    let estimate = solve(&acc)?;
     let mut warnings = Vec::new();
     if options.estimator == Estimator::Tls {
         let ols = acc.ols(opts)?;
@@ -368,6 +380,16 @@ fn from_torques(
             ));
         }
     }
+    let (estimate, stribeck) = match options.joints {
+        JointTerms::Stribeck(coulomb) if !principal => {
+            let (estimate, fit) = crate::stribeck::refine(dynamics, traj, coulomb, estimate, |t| {
+                let acc = accumulate(dynamics, t, regressor, 1, options.accumulation)?;
+                Ok::<_, PipelineError>(solve(&acc)?)
+            })?;
+            (estimate, Some(fit))
+        }
+        _ => (estimate, None),
+    };
     let mut names = if principal {
         dyngen_model::names::principal_param_names(n)
     } else {
@@ -394,7 +416,11 @@ fn from_torques(
         regressor: parameterisation,
         coulomb,
         solution: estimate.solution.clone(),
+        stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
     });
+    if let Some(fit) = &stribeck {
+        report.parameters.extend(fit.param_reports());
+    }
     Ok(Identification {
         mode: options.mode,
         report,
@@ -406,6 +432,7 @@ fn from_torques(
             truth: options.model_is_truth.then_some(nominal),
         })),
         warnings,
+        stribeck,
     })
 }
 
@@ -507,6 +534,7 @@ fn by_mim(
         prediction: Prediction::Parameters(principal_params_to_standard(model, &theta)),
         mim: Some(estimate),
         warnings: Vec::new(),
+        stribeck: None,
     })
 }
 
@@ -589,12 +617,32 @@ pub fn predict_with(
             reason: format!("entry {k} of the solution is not finite"),
         });
     }
+    let stribeck = match (&prediction.stribeck, regressor) {
+        (None, _) => None,
+        (Some(s), TorqueRegressor::StandardAndJoints(coulomb)) => {
+            crate::stribeck::check(s, n).map_err(|e| PipelineError::InvalidOption {
+                option: "prediction",
+                reason: format!("stribeck: {e}"),
+            })?;
+            Some((s, coulomb))
+        }
+        (Some(_), _) => {
+            return Err(PipelineError::InvalidOption {
+                option: "prediction",
+                reason: "Stribeck terms need the standard_and_joints regressor".into(),
+            })
+        }
+    };
     need_derivatives(trajectory)?;
     let mut y = vec![0.0; n * p];
     Ok((0..trajectory.len())
         .map(|k| {
             let (q, v, a) = state(trajectory, k);
-            regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y)
+            let mut tau = regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y);
+            if let Some((s, coulomb)) = stribeck {
+                crate::stribeck::add_excess(&mut tau, v, &prediction.solution[10 * n..], s, coulomb);
+            }
+            tau
         })
         .collect())
 }
@@ -640,7 +688,14 @@ impl Identification {
             .map(|k| {
                 let (q, v, a) = state(trajectory, k);
                 match &self.prediction {
-                    Prediction::Regressor(estimate) => estimate.predict(dynamics, q, v, a),
+                    Prediction::Regressor(estimate) => {
+                        let mut tau = estimate.predict(dynamics, q, v, a);
+                        if let Some(fit) = &self.stribeck {
+                            let joints = &estimate.estimate.solution[10 * n..];
+                            crate::stribeck::add_excess(&mut tau, v, joints, &fit.joints, fit.coulomb);
+                        }
+                        tau
+                    }
                     Prediction::Parameters(params) => {
                         dynamics.rnea(q, v, a, params, &mut tau);
                         tau.clone()

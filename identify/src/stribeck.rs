@@ -23,8 +23,10 @@
 //! start; the loop stops when a round gains less than [`REFINE_TOLERANCE`].
 
 use crate::data::Trajectory;
+use crate::report::{ParamReport, ParamStatus};
 use crate::Estimate;
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
+use dyngen_model::names::param_name;
 use dyngen_reference::Dynamics;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -344,6 +346,8 @@ pub const REFINE_TOLERANCE: f64 = 1e-6;
 pub struct StribeckFit {
     pub coulomb: Coulomb,
     pub joints: Vec<Stribeck>,
+    /// Per joint, the Coulomb friction `Fc` of the final linear fit.
+    pub fc: Vec<f64>,
     /// Per joint, σ of `Fs` and `vs` (see [`JointFit::sigma`]).
     pub sigma: Vec<[Option<f64>; 2]>,
     /// Per joint, Levenberg–Marquardt iterations over all rounds.
@@ -361,6 +365,62 @@ impl StribeckFit {
     pub fn rms(&self) -> (f64, f64) {
         let rows = self.rows.max(1) as f64;
         ((self.initial_cost / rows).sqrt(), (self.cost / rows).sqrt())
+    }
+
+    /// `Fs1, vs1, Fs2, vs2, …` for the parameter report: identified with their σ,
+    /// or without a value (`no_effect`) for a joint whose fit found nothing to
+    /// improve (its prediction is the linear one whatever `vs` holds).
+    pub fn param_reports(&self) -> Vec<ParamReport> {
+        let mut out = Vec::with_capacity(2 * self.joints.len());
+        for (j, (s, sigma)) in self.joints.iter().zip(&self.sigma).enumerate() {
+            for (name, value, sigma) in [("Fs", s.fs, sigma[0]), ("vs", s.vs, sigma[1])] {
+                let known = sigma.is_some();
+                out.push(ParamReport {
+                    name: param_name(name, j + 1),
+                    value: known.then_some(value),
+                    sigma,
+                    sigma_percent: sigma.filter(|_| value != 0.0).map(|s| 100.0 * s / value.abs()),
+                    status: if known {
+                        ParamStatus::Identified
+                    } else {
+                        ParamStatus::NoEffect
+                    },
+                });
+            }
+        }
+        out
+    }
+}
+
+impl fmt::Display for StribeckFit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (before, after) = self.rms();
+        writeln!(
+            f,
+            "Stribeck friction (Fs at rest falling to Fc above vs): {} rounds, torque residual RMS {before:.4e} → \
+             {after:.4e}",
+            self.rounds
+        )?;
+        writeln!(
+            f,
+            "joint          Fc            Fs        σ(Fs)            vs        σ(vs)  LM iterations"
+        )?;
+        let cell = |x: Option<f64>| x.map_or_else(|| format!("{:>12}", "—"), |x| format!("{x:>12.5}"));
+        for (j, (s, sigma)) in self.joints.iter().zip(&self.sigma).enumerate() {
+            let known = sigma[0].is_some();
+            writeln!(
+                f,
+                "{:>5} {:>11.5} {} {} {} {} {:>14}",
+                j + 1,
+                self.fc[j],
+                cell(known.then_some(s.fs)),
+                cell(sigma[0]),
+                cell(known.then_some(s.vs)),
+                cell(sigma[1]),
+                self.iterations[j]
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -473,11 +533,13 @@ pub fn refine<E>(
             break;
         }
     }
+    let fc = (0..n).map(|j| linear_of(&estimate.solution, j)[2]).collect();
     Ok((
         estimate,
         StribeckFit {
             coulomb,
             joints: stribeck,
+            fc,
             sigma,
             iterations,
             rounds,

@@ -81,6 +81,12 @@ pub struct PredictionModel {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coulomb: Option<CoulombReport>,
     pub solution: Vec<f64>,
+    /// For `standard_and_joints` with Stribeck friction: per joint the static
+    /// friction `fs` and Stribeck velocity `vs`; row `j` of the prediction gains
+    /// `(fs − Fc)·exp(−(q̇_j/vs)²)·s(q̇_j)`, `Fc` the joint's Coulomb entry of the
+    /// solution ([`crate::stribeck`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stribeck: Option<Vec<crate::stribeck::Stribeck>>,
 }
 
 /// [`Status`] as written in the JSON.

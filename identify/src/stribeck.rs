@@ -337,7 +337,7 @@ fn linear_at(v: &[f64], a: &[f64], target: &[f64], vs: f64, coulomb: Coulomb) ->
 pub const MAX_ROUNDS: usize = 20;
 
 /// [`refine`] stops when a round lowers the cost by less than this fraction.
-pub const REFINE_TOLERANCE: f64 = 1e-6;
+pub const REFINE_TOLERANCE: f64 = 1e-5;
 
 /// What [`refine`] found: per joint the Stribeck parameters and their fits, and the
 /// sum of squared torque residuals (all joints, N²·m²) of the linear start and of
@@ -426,11 +426,17 @@ impl fmt::Display for StribeckFit {
 
 /// The Stribeck model fitted from the linear fit `start` (whose solution is the
 /// `10n` standard parameters then `[Ia, Fv, Fc, F0]` per joint, Coulomb term
-/// `coulomb`) of `traj`'s torques; `linear_fit` redoes that linear fit on a
-/// trajectory whose torques have the Stribeck term taken out. Returns the final
-/// linear fit (its solution holds the rigid-body parameters and `[Ia, Fv, Fc, F0]`;
-/// its residuals are those of the whole model) and the Stribeck parameters.
-/// `traj` must have velocities and accelerations.
+/// `coulomb`) of `traj`'s torques; `linear_fit` redoes that linear fit on any
+/// trajectory (`traj`, a part of it, or either with the Stribeck term taken out of
+/// the torques). Returns the final linear fit (its solution holds the rigid-body
+/// parameters and `[Ia, Fv, Fc, F0]`; its residuals are those of the whole model)
+/// and the Stribeck parameters. `traj` must have velocities and accelerations.
+///
+/// A long recording is fitted first on at most [`ROUND_SAMPLES`] samples spread
+/// over it (the rounds, each a linear fit, are then cheap), and the result carried
+/// to every sample by one linear fit and at most [`FINAL_ROUNDS`] more rounds; the
+/// result is accepted only where it lowers the cost over every sample, so it is
+/// never worse than `start`.
 pub fn refine<E>(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
@@ -439,27 +445,13 @@ pub fn refine<E>(
     mut linear_fit: impl FnMut(&Trajectory) -> Result<Estimate, E>,
 ) -> Result<(Estimate, StribeckFit), E> {
     let n = dynamics.nv();
-    let len = traj.len();
-    let column = |data: &[f64], j: usize| -> Vec<f64> { (0..len).map(|k| data[k * n + j]).collect() };
-    let empty = Vec::new();
-    let (vel, acc) = (
-        traj.velocities().unwrap_or(&empty),
-        traj.accelerations().unwrap_or(&empty),
-    );
-    let v: Vec<Vec<f64>> = (0..n).map(|j| column(vel, j)).collect();
-    let a: Vec<Vec<f64>> = (0..n).map(|j| column(acc, j)).collect();
-    let tau: Vec<Vec<f64>> = (0..n).map(|j| column(traj.torques(), j)).collect();
-    let rigid_len = 10 * n;
-    let linear_of = |x: &[f64], j: usize| -> [f64; PER_JOINT] {
-        let at = rigid_len + PER_JOINT * j;
-        [x[at], x[at + 1], x[at + 2], x[at + 3]]
-    };
+    let full = Columns::new(traj, n);
     // The start: Fs = Fc, vs a tenth of the joint's largest speed.
-    let mut stribeck: Vec<Stribeck> = (0..n)
+    let first: Vec<Stribeck> = (0..n)
         .map(|j| {
-            let v_max = v[j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let v_max = full.v[j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
             Stribeck {
-                fs: linear_of(&start.solution, j)[2],
+                fs: joint_linear(&start.solution, n, j)[2],
                 vs: if v_max > 0.0 && v_max.is_finite() {
                     0.1 * v_max
                 } else {
@@ -468,87 +460,262 @@ pub fn refine<E>(
             }
         })
         .collect();
-    let mut sigma = vec![[None, None]; n];
-    let mut iterations = vec![0; n];
-    let mut estimate = start;
-    let mut cost = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
-    let initial_cost = cost;
-    let mut rounds = 0;
-    while rounds < MAX_ROUNDS {
-        rounds += 1;
-        let before = cost;
-        // (1) Every joint on its own, the rigid-body torques held.
-        let rigid = rigid_torques(dynamics, traj, &estimate.solution[..rigid_len]);
-        let mut trial = stribeck.clone();
-        let mut lm_cost = 0.0;
-        let mut fits = Vec::with_capacity(n);
-        for j in 0..n {
-            let target: Vec<f64> = (0..len).map(|k| tau[j][k] - rigid[k * n + j]).collect();
-            let linear = linear_of(&estimate.solution, j);
-            let fit = fit_joint(
-                &v[j],
-                &a[j],
-                &target,
-                (linear, stribeck[j]),
-                coulomb,
-                rounds == 1,
-                &LmOptions::default(),
-            );
-            iterations[j] += fit.iterations;
-            lm_cost += fit.cost;
-            trial[j] = fit.stribeck;
-            fits.push(fit);
+    let (initial_cost, rigid) = total_cost(dynamics, traj, &start.solution, &first, coulomb);
+    let mut state = State {
+        estimate: start,
+        stribeck: first,
+        sigma: vec![[None, None]; n],
+        iterations: vec![0; n],
+        rounds: 0,
+        cost: initial_cost,
+        rigid,
+    };
+    let stride = traj.len().div_ceil(ROUND_SAMPLES).max(1);
+    if stride == 1 {
+        state = rounds(dynamics, traj, &full, coulomb, state, true, MAX_ROUNDS, &mut linear_fit)?;
+    } else if let Some(part) = every(traj, stride) {
+        let columns = Columns::new(&part, n);
+        let estimate = linear_fit(&part)?;
+        let (cost, rigid) = total_cost(dynamics, &part, &estimate.solution, &state.stribeck, coulomb);
+        let found = rounds(
+            dynamics,
+            &part,
+            &columns,
+            coulomb,
+            State {
+                estimate,
+                cost,
+                rigid,
+                ..state.clone()
+            },
+            true,
+            MAX_ROUNDS,
+            &mut linear_fit,
+        )?;
+        // Each joint's Fs − Fc and vs carried to every sample.
+        let excess: Vec<f64> = (0..n)
+            .map(|j| found.stribeck[j].fs - joint_linear(&found.estimate.solution, n, j)[2])
+            .collect();
+        if let Some((estimate, stribeck)) =
+            relinearise(traj, &full, coulomb, &excess, &found.stribeck, &mut linear_fit)?
+        {
+            let (cost, rigid) = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
+            if cost < state.cost {
+                state = State {
+                    estimate,
+                    stribeck,
+                    sigma: found.sigma,
+                    iterations: found.iterations,
+                    rounds: found.rounds,
+                    cost,
+                    rigid,
+                };
+            }
         }
-        if lm_cost.is_nan() || lm_cost >= cost {
+        state = rounds(
+            dynamics,
+            traj,
+            &full,
+            coulomb,
+            state,
+            false,
+            FINAL_ROUNDS,
+            &mut linear_fit,
+        )?;
+    }
+    let fc = (0..n)
+        .map(|j| joint_linear(&state.estimate.solution, n, j)[2])
+        .collect();
+    Ok((
+        state.estimate,
+        StribeckFit {
+            coulomb,
+            joints: state.stribeck,
+            fc,
+            sigma: state.sigma,
+            iterations: state.iterations,
+            rounds: state.rounds,
+            initial_cost,
+            cost: state.cost,
+            rows: traj.len() * n,
+        },
+    ))
+}
+
+/// Samples the rounds of [`refine`] run on, at most.
+pub const ROUND_SAMPLES: usize = 20_000;
+
+/// Rounds of [`refine`] on every sample of a recording longer than [`ROUND_SAMPLES`].
+pub const FINAL_ROUNDS: usize = 2;
+
+/// Where [`refine`] is: the linear fit, the Stribeck terms, and the cost with the
+/// rigid-body torques it was computed with (row-major, samples × joints).
+#[derive(Clone)]
+struct State {
+    estimate: Estimate,
+    stribeck: Vec<Stribeck>,
+    sigma: Vec<[Option<f64>; 2]>,
+    iterations: Vec<usize>,
+    rounds: usize,
+    cost: f64,
+    rigid: Vec<f64>,
+}
+
+/// A trajectory's velocities, accelerations and torques by joint.
+struct Columns {
+    v: Vec<Vec<f64>>,
+    a: Vec<Vec<f64>>,
+    tau: Vec<Vec<f64>>,
+}
+
+impl Columns {
+    fn new(traj: &Trajectory, n: usize) -> Columns {
+        let len = traj.len();
+        let column = |data: Option<&[f64]>, j: usize| -> Vec<f64> {
+            data.map_or_else(|| vec![0.0; len], |d| (0..len).map(|k| d[k * n + j]).collect())
+        };
+        Columns {
+            v: (0..n).map(|j| column(traj.velocities(), j)).collect(),
+            a: (0..n).map(|j| column(traj.accelerations(), j)).collect(),
+            tau: (0..n).map(|j| column(Some(traj.torques()), j)).collect(),
+        }
+    }
+}
+
+/// `[Ia, Fv, Fc, F0]` of joint `j` in a solution of `10n + 4n` entries.
+fn joint_linear(x: &[f64], n: usize, j: usize) -> [f64; PER_JOINT] {
+    let at = 10 * n + PER_JOINT * j;
+    [x[at], x[at + 1], x[at + 2], x[at + 3]]
+}
+
+/// Every `stride`-th sample of `traj`.
+fn every(traj: &Trajectory, stride: usize) -> Option<Trajectory> {
+    let n = traj.dof();
+    let keep: Vec<usize> = (0..traj.len()).step_by(stride).collect();
+    let rows = |data: &[f64]| -> Vec<f64> { keep.iter().flat_map(|&k| data[k * n..(k + 1) * n].to_vec()).collect() };
+    let t = keep.iter().map(|&k| traj.t()[k]).collect();
+    Trajectory::new(n, t, rows(traj.positions()), rows(traj.torques()))
+        .and_then(|p| p.with_velocities(rows(traj.velocities().unwrap_or(&[]))))
+        .and_then(|p| p.with_accelerations(rows(traj.accelerations().unwrap_or(&[]))))
+        .ok()
+}
+
+/// The linear fit of `traj` with each joint's Stribeck term `excess[j]·g(q̇; vs)·s(q̇)`
+/// (`vs` from `stribeck`) taken out of the torques, and the Stribeck terms with
+/// `Fs = Fc + excess` for its `Fc`. `None` if the torques cannot be replaced.
+fn relinearise<E>(
+    traj: &Trajectory,
+    columns: &Columns,
+    coulomb: Coulomb,
+    excess: &[f64],
+    stribeck: &[Stribeck],
+    linear_fit: &mut impl FnMut(&Trajectory) -> Result<Estimate, E>,
+) -> Result<Option<(Estimate, Vec<Stribeck>)>, E> {
+    let n = traj.dof();
+    let mut without = traj.torques().to_vec();
+    for (k, row) in without.chunks_exact_mut(n).enumerate() {
+        for j in 0..n {
+            let v = columns.v[j][k];
+            row[j] -= excess[j] * stribeck_factor(v, stribeck[j].vs) * coulomb.eval(v);
+        }
+    }
+    let Ok(shifted) = traj.clone().with_torques(without) else {
+        return Ok(None);
+    };
+    let estimate = linear_fit(&shifted)?;
+    let moved = (0..n)
+        .map(|j| Stribeck {
+            fs: joint_linear(&estimate.solution, n, j)[2] + excess[j],
+            vs: stribeck[j].vs,
+        })
+        .collect();
+    Ok(Some((estimate, moved)))
+}
+
+/// Up to `max` alternating rounds from `state`, each accepted only if it lowers the
+/// cost: (1) every joint's Levenberg–Marquardt fit with the rigid-body torques held
+/// (from a grid of `vs` in the first round when `grid`), (2) the linear fit with each
+/// joint's `Fs − Fc` and `vs` held.
+#[allow(clippy::too_many_arguments)]
+fn rounds<E>(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    columns: &Columns,
+    coulomb: Coulomb,
+    mut state: State,
+    grid: bool,
+    max: usize,
+    linear_fit: &mut impl FnMut(&Trajectory) -> Result<Estimate, E>,
+) -> Result<State, E> {
+    let n = dynamics.nv();
+    let len = traj.len();
+    for round in 0..max {
+        let before = state.cost;
+        // (1) Every joint on its own (in parallel), the rigid-body torques held.
+        let fit = |j: usize| {
+            let target: Vec<f64> = (0..len).map(|k| columns.tau[j][k] - state.rigid[k * n + j]).collect();
+            fit_joint(
+                &columns.v[j],
+                &columns.a[j],
+                &target,
+                (joint_linear(&state.estimate.solution, n, j), state.stribeck[j]),
+                coulomb,
+                grid && round == 0,
+                &ROUND_LM,
+            )
+        };
+        let threads = crate::accumulate::cores().clamp(1, n.max(1));
+        let mut fits: Vec<(usize, JointFit)> = std::thread::scope(|s| {
+            let fit = &fit;
+            let handles: Vec<_> = (0..threads)
+                .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, fit(j))).collect::<Vec<_>>()))
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        });
+        fits.sort_by_key(|(j, _)| *j);
+        let fits: Vec<JointFit> = fits.into_iter().map(|(_, f)| f).collect();
+        for (count, f) in state.iterations.iter_mut().zip(&fits) {
+            *count += f.iterations;
+        }
+        let lm_cost: f64 = fits.iter().map(|f| f.cost).sum();
+        if lm_cost.is_nan() || lm_cost >= state.cost {
             break;
         }
         // (2) The whole linear fit with each joint's Fs − Fc and vs held: Fc moves,
         // and Fs with it.
         let excess: Vec<f64> = fits.iter().map(|f| f.stribeck.fs - f.linear[2]).collect();
-        let mut without = traj.torques().to_vec();
-        for k in 0..len {
-            for j in 0..n {
-                without[k * n + j] -= excess[j] * stribeck_factor(v[j][k], trial[j].vs) * coulomb.eval(v[j][k]);
-            }
-        }
-        let Ok(shifted) = traj.clone().with_torques(without) else {
+        let trial: Vec<Stribeck> = fits.iter().map(|f| f.stribeck).collect();
+        let Some((estimate, stribeck)) = relinearise(traj, columns, coulomb, &excess, &trial, linear_fit)? else {
             break;
         };
-        let refit = linear_fit(&shifted)?;
-        let moved: Vec<Stribeck> = (0..n)
-            .map(|j| Stribeck {
-                fs: linear_of(&refit.solution, j)[2] + excess[j],
-                vs: trial[j].vs,
-            })
-            .collect();
-        let refit_cost = total_cost(dynamics, traj, &refit.solution, &moved, coulomb);
-        if refit_cost.is_nan() || refit_cost >= cost {
+        let (cost, rigid) = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
+        if cost.is_nan() || cost >= state.cost {
             break;
         }
-        (estimate, stribeck, cost) = (refit, moved, refit_cost);
-        for (s, f) in sigma.iter_mut().zip(&fits) {
-            *s = f.sigma;
-        }
+        state = State {
+            estimate,
+            stribeck,
+            sigma: fits.iter().map(|f| f.sigma).collect(),
+            iterations: state.iterations,
+            rounds: state.rounds + 1,
+            cost,
+            rigid,
+        };
         if before - cost < REFINE_TOLERANCE * before {
             break;
         }
     }
-    let fc = (0..n).map(|j| linear_of(&estimate.solution, j)[2]).collect();
-    Ok((
-        estimate,
-        StribeckFit {
-            coulomb,
-            joints: stribeck,
-            fc,
-            sigma,
-            iterations,
-            rounds,
-            initial_cost,
-            cost,
-            rows: len * n,
-        },
-    ))
+    Ok(state)
 }
+
+/// The Levenberg–Marquardt limits of one round of [`refine`].
+const ROUND_LM: LmOptions = LmOptions {
+    max_iterations: 100,
+    tolerance: 1e-10,
+};
 
 /// `rnea(q, v, a)` with the standard parameters `params` at every sample
 /// (row-major, `len × n`): the regressor times `params`, without forming it.
@@ -562,9 +729,16 @@ fn rigid_torques(dynamics: &dyn Dynamics, traj: &Trajectory, params: &[f64]) -> 
     out
 }
 
-/// The sum of squared torque residuals of the whole model: rigid bodies
-/// `x[..10n]`, linear joint terms `x[10n..]`, and the Stribeck terms.
-fn total_cost(dynamics: &dyn Dynamics, traj: &Trajectory, x: &[f64], stribeck: &[Stribeck], coulomb: Coulomb) -> f64 {
+/// The sum of squared torque residuals of the whole model (rigid bodies
+/// `x[..10n]`, linear joint terms `x[10n..]`, the Stribeck terms), and the rigid-body
+/// torques (row-major, samples × joints).
+fn total_cost(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    x: &[f64],
+    stribeck: &[Stribeck],
+    coulomb: Coulomb,
+) -> (f64, Vec<f64>) {
     let n = dynamics.nv();
     let rigid = rigid_torques(dynamics, traj, &x[..10 * n]);
     let joints = &x[10 * n..];
@@ -581,7 +755,7 @@ fn total_cost(dynamics: &dyn Dynamics, traj: &Trajectory, x: &[f64], stribeck: &
             cost += (tau[j] - predicted).powi(2);
         }
     }
-    cost
+    (cost, rigid)
 }
 
 #[cfg(test)]

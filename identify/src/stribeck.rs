@@ -155,16 +155,16 @@ pub fn velocity_bounds(v_max: f64) -> (f64, f64) {
 /// `target` (the joint's torque without its rigid-body part) at velocities `v` and
 /// accelerations `a`, from `start` (`[Ia, Fv, Fc, F0]`, Stribeck). `vs` is searched
 /// as `ln vs` within [`velocity_bounds`]; only steps that lower the sum of squared
-/// residuals are taken, so the result is never worse than the start. With
-/// `grid` the start's `Fs` and `vs` are replaced first by the best of a grid of
-/// `vs` (each point a linear fit of the other five), when that is better.
+/// residuals are taken, so the result is never worse than the start. `starts`
+/// gives other values of `vs` to try first (each a linear fit of the other five
+/// parameters); the best of them replaces the start when it is better.
 pub fn fit_joint(
     v: &[f64],
     a: &[f64],
     target: &[f64],
     start: ([f64; PER_JOINT], Stribeck),
     coulomb: Coulomb,
-    grid: bool,
+    starts: Starts<'_>,
     options: &LmOptions,
 ) -> JointFit {
     let v_max = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -191,9 +191,15 @@ pub fn fit_joint(
             ..out(&p, cost, 0, [None, None])
         };
     }
-    if grid {
-        for k in 0..=GRID {
-            let vs = lo * (hi / lo).powf(k as f64 / GRID as f64);
+    let candidates: Vec<f64> = match starts {
+        Starts::None => Vec::new(),
+        Starts::Grid => (0..=GRID)
+            .map(|k| lo * (hi / lo).powf(k as f64 / GRID as f64))
+            .collect(),
+        Starts::These(vs) => vs.iter().map(|v| v.clamp(lo, hi)).collect(),
+    };
+    {
+        for vs in candidates {
             if let Some(q) = linear_at(v, a, target, vs, coulomb) {
                 let c = joint_cost(v, a, target, &q, coulomb);
                 if c < cost {
@@ -254,6 +260,17 @@ pub fn fit_joint(
         _ => [None, None],
     };
     out(&p, cost, iterations, sigma)
+}
+
+/// Values of `vs` [`fit_joint`] tries before its Levenberg–Marquardt iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Starts<'a> {
+    /// Only the start.
+    None,
+    /// A grid of 17 log-spaced values over [`velocity_bounds`].
+    Grid,
+    /// These (clamped to [`velocity_bounds`]).
+    These(&'a [f64]),
 }
 
 /// Points of the `vs` grid in [`fit_joint`], minus one (log-spaced over [`velocity_bounds`]).
@@ -472,7 +489,7 @@ pub fn refine<E>(
     };
     let stride = traj.len().div_ceil(ROUND_SAMPLES).max(1);
     if stride == 1 {
-        state = rounds(dynamics, traj, &full, coulomb, state, true, MAX_ROUNDS, &mut linear_fit)?;
+        state = rounds(dynamics, traj, &full, coulomb, state, None, MAX_ROUNDS, &mut linear_fit)?;
     } else if let Some(part) = every(traj, stride) {
         let columns = Columns::new(&part, n);
         let estimate = linear_fit(&part)?;
@@ -488,37 +505,22 @@ pub fn refine<E>(
                 rigid,
                 ..state.clone()
             },
-            true,
+            None,
             MAX_ROUNDS,
             &mut linear_fit,
         )?;
-        // Each joint's Fs − Fc and vs carried to every sample.
-        let excess: Vec<f64> = (0..n)
-            .map(|j| found.stribeck[j].fs - joint_linear(&found.estimate.solution, n, j)[2])
-            .collect();
-        if let Some((estimate, stribeck)) =
-            relinearise(traj, &full, coulomb, &excess, &found.stribeck, &mut linear_fit)?
-        {
-            let (cost, rigid) = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
-            if cost < state.cost {
-                state = State {
-                    estimate,
-                    stribeck,
-                    sigma: found.sigma,
-                    iterations: found.iterations,
-                    rounds: found.rounds,
-                    cost,
-                    rigid,
-                };
-            }
-        }
+        // Each joint's vs carried to every sample: the first round there starts
+        // from it (Fs and the linear terms fitted for it), rounds counted on.
+        let vs: Vec<f64> = found.stribeck.iter().map(|s| s.vs).collect();
+        state.rounds = found.rounds;
+        state.iterations = found.iterations;
         state = rounds(
             dynamics,
             traj,
             &full,
             coulomb,
             state,
-            false,
+            Some(&vs),
             FINAL_ROUNDS,
             &mut linear_fit,
         )?;
@@ -643,7 +645,7 @@ fn rounds<E>(
     columns: &Columns,
     coulomb: Coulomb,
     mut state: State,
-    grid: bool,
+    hint: Option<&[f64]>,
     max: usize,
     linear_fit: &mut impl FnMut(&Trajectory) -> Result<Estimate, E>,
 ) -> Result<State, E> {
@@ -660,7 +662,11 @@ fn rounds<E>(
                 &target,
                 (joint_linear(&state.estimate.solution, n, j), state.stribeck[j]),
                 coulomb,
-                grid && round == 0,
+                match (round, hint) {
+                    (0, None) => Starts::Grid,
+                    (0, Some(vs)) => Starts::These(&vs[j..j + 1]),
+                    _ => Starts::None,
+                },
                 &ROUND_LM,
             )
         };
@@ -787,7 +793,7 @@ mod tests {
         let truth = ([0.3, 2.0, 4.0, 0.1], Stribeck { fs: 6.0, vs: 0.05 });
         let (v, a, tau) = joint_data(truth, 0.02, 3);
         let start = ([0.0, 0.0, 0.0, 0.0], Stribeck { fs: 0.0, vs: 0.08 });
-        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, true, &LmOptions::default());
+        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, Starts::Grid, &LmOptions::default());
         assert!(fit.cost < fit.initial_cost);
         assert!((fit.stribeck.fs / 6.0 - 1.0).abs() < 0.01, "{fit:?}");
         assert!((fit.stribeck.vs / 0.05 - 1.0).abs() < 0.02, "{fit:?}");
@@ -807,7 +813,7 @@ mod tests {
         let truth = ([0.0, 1.0, 2.0, 0.0], Stribeck { fs: 2.0, vs: 0.1 });
         let (v, a, tau) = joint_data(truth, 0.05, 5);
         let start = (truth.0, truth.1);
-        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, true, &LmOptions::default());
+        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, Starts::Grid, &LmOptions::default());
         assert!(fit.cost <= fit.initial_cost);
         let (lo, hi) = velocity_bounds(v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
         assert!(
@@ -822,7 +828,7 @@ mod tests {
             &[1.0; 10],
             start,
             Coulomb::Sign,
-            true,
+            Starts::Grid,
             &LmOptions::default(),
         );
         assert_eq!((fit.stribeck, fit.iterations), (truth.1, 0));

@@ -224,3 +224,28 @@ fn bad_stribeck_parameters_are_refused_with_the_joint_named() {
         assert!(err.to_string().starts_with("friction "), "{err}");
     }
 }
+
+/// A recording longer than `ROUND_SAMPLES`: the rounds run on a part of it, the
+/// result is carried to every sample, and the parameters still come back.
+#[test]
+fn a_long_recording_is_fitted_on_a_part_then_on_every_sample() {
+    let robot = robot();
+    let len = dyngen_identify::stribeck::ROUND_SAMPLES + 6_000;
+    let times: Vec<f64> = (0..len).map(|k| 0.005 * k as f64).collect();
+    let mut rec = record_trajectory(&robot, &robot.model().standard_params(), &motion(7), &times);
+    let joints: Vec<f64> = (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect();
+    let truth: Vec<Stribeck> = (0..6).map(|j| Stribeck { fs: FS[j], vs: VS[j] }).collect();
+    add_joint_terms(&mut rec, &joints, Coulomb::Sign);
+    add_stribeck_terms(&mut rec, &joints, &truth, Coulomb::Sign).unwrap();
+    add_torque_noise(&mut rec, 8);
+    let traj = rec.to_trajectory().unwrap();
+    let id = identify(&robot, &traj, JointTerms::Stribeck(Coulomb::Sign));
+    let fit = id.stribeck.as_ref().unwrap();
+    println!("{fit}");
+    assert_eq!(fit.rows, 6 * len);
+    assert!(fit.rounds >= 2 && fit.cost < 0.5 * fit.initial_cost, "{fit}");
+    for (j, (s, t)) in fit.joints.iter().zip(&truth).enumerate() {
+        assert!((s.fs / t.fs - 1.0).abs() < 0.03, "joint {}: {s:?} vs {t:?}", j + 1);
+        assert!((s.vs / t.vs - 1.0).abs() < 0.05, "joint {}: {s:?} vs {t:?}", j + 1);
+    }
+}

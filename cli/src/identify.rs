@@ -27,11 +27,15 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \
       --validate run2.csv
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
-the Coulomb term smoothed as the data best support; --validate predicts a second
-recording with the result.
+the Coulomb term smoothed as the data best support; --friction stribeck replaces the
+Coulomb term by (Fc + (Fs − Fc)·exp(−(q̇/vs)²))·sign(q̇), static friction Fs and
+Stribeck velocity vs per joint fitted by nonlinear least squares from the linear fit
+(never a worse fit than sign); --validate predicts a second recording with the
+result.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them,
@@ -146,7 +150,8 @@ pub struct IdentifyArgs {
     #[arg(long, value_enum, default_value_t = Friction::None)]
     pub friction: Friction,
 
-    /// --friction smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for prismatic joints).
+    /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
+    /// prismatic joints).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     pub epsilon: f64,
 

@@ -29,13 +29,17 @@ Examples:
       --validate run2.csv
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --method consistent \
       --exclude-below 0.05 --validate run2.csv
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
-the Coulomb term smoothed as the data best support; --validate predicts a second
-recording with the result. --method consistent keeps every body physical and (with
-friction) Ia, Fv, Fc >= 0; --exclude-below SPEED leaves out a joint's rows where it
-moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
+the Coulomb term smoothed as the data best support; --friction stribeck replaces the
+Coulomb term by (Fc + (Fs − Fc)·exp(−(q̇/vs)²))·sign(q̇), static friction Fs and
+Stribeck velocity vs per joint fitted by nonlinear least squares from the linear fit
+(never a worse fit than sign); --validate predicts a second recording with the
+result. --method consistent keeps every body physical and (with friction) Ia, Fv,
+Fc >= 0; --exclude-below SPEED leaves out a joint's rows where it moves slower than
+SPEED (rad/s), where sticking defeats the Coulomb model.
 
 The CSV needs t, q1..qn and tau1..taun; v and a are estimated from q (zero-phase
 low-pass at --cutoff Hz, then central differences) when the file does not have them,
@@ -91,6 +95,11 @@ pub enum Friction {
     Smooth,
     /// The same with the ε that fits the data best (a search on the fit residual).
     Auto,
+    /// Sign, plus per joint a Stribeck term: static friction Fs at rest falling to
+    /// Fc above the Stribeck velocity vs, fitted by nonlinear least squares.
+    Stribeck,
+    /// Stribeck with the Coulomb term Fc·tanh(q̇/ε), ε from --epsilon.
+    StribeckSmooth,
 }
 
 /// How the rows are compressed (dyngen_identify::Accumulation).
@@ -150,7 +159,8 @@ pub struct IdentifyArgs {
     #[arg(long, value_enum, default_value_t = Friction::None)]
     pub friction: Friction,
 
-    /// --friction smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for prismatic joints).
+    /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
+    /// prismatic joints).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     pub epsilon: f64,
 
@@ -376,6 +386,8 @@ impl IdentifyArgs {
                 Friction::Sign => JointTerms::Friction(Coulomb::Sign),
                 Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
                 Friction::Auto => JointTerms::FrictionAuto,
+                Friction::Stribeck => JointTerms::Stribeck(Coulomb::Sign),
+                Friction::StribeckSmooth => JointTerms::Stribeck(Coulomb::Smooth { epsilon: self.epsilon }),
             },
             exclude_below: self.exclude_below,
             cutoff_hz: self.recording.cutoff,
@@ -434,6 +446,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
             println!("{}", torque.estimate.table(&names));
             print_fit(&torque.estimate);
+            if let Some(fit) = &identified.stribeck {
+                print!("{fit}");
+            }
             if args.mode == Mode::Standard && args.friction == Friction::None {
                 hint_friction(&torque.estimate, &traj);
             }

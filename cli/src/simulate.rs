@@ -4,8 +4,10 @@ use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg
 use crate::error::CliError;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{
-    add_joint_terms, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Logger, Motion, NoiseModel,
+    add_joint_terms, add_stribeck_terms, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Logger,
+    Motion, NoiseModel,
 };
+use dyngen_identify::stribeck::Stribeck;
 use dyngen_model::joint_params::Coulomb;
 use dyngen_reference::Reference;
 use std::path::PathBuf;
@@ -91,6 +93,15 @@ pub struct SimulateArgs {
     /// τ += Fc·sign(q̇).
     #[arg(long, value_name = "FC", allow_hyphen_values = true)]
     pub coulomb: Option<String>,
+
+    /// Static friction Fs per joint, with --stribeck-velocity: the Coulomb term
+    /// becomes the Stribeck model (Fc + (Fs − Fc)·exp(−(q̇/vs)²))·sign(q̇).
+    #[arg(long, value_name = "FS", allow_hyphen_values = true, requires = "stribeck_velocity")]
+    pub static_friction: Option<String>,
+
+    /// Stribeck velocity vs per joint (rad/s or m/s, positive), with --static-friction.
+    #[arg(long, value_name = "VS", allow_hyphen_values = true, requires = "static_friction")]
+    pub stribeck_velocity: Option<String>,
 
     /// Torque offset F0 per joint: τ += F0.
     #[arg(long, value_name = "F0", allow_hyphen_values = true)]
@@ -246,6 +257,19 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         column("--offset", &args.offset, 3)?,
     ];
     let joint_params: Vec<f64> = (0..n).flat_map(|j| [ia[j], fv[j], fc[j], f0[j]]).collect();
+    let stribeck = match (&args.static_friction, &args.stribeck_velocity) {
+        (Some(fs), Some(vs)) => {
+            let (fs, vs) = (
+                per_joint("--static-friction", fs, n)?,
+                per_joint("--stribeck-velocity", vs, n)?,
+            );
+            let stribeck: Vec<Stribeck> = fs.iter().zip(&vs).map(|(&fs, &vs)| Stribeck { fs, vs }).collect();
+            dyngen_identify::stribeck::check(&stribeck, n)
+                .map_err(|e| CliError::usage(format!("--stribeck-velocity: {e}")))?;
+            Some(stribeck)
+        }
+        _ => None,
+    };
     let logger = match args.logger_period {
         Some(period) => Some(Logger {
             period,
@@ -271,6 +295,9 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     });
     if joint_params.iter().any(|&x| x != 0.0) {
         add_joint_terms(&mut clean, &joint_params, Coulomb::Sign);
+    }
+    if let Some(stribeck) = &stribeck {
+        add_stribeck_terms(&mut clean, &joint_params, stribeck, Coulomb::Sign).map_err(CliError::failed)?;
     }
     let recording = if args.noise > 0.0 {
         NoiseModel::relative(args.noise).apply(&clean, args.seed)

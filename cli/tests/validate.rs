@@ -406,3 +406,85 @@ fn rows_below_a_speed_are_left_out() {
     );
     assert_exit(&o, 2, "--exclude-below applies to the standard and principal modes");
 }
+
+/// `--friction stribeck` on the MuJoCo fixture: MuJoCo's joint friction vanishes at
+/// rest, which a static friction below the Coulomb friction describes; the fit
+/// predicts the second recording better than sign friction, and `validate`
+/// predicts the same from the JSON, which holds Fs and vs.
+#[test]
+fn stribeck_friction_predicts_the_mujoco_recording_better_than_sign_friction() {
+    let dir = temp_dir("dyngen-validate", "stribeck");
+    let params = dir.join("ur5.json");
+    let identify = |friction: &str, json: Option<&PathBuf>| {
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "identify".into(),
+            ur5().into(),
+            fixture("ur5_identify.csv").into(),
+            "--friction".into(),
+            friction.into(),
+            "--cutoff".into(),
+            "5".into(),
+            "--validate".into(),
+            fixture("ur5_validate.csv").into(),
+        ];
+        if let Some(json) = json {
+            args.extend(["--params-json".into(), json.into(), "--force".into()]);
+        }
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let o = common::dyngen(&args);
+        assert_ok(&o);
+        stdout(&o)
+    };
+    let sign = overall(&identify("sign", None));
+    let out = identify("stribeck", Some(&params));
+    let stribeck = overall(&out);
+    assert!(stribeck < 0.7 * sign, "sign {sign}, stribeck {stribeck}\n{out}");
+    assert!(
+        out.contains("Stribeck friction (Fs at rest falling to Fc above vs)"),
+        "{out}"
+    );
+    let json = std::fs::read_to_string(&params).unwrap();
+    assert!(json.contains("\"stribeck\"") && json.contains("\"Fs1\"") && json.contains("\"vs6\""));
+    let o = run!("validate", ur5(), &params, fixture("ur5_validate.csv"), "--cutoff", "5");
+    assert_ok(&o);
+    assert_eq!(overall(&stdout(&o)), stribeck);
+}
+
+#[test]
+fn simulated_stribeck_friction_needs_a_positive_velocity() {
+    let dir = temp_dir("dyngen-validate", "stribeck-simulate");
+    let csv = dir.join("s.csv");
+    let simulate = |extra: &[&str]| {
+        let mut args: Vec<std::ffi::OsString> = vec!["simulate".into(), ur5().into(), "-o".into(), csv.clone().into()];
+        args.extend(extra.iter().map(|a| a.into()));
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        common::dyngen(&args)
+    };
+    let o = simulate(&[
+        "--static-friction",
+        "2",
+        "--stribeck-velocity",
+        "0.05,0.05,0,0.05,0.05,0.05",
+    ]);
+    assert_exit(
+        &o,
+        2,
+        "joint 3: the Stribeck velocity must be positive and finite, got 0",
+    );
+    assert_exit(&simulate(&["--static-friction", "2"]), 2, "--stribeck-velocity");
+    assert_exit(
+        &simulate(&["--static-friction", "2,3", "--stribeck-velocity", "0.05"]),
+        2,
+        "--static-friction: 2 values for 6 joints",
+    );
+    let o = simulate(&[
+        "--coulomb",
+        "1",
+        "--static-friction",
+        "2",
+        "--stribeck-velocity",
+        "0.05",
+    ]);
+    assert_ok(&o);
+    assert!(csv.exists());
+}

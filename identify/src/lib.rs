@@ -36,6 +36,7 @@ pub mod payload;
 pub mod pipeline;
 pub mod report;
 pub mod simulate;
+pub mod stribeck;
 pub mod validate;
 
 mod accumulate;

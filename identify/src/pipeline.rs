@@ -28,6 +28,7 @@ use crate::report::{
     self, CoulombReport, MergedLinks, ParamStatus, ParameterReport, Parameterisation, PredictionModel, ReportError,
 };
 use crate::simulate::Recording;
+use crate::stribeck::StribeckFit;
 use crate::{Accumulation, Accumulator, Channels, IdentifyError, Layout, Options, PrincipalOptions, StandardOptions};
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
 use dyngen_model::{ErrorKind, Inertial, Model};
@@ -87,6 +88,10 @@ pub enum JointTerms {
     /// residual ([`crate::friction::best_epsilon`], on at most
     /// [`SMOOTHING_SAMPLES`] samples spread over the recording).
     FrictionAuto,
+    /// Friction and rotor inertia with the Coulomb term as given, and per joint a
+    /// Stribeck term: static friction `Fs` and Stribeck velocity `vs`
+    /// ([`crate::stribeck`]), fitted by nonlinear least squares from the linear fit.
+    Stribeck(Coulomb),
 }
 
 /// Samples the search for the Coulomb smoothing fits on, at most.
@@ -164,7 +169,9 @@ impl IdentifyOptions {
                 "applies to the standard mode (the joint terms enter the joint torques, not the body equations)".into(),
             );
         }
-        if let JointTerms::Friction(Coulomb::Smooth { epsilon }) = self.joints {
+        if let JointTerms::Friction(Coulomb::Smooth { epsilon }) | JointTerms::Stribeck(Coulomb::Smooth { epsilon }) =
+            self.joints
+        {
             if !(epsilon.is_finite() && epsilon > 0.0) {
                 return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
             }
@@ -301,6 +308,8 @@ pub struct Identification {
     /// Per joint, the torque rows left out by [`IdentifyOptions::exclude_below`]
     /// (all 0 without it, and for MIM).
     pub excluded_rows: Vec<usize>,
+    /// The Stribeck terms, with [`JointTerms::Stribeck`].
+    pub stribeck: Option<StribeckFit>,
 }
 
 /// A TLS residual this many times the OLS residual means TLS's assumption (noise
@@ -342,7 +351,9 @@ fn from_torques(
     let regressor = match (principal, options.joints) {
         (true, _) => TorqueRegressor::Principal,
         (false, JointTerms::None) => TorqueRegressor::Standard,
-        (false, JointTerms::Friction(coulomb)) => TorqueRegressor::StandardAndJoints(coulomb),
+        (false, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
+            TorqueRegressor::StandardAndJoints(coulomb)
+        }
         (false, JointTerms::FrictionAuto) => {
             let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
             let mut failure = None;
@@ -378,7 +389,7 @@ fn from_torques(
     if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
         nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
     }
-    let estimate = match options.estimator {
+    let solve = |acc: &Accumulator| match options.estimator {
         Estimator::Ols => acc.ols(opts),
         Estimator::Wls => acc.wls(opts),
         Estimator::Tls { column_scaling: true } => acc.tls(opts),
@@ -386,7 +397,8 @@ fn from_torques(
         Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
         Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
         Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
-    }?;
+    };
+    let estimate = solve(&acc)?;
     let mut warnings = Vec::new();
     if let Estimator::Tls { column_scaling } = options.estimator {
         let ols = acc.ols(opts)?;
@@ -405,6 +417,16 @@ fn from_torques(
             ));
         }
     }
+    let (estimate, stribeck) = match options.joints {
+        JointTerms::Stribeck(coulomb) if !principal => {
+            let (estimate, fit) = crate::stribeck::refine(dynamics, traj, coulomb, estimate, |t| {
+                let acc = accumulate(dynamics, t, regressor, 1, options)?;
+                Ok::<_, PipelineError>(solve(&acc)?)
+            })?;
+            (estimate, Some(fit))
+        }
+        _ => (estimate, None),
+    };
     let mut names = if principal {
         dyngen_model::names::principal_param_names(n)
     } else {
@@ -431,7 +453,11 @@ fn from_torques(
         regressor: parameterisation,
         coulomb,
         solution: estimate.solution.clone(),
+        stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
     });
+    if let Some(fit) = &stribeck {
+        report.parameters.extend(fit.param_reports());
+    }
     Ok(Identification {
         mode: options.mode,
         report,
@@ -444,6 +470,7 @@ fn from_torques(
         })),
         warnings,
         excluded_rows,
+        stribeck,
     })
 }
 
@@ -573,6 +600,7 @@ fn by_mim(
         mim: Some(estimate),
         warnings: Vec::new(),
         excluded_rows: vec![0; model.dof()],
+        stribeck: None,
     })
 }
 
@@ -655,12 +683,32 @@ pub fn predict_with(
             reason: format!("entry {k} of the solution is not finite"),
         });
     }
+    let stribeck = match (&prediction.stribeck, regressor) {
+        (None, _) => None,
+        (Some(s), TorqueRegressor::StandardAndJoints(coulomb)) => {
+            crate::stribeck::check(s, n).map_err(|e| PipelineError::InvalidOption {
+                option: "prediction",
+                reason: format!("stribeck: {e}"),
+            })?;
+            Some((s, coulomb))
+        }
+        (Some(_), _) => {
+            return Err(PipelineError::InvalidOption {
+                option: "prediction",
+                reason: "Stribeck terms need the standard_and_joints regressor".into(),
+            })
+        }
+    };
     need_derivatives(trajectory)?;
     let mut y = vec![0.0; n * p];
     Ok((0..trajectory.len())
         .map(|k| {
             let (q, v, a) = state(trajectory, k);
-            regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y)
+            let mut tau = regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y);
+            if let Some((s, coulomb)) = stribeck {
+                crate::stribeck::add_excess(&mut tau, v, &prediction.solution[10 * n..], s, coulomb);
+            }
+            tau
         })
         .collect())
 }
@@ -706,7 +754,14 @@ impl Identification {
             .map(|k| {
                 let (q, v, a) = state(trajectory, k);
                 match &self.prediction {
-                    Prediction::Regressor(estimate) => estimate.predict(dynamics, q, v, a),
+                    Prediction::Regressor(estimate) => {
+                        let mut tau = estimate.predict(dynamics, q, v, a);
+                        if let Some(fit) = &self.stribeck {
+                            let joints = &estimate.estimate.solution[10 * n..];
+                            crate::stribeck::add_excess(&mut tau, v, joints, &fit.joints, fit.coulomb);
+                        }
+                        tau
+                    }
                     Prediction::Parameters(params) => {
                         dynamics.rnea(q, v, a, params, &mut tau);
                         tau.clone()

@@ -101,6 +101,14 @@ impl Trajectory {
         Ok(self)
     }
 
+    /// The same trajectory with the joint torques replaced by `tau` (row-major,
+    /// `len() × dof`), e.g. torques with a known term taken out.
+    pub fn with_torques(mut self, tau: Vec<f64>) -> Result<Self, DataError> {
+        self.tau = tau;
+        self.check()?;
+        Ok(self)
+    }
+
     /// The same trajectory with joint reaction wrenches (row-major, `len() × dof`):
     /// `wrenches[k * dof + j]` is what joint `j + 1` applies to its outboard body at
     /// sample `k`, in that body's frame, moment about the joint origin.

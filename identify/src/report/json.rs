@@ -17,9 +17,18 @@
 //!   "combinations": [
 //!     { "expression": "mx1 + 0.425·m2", "terms": [{ "name": "mx1", "coefficient": 1.0 }, ...],
 //!       "value": 1.2, "sigma": 0.003 }
-//!   ]
+//!   ],
+//!   "prediction": {                          // absent for MIM
+//!     "regressor": "standard_and_joints",
+//!     "coulomb": { "kind": "sign" },
+//!     "solution": [ ... ],
+//!     "stribeck": [{ "fs": 9.0, "vs": 0.05 }, ...]   // only with Stribeck friction
+//!   }
 //! }
 //! ```
+//!
+//! With Stribeck friction `parameters` ends with `Fs1, vs1, …, Fsn, vsn`
+//! ([`crate::stribeck`]).
 //!
 //! `status` is one of `identified` (value and σ from the data), `in_combination`
 //! (no value: only enters the listed combinations), `no_effect` (no value: the data
@@ -81,6 +90,12 @@ pub struct PredictionModel {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coulomb: Option<CoulombReport>,
     pub solution: Vec<f64>,
+    /// For `standard_and_joints` with Stribeck friction: per joint the static
+    /// friction `fs` and Stribeck velocity `vs`; row `j` of the prediction gains
+    /// `(fs − Fc)·exp(−(q̇_j/vs)²)·s(q̇_j)`, `Fc` the joint's Coulomb entry of the
+    /// solution ([`crate::stribeck`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stribeck: Option<Vec<crate::stribeck::Stribeck>>,
 }
 
 /// [`Status`] as written in the JSON.

@@ -6,6 +6,7 @@
 //! ([`Logger::write`]). Everything is seeded.
 
 use super::experiment::Recording;
+use crate::stribeck::{Stribeck, StribeckError};
 use dyngen_model::joint_params::{joint_torque, Coulomb, PER_JOINT};
 use dyngen_model::sample::SplitMix64;
 
@@ -29,6 +30,31 @@ pub fn add_joint_terms(recording: &mut Recording, joint_params: &[f64], coulomb:
             s.tau[j] += joint_torque(p, s.v[j], s.a[j], coulomb);
         }
     }
+}
+
+/// Adds every joint's Stribeck term `(Fs − Fc)·exp(−(q̇/vs)²)·s(q̇)`
+/// ([`crate::stribeck`]) to the recorded joint torques, on top of
+/// [`add_joint_terms`] with the same `joint_params` (`4n`, giving `Fc`) and
+/// `coulomb`: the friction at rest is then `Fs`. Refuses (naming the joint) a
+/// Stribeck velocity that is not positive, and a length other than one set per joint.
+pub fn add_stribeck_terms(
+    recording: &mut Recording,
+    joint_params: &[f64],
+    stribeck: &[Stribeck],
+    coulomb: Coulomb,
+) -> Result<(), StribeckError> {
+    let n = recording.joint_names.len();
+    crate::stribeck::check(stribeck, n)?;
+    if joint_params.len() != PER_JOINT * n {
+        return Err(StribeckError::Joints {
+            expected: n,
+            found: joint_params.len() / PER_JOINT,
+        });
+    }
+    for s in &mut recording.samples {
+        crate::stribeck::add_excess(&mut s.tau, &s.v, joint_params, stribeck, coulomb);
+    }
+    Ok(())
 }
 
 /// A logger as real robots have them.

@@ -1,0 +1,251 @@
+//! Stribeck friction identified by nonlinear least squares from the linear fit
+//! (`JointTerms::Stribeck`): on a simulated UR5 whose joints have a static friction
+//! above their Coulomb friction (1 % torque noise, fixed seeds), `Fs` and `vs` come
+//! back and the model predicts a second recording better than sign friction; on
+//! joints without a Stribeck effect it is no worse; its JSON predicts the same.
+
+use dyngen_identify::data::Trajectory;
+use dyngen_identify::pipeline::{self, Identification, IdentifyOptions, JointTerms, PipelineError};
+use dyngen_identify::report::ParameterReport;
+use dyngen_identify::simulate::{
+    add_joint_terms, add_stribeck_terms, record_trajectory, FourierExcitation, Gaussian, Recording,
+};
+use dyngen_identify::stribeck::{Stribeck, StribeckError};
+use dyngen_identify::validate::Validation;
+use dyngen_model::joint_params::Coulomb;
+use dyngen_model::sample::SplitMix64;
+use dyngen_reference::Reference;
+
+const IA: [f64; 6] = [0.40, 0.40, 0.20, 0.08, 0.08, 0.08];
+const FV: [f64; 6] = [3.0, 3.0, 2.0, 0.6, 0.6, 0.6];
+const FC: [f64; 6] = [6.0, 6.0, 4.0, 1.5, 1.5, 1.5];
+const F0: [f64; 6] = [0.2, -0.3, 0.1, 0.05, -0.05, 0.02];
+const FS: [f64; 6] = [9.0, 9.0, 6.0, 2.2, 2.2, 2.2];
+const VS: [f64; 6] = [0.05, 0.05, 0.08, 0.04, 0.04, 0.04];
+
+fn robot() -> Reference {
+    Reference::new(&dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap())
+}
+
+/// A multi-sine of 5 harmonics of 0.1 Hz per joint, seeded, about a pose where
+/// gravity on the shoulder and elbow varies: every joint reverses a few times.
+fn motion(seed: u64) -> FourierExcitation {
+    let mut rng = SplitMix64::new(seed);
+    let mut coef = || -> Vec<Vec<f64>> {
+        (0..6)
+            .map(|_| (1..=5).map(|_| rng.uniform(-0.3, 0.3)).collect())
+            .collect()
+    };
+    let (a, b) = (coef(), coef());
+    FourierExcitation::new(0.1, vec![0.0, -1.0, 1.0, 0.0, 0.0, 0.0], &a, &b)
+}
+
+/// 60 s at 100 Hz of the motion of `seed`, with rotor inertia and linear friction,
+/// Stribeck terms when `stribeck`, and 1 % of each joint's RMS torque as noise.
+fn recording(robot: &Reference, seed: u64, stribeck: bool) -> Trajectory {
+    let times: Vec<f64> = (0..6000).map(|k| 0.01 * k as f64).collect();
+    let mut rec = record_trajectory(robot, &robot.model().standard_params(), &motion(seed), &times);
+    let joints: Vec<f64> = (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect();
+    add_joint_terms(&mut rec, &joints, Coulomb::Sign);
+    if stribeck {
+        let s: Vec<Stribeck> = (0..6).map(|j| Stribeck { fs: FS[j], vs: VS[j] }).collect();
+        add_stribeck_terms(&mut rec, &joints, &s, Coulomb::Sign).unwrap();
+    }
+    add_torque_noise(&mut rec, seed + 100);
+    rec.to_trajectory().unwrap()
+}
+
+fn add_torque_noise(rec: &mut Recording, seed: u64) {
+    let mut noise = Gaussian::new(seed);
+    let sigma: Vec<f64> = (0..6)
+        .map(|j| 0.01 * (rec.samples.iter().map(|s| s.tau[j].powi(2)).sum::<f64>() / rec.len() as f64).sqrt())
+        .collect();
+    for s in &mut rec.samples {
+        for j in 0..6 {
+            s.tau[j] += noise.normal(sigma[j]);
+        }
+    }
+}
+
+fn identify(robot: &Reference, traj: &Trajectory, joints: JointTerms) -> Identification {
+    let options = IdentifyOptions {
+        joints,
+        ..IdentifyOptions::default()
+    };
+    pipeline::identify(robot, traj, &options).unwrap()
+}
+
+/// The overall relative prediction error of `id` on `traj`.
+fn validate(robot: &Reference, id: &Identification, traj: &Trajectory) -> f64 {
+    let predicted = id.predict(robot, traj).unwrap();
+    let names: Vec<String> = robot.model().joints.iter().map(|j| j.name.clone()).collect();
+    Validation::new(
+        &names,
+        (0..traj.len()).map(|k| traj.tau(k)),
+        predicted.iter().map(|p| &p[..]),
+    )
+    .unwrap()
+    .overall
+}
+
+#[test]
+fn stribeck_friction_is_recovered_and_predicts_better_than_sign() {
+    let robot = robot();
+    let (train, test) = (recording(&robot, 1, true), recording(&robot, 2, true));
+    let sign = identify(&robot, &train, JointTerms::Friction(Coulomb::Sign));
+    let stribeck = identify(&robot, &train, JointTerms::Stribeck(Coulomb::Sign));
+    let fit = stribeck.stribeck.as_ref().expect("a Stribeck fit");
+    println!("{fit}");
+    assert!(fit.cost < 0.5 * fit.initial_cost, "{fit}");
+    for j in 0..6 {
+        let s = fit.joints[j];
+        assert!(
+            (s.fs / FS[j] - 1.0).abs() < 0.03,
+            "joint {}: Fs {} vs {}",
+            j + 1,
+            s.fs,
+            FS[j]
+        );
+        assert!(
+            (s.vs / VS[j] - 1.0).abs() < 0.05,
+            "joint {}: vs {} vs {}",
+            j + 1,
+            s.vs,
+            VS[j]
+        );
+        assert!(
+            (fit.fc[j] / FC[j] - 1.0).abs() < 0.02,
+            "joint {}: Fc {} vs {}",
+            j + 1,
+            fit.fc[j],
+            FC[j]
+        );
+        let [sf, sv] = fit.sigma[j];
+        assert!(
+            sf.is_some_and(|x| x > 0.0) && sv.is_some_and(|x| x > 0.0),
+            "joint {}",
+            j + 1
+        );
+    }
+    let (e_sign, e_stribeck) = (validate(&robot, &sign, &test), validate(&robot, &stribeck, &test));
+    println!(
+        "validation: sign {:.3} %, stribeck {:.3} %",
+        100.0 * e_sign,
+        100.0 * e_stribeck
+    );
+    assert!(e_stribeck < 0.7 * e_sign, "sign {e_sign}, stribeck {e_stribeck}");
+
+    // The report holds Fs and vs (value and σ), and its JSON predicts exactly what
+    // the identification does.
+    let names: Vec<&str> = stribeck.report.parameters.iter().map(|p| p.name.as_str()).collect();
+    assert!(names.ends_with(&["Fs6", "vs6"]), "{names:?}");
+    let json = ParameterReport::from_json(&stribeck.report.to_json().unwrap()).unwrap();
+    let prediction = json.prediction.as_ref().unwrap();
+    assert_eq!(prediction.stribeck.as_deref(), Some(&fit.joints[..]));
+    let from_json = pipeline::predict_with(prediction, &robot, &test).unwrap();
+    let direct = stribeck.predict(&robot, &test).unwrap();
+    for (a, b) in from_json.iter().flatten().zip(direct.iter().flatten()) {
+        assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} vs {b}");
+    }
+}
+
+#[test]
+fn without_a_stribeck_effect_it_is_no_worse_than_sign() {
+    let robot = robot();
+    let (train, test) = (recording(&robot, 3, false), recording(&robot, 4, false));
+    let sign = identify(&robot, &train, JointTerms::Friction(Coulomb::Sign));
+    let stribeck = identify(&robot, &train, JointTerms::Stribeck(Coulomb::Sign));
+    let fit = stribeck.stribeck.as_ref().unwrap();
+    println!("{fit}");
+    assert!(fit.cost <= fit.initial_cost);
+    let residual = |id: &Identification| -> f64 {
+        let predicted = id.predict(&robot, &train).unwrap();
+        (0..train.len())
+            .flat_map(|k| train.tau(k).iter().zip(&predicted[k]).map(|(m, p)| (m - p).powi(2)))
+            .sum()
+    };
+    assert!(residual(&stribeck) <= residual(&sign) * (1.0 + 1e-12));
+    let (e_sign, e_stribeck) = (validate(&robot, &sign, &test), validate(&robot, &stribeck, &test));
+    println!(
+        "validation: sign {:.4} %, stribeck {:.4} %",
+        100.0 * e_sign,
+        100.0 * e_stribeck
+    );
+    assert!(e_stribeck < 1.01 * e_sign, "sign {e_sign}, stribeck {e_stribeck}");
+}
+
+#[test]
+fn bad_stribeck_parameters_are_refused_with_the_joint_named() {
+    let robot = robot();
+    let traj = recording(&robot, 5, true);
+    // The simulator refuses a Stribeck velocity that is not positive.
+    let times: Vec<f64> = (0..10).map(|k| 0.01 * k as f64).collect();
+    let mut rec = record_trajectory(&robot, &robot.model().standard_params(), &motion(5), &times);
+    let mut s = vec![Stribeck { fs: 2.0, vs: 0.05 }; 6];
+    s[3].vs = -0.1;
+    let err = add_stribeck_terms(&mut rec, &[0.0; 24], &s, Coulomb::Sign).unwrap_err();
+    assert_eq!(err, StribeckError::Velocity { joint: 4, vs: -0.1 });
+    assert!(
+        err.to_string()
+            .starts_with("joint 4: the Stribeck velocity must be positive"),
+        "{err}"
+    );
+    let err = add_stribeck_terms(&mut rec, &[0.0; 24], &s[..5], Coulomb::Sign).unwrap_err();
+    assert_eq!(err, StribeckError::Joints { expected: 6, found: 5 });
+
+    // A parameter JSON with a broken Stribeck entry, or on a model without the
+    // joint terms, predicts nothing.
+    let id = identify(&robot, &traj, JointTerms::Stribeck(Coulomb::Sign));
+    let mut prediction = id.report.prediction.clone().unwrap();
+    prediction.stribeck.as_mut().unwrap()[1].vs = 0.0;
+    let err = pipeline::predict_with(&prediction, &robot, &traj).unwrap_err();
+    assert!(matches!(err, PipelineError::InvalidOption { .. }), "{err:?}");
+    assert!(err.to_string().contains("joint 2: the Stribeck velocity"), "{err}");
+    prediction.stribeck.as_mut().unwrap().pop();
+    let err = pipeline::predict_with(&prediction, &robot, &traj).unwrap_err();
+    assert!(
+        err.to_string().contains("5 Stribeck parameter sets for 6 joints"),
+        "{err}"
+    );
+
+    // Smoothing that is not positive, and Stribeck friction outside the standard mode.
+    for options in [
+        IdentifyOptions {
+            joints: JointTerms::Stribeck(Coulomb::Smooth { epsilon: 0.0 }),
+            ..IdentifyOptions::default()
+        },
+        IdentifyOptions {
+            joints: JointTerms::Stribeck(Coulomb::Sign),
+            mode: pipeline::Mode::Principal,
+            ..IdentifyOptions::default()
+        },
+    ] {
+        let err = options.check().unwrap_err();
+        assert!(err.to_string().starts_with("friction "), "{err}");
+    }
+}
+
+/// A recording longer than `ROUND_SAMPLES`: the rounds run on a part of it, the
+/// result is carried to every sample, and the parameters still come back.
+#[test]
+fn a_long_recording_is_fitted_on_a_part_then_on_every_sample() {
+    let robot = robot();
+    let len = dyngen_identify::stribeck::ROUND_SAMPLES + 6_000;
+    let times: Vec<f64> = (0..len).map(|k| 0.005 * k as f64).collect();
+    let mut rec = record_trajectory(&robot, &robot.model().standard_params(), &motion(7), &times);
+    let joints: Vec<f64> = (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect();
+    let truth: Vec<Stribeck> = (0..6).map(|j| Stribeck { fs: FS[j], vs: VS[j] }).collect();
+    add_joint_terms(&mut rec, &joints, Coulomb::Sign);
+    add_stribeck_terms(&mut rec, &joints, &truth, Coulomb::Sign).unwrap();
+    add_torque_noise(&mut rec, 8);
+    let traj = rec.to_trajectory().unwrap();
+    let id = identify(&robot, &traj, JointTerms::Stribeck(Coulomb::Sign));
+    let fit = id.stribeck.as_ref().unwrap();
+    println!("{fit}");
+    assert_eq!(fit.rows, 6 * len);
+    assert!(fit.rounds >= 2 && fit.cost < 0.5 * fit.initial_cost, "{fit}");
+    for (j, (s, t)) in fit.joints.iter().zip(&truth).enumerate() {
+        assert!((s.fs / t.fs - 1.0).abs() < 0.03, "joint {}: {s:?} vs {t:?}", j + 1);
+        assert!((s.vs / t.vs - 1.0).abs() < 0.05, "joint {}: {s:?} vs {t:?}", j + 1);
+    }
+}

@@ -220,7 +220,18 @@ impl Description {
             }
         }
         let roots: Vec<usize> = (0..self.links.len()).filter(|&c| parent_joint[c].is_empty()).collect();
-        if roots.len() > 1 {
+        // A joint naming a link that does not exist, or two links of one name, leave
+        // links without their parent joint: the roots and loops that follow from that
+        // are not the user's mistake, the name is.
+        let names_wrong = errors.iter().any(|e| {
+            matches!(
+                e.kind,
+                ErrorKind::UnknownChildLink(_) | ErrorKind::UnknownParentLink(_) | ErrorKind::DuplicateLink
+            )
+        });
+        if names_wrong {
+            // Reported above.
+        } else if roots.len() > 1 {
             let names = roots.iter().map(|&r| self.links[r].name.clone()).collect();
             errors.push(err(Element::Robot, None, ErrorKind::SeveralRoots(names)));
         } else if roots.is_empty() && !self.links.is_empty() {

@@ -86,17 +86,23 @@ fn unknown_child_link() {
         &link("a"),
         &joint("j", "continuous", "base", "nope", ""),
     ]);
-    let errs = errors(&text);
-    // `a` then has no parent joint, so it is a second root (reported first, on line 1).
-    assert_eq!(errs.len(), 2, "{errs:#?}");
-    assert_eq!(errs[0].kind, ErrorKind::SeveralRoots(vec!["base".into(), "a".into()]));
-    assert_named(&errs[1], &Element::Joint("j".into()), 4);
-    assert_eq!(errs[1].kind, ErrorKind::UnknownChildLink("nope".into()));
-    assert!(
-        errs[1].to_string().contains("child link `nope` does not exist"),
-        "{}",
-        errs[1]
-    );
+    // `a` then has no parent joint; the name is the mistake, not a second root.
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnknownChildLink("nope".into()));
+    assert!(e.to_string().contains("child link `nope` does not exist"), "{e}");
+}
+
+#[test]
+fn unknown_parent_link_in_a_chain_is_not_a_missing_root() {
+    // Every link has a parent joint, one of them from a misspelt link.
+    let text = robot(&[
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "bsae", "a", ""),
+        &joint("jb", "continuous", "a", "b", ""),
+    ]);
+    let e = single(&text, Element::Joint("ja".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnknownParentLink("bsae".into()));
 }
 
 #[test]
@@ -193,6 +199,19 @@ fn duplicate_names() {
     };
     assert_named(find(ErrorKind::DuplicateLink), &Element::Link("a".into()), 4);
     assert_named(find(ErrorKind::DuplicateJoint), &Element::Joint("j".into()), 6);
+}
+
+#[test]
+fn duplicate_link_is_not_reported_as_a_second_root() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Link("a".into()), 4);
+    assert_eq!(e.kind, ErrorKind::DuplicateLink);
+    assert!(e.to_string().contains("defined more than once"), "{e}");
 }
 
 #[test]
@@ -332,14 +351,195 @@ fn non_finite_mass() {
 }
 
 #[test]
-fn unreadable_number_is_a_parse_error() {
-    let errs = errors(&one_body(&link_with("a", "heavy", ["1", "1", "1"])));
-    assert_eq!(errs.len(), 1);
-    assert!(
-        matches!(&errs[0].kind, ErrorKind::Parse(m) if m.contains("invalid float")),
-        "{errs:?}"
+fn unreadable_number_names_the_element_and_line() {
+    let e = single(
+        &one_body(&link_with("a", "heavy", ["1", "1", "1"])),
+        Element::Link("a".into()),
+        3,
     );
-    assert!(errs[0].to_string().starts_with("robot: not valid URDF"), "{}", errs[0]);
+    assert_eq!(
+        e.kind,
+        ErrorKind::BadNumber {
+            attribute: "mass value".into(),
+            value: "heavy".into(),
+            expected: 1
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "line 3: link `a`: <mass value=\"heavy\"> is not a number; write one number such as `0.5`"
+    );
+}
+
+#[test]
+fn wrong_count_or_unreadable_vectors_name_the_element_and_line() {
+    let cases = [
+        (r#"<origin xyz="0 0 1" rpy="0 1.57"/>"#, "origin rpy", "0 1.57", 3),
+        (r#"<origin xyz="0 0 1 0"/>"#, "origin xyz", "0 0 1 0", 3),
+        (r#"<origin xyz="0, 0, 1"/>"#, "origin xyz", "0, 0, 1", 3),
+        (r#"<axis xyz="z"/>"#, "axis xyz", "z", 3),
+        (
+            r#"<limit lower="-1" upper="one" effort="1" velocity="1"/>"#,
+            "limit upper",
+            "one",
+            1,
+        ),
+        (r#"<dynamics damping="0.1 0.2"/>"#, "dynamics damping", "0.1 0.2", 1),
+    ];
+    for (extra, attribute, value, expected) in cases {
+        let text = robot(&[
+            r#"<link name="base"/>"#,
+            &link("a"),
+            &joint("j", "revolute", "base", "a", extra),
+        ]);
+        let e = single(&text, Element::Joint("j".into()), 4);
+        assert_eq!(
+            e.kind,
+            ErrorKind::BadNumber {
+                attribute: attribute.into(),
+                value: value.into(),
+                expected
+            },
+            "{extra}"
+        );
+        assert!(e.to_string().contains(&format!("=\"{value}\"> is not")), "{e}");
+    }
+    // Inertia values and the inertial origin, all reported at once.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        r#"<link name="a"><inertial><origin rpy="0 0"/><mass value="1"/>"#,
+        r#"<inertia ixx="1e-3" iyy="x" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_named(&errs[0], &Element::Link("a".into()), 3);
+    assert_named(&errs[1], &Element::Link("a".into()), 4);
+    assert!(
+        errs[1].to_string().contains("<inertia iyy=\"x\"> is not a number"),
+        "{}",
+        errs[1]
+    );
+    // Geometry is not read, so its numbers are not checked.
+    let text = robot(&[
+        r#"<link name="base"><visual><origin xyz="bogus"/><geometry><box size="1 1"/></geometry></visual></link>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    assert_eq!(parse_urdf(&text).map(|m| m.dof()), Ok(1));
+}
+
+#[test]
+fn mimic_joint_is_reported() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint(
+            "jb",
+            "continuous",
+            "base",
+            "b",
+            r#"<mimic joint="ja" multiplier="-1"/>"#,
+        ),
+    ]);
+    let e = single(&text, Element::Joint("jb".into()), 6);
+    assert_eq!(e.kind, ErrorKind::MimicJoint("ja".into()));
+    assert!(
+        e.to_string()
+            .contains("mimics joint `ja` (<mimic>), which is not supported"),
+        "{e}"
+    );
+    // Also when the description alone is asked for, and beside other errors.
+    assert!(urdf_description(&text).is_err());
+    let text = text.replace(r#"<link name="b">"#, r#"<link name="b_">"#);
+    let errs = errors(&text);
+    assert!(
+        errs.iter().any(|e| e.kind == ErrorKind::MimicJoint("ja".into())),
+        "{errs:#?}"
+    );
+    assert!(
+        errs.iter().any(|e| e.kind == ErrorKind::UnknownChildLink("b".into())),
+        "{errs:#?}"
+    );
+}
+
+#[test]
+fn nesting_beyond_the_limit_is_an_error_not_a_stack_overflow() {
+    let depth = 20_000;
+    let text = format!(
+        "<robot name=\"r\">\n<link name=\"base\">\n{}{}</link>\n</robot>\n",
+        "<a>".repeat(depth),
+        "</a>".repeat(depth)
+    );
+    let e = single(&text, Element::Robot, 3);
+    assert_eq!(e.kind, ErrorKind::TooDeep { tag: "a".into() });
+    assert!(
+        e.to_string().contains("<a> is nested more than 256 elements deep"),
+        "{e}"
+    );
+    // Just inside the limit, the file is read (the unknown elements are ignored).
+    let depth = dyngen_model::xml::MAX_DEPTH - 3;
+    let text = robot(&[
+        &format!(
+            "<link name=\"base\">{}{}</link>",
+            "<a>".repeat(depth),
+            "</a>".repeat(depth)
+        ),
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    assert_eq!(parse_urdf(&text).map(|m| m.dof()), Ok(1));
+}
+
+#[test]
+fn file_beyond_the_size_limit_is_an_error() {
+    let limit = dyngen_model::urdf::MAX_FILE_BYTES as usize;
+    let mut text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    text.push_str(&" ".repeat(limit + 1 - text.len()));
+    let errs = errors(&text);
+    assert_eq!(
+        errs[0].kind,
+        ErrorKind::TooLarge {
+            bytes: limit as u64 + 1
+        }
+    );
+    let file = TempFile::new("large.urdf", &text);
+    let e = load_urdf(&file.0).unwrap_err();
+    assert_eq!(
+        e.errors[0].kind,
+        ErrorKind::TooLarge {
+            bytes: limit as u64 + 1
+        }
+    );
+    assert!(e.to_string().contains("more than the 64 MiB"), "{e}");
+}
+
+#[test]
+// Values near π and π/2 that are not the constants are the point.
+#[allow(clippy::approx_constant)]
+fn rpy_near_a_quarter_turn_is_taken_as_written() {
+    let urdf = |rpy: &str| {
+        robot(&[
+            r#"<link name="base"/>"#,
+            &link("a"),
+            &joint("j", "continuous", "base", "a", &format!(r#"<origin rpy="{rpy}"/>"#)),
+        ])
+    };
+    let rotation = |rpy: &str| parse_urdf(&urdf(rpy)).unwrap().joints[0].origin.rotation;
+    // As written: 2.07e-13 rad short of π, as Pinocchio reads it.
+    let r = rotation("3.14159265359 0 0");
+    let (s, c) = 3.14159265359f64.sin_cos();
+    assert_eq!((r[2][1], r[1][1]), (s, c));
+    assert!(r[2][1] != 0.0);
+    // The f64 nearest π is a half turn, exactly.
+    let r = rotation("3.141592653589793 0 0");
+    assert_eq!((r[2][1], r[1][1]), (0.0, -1.0));
 }
 
 #[test]

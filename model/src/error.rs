@@ -75,6 +75,11 @@ pub enum ErrorKind {
     UnsupportedJointType(String),
     ZeroAxis,
     NonFiniteValue(&'static str),
+    /// A finite value beyond [`MAX_MAGNITUDE`](crate::desc::MAX_MAGNITUDE).
+    OutOfRange {
+        what: &'static str,
+        value: f64,
+    },
     MissingInertial,
     NonPositiveMass(f64),
     NotPositiveDefinite([f64; 3]),
@@ -165,6 +170,11 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
             ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),
+            ErrorKind::OutOfRange { what, value } => write!(
+                f,
+                "{what} holds {value:e}, beyond ±{:e} in SI units (m, kg, kg·m²); check the unit",
+                crate::desc::MAX_MAGNITUDE
+            ),
             ErrorKind::MissingInertial => write!(
                 f,
                 "this moving body has no <inertial> (nor any fixed-attached link with one); give it a mass and inertia"
@@ -190,6 +200,18 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
         }
+    }
+}
+
+impl ModelError {
+    /// The message of a problem accepted with a warning ([`Model::warnings`](crate::Model)):
+    /// what is wrong, and why it was let through.
+    pub fn warning_message(&self) -> String {
+        format!(
+            "{self}; accepted as written: within the relative tolerance of {:e} for CAD rounding (the nearest \
+             physical inertia is used where consistency is needed; a strict build refuses it)",
+            crate::desc::INERTIA_TOLERANCE
+        )
     }
 }
 

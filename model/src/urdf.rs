@@ -17,12 +17,25 @@ use std::path::Path;
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
 
 /// Parses and checks URDF text; errors carry line numbers but no file name.
+/// Inertias within [`INERTIA_TOLERANCE`](crate::desc::INERTIA_TOLERANCE) of
+/// physical are accepted as written, each with a warning in [`Model::warnings`].
 pub fn parse_urdf(text: &str) -> Result<Model, ModelErrors> {
-    build(text).map_err(|errors| ModelErrors { file: None, errors })
+    parse_urdf_with(text, false)
+}
+
+/// [`parse_urdf`]; `strict` refuses what it would accept with a warning.
+pub fn parse_urdf_with(text: &str, strict: bool) -> Result<Model, ModelErrors> {
+    build(text, strict).map_err(|errors| ModelErrors { file: None, errors })
 }
 
 /// Reads, parses and checks a URDF file; errors are prefixed with its path.
+/// Warnings as for [`parse_urdf`].
 pub fn load_urdf(path: &Path) -> Result<Model, ModelErrors> {
+    load_urdf_with(path, false)
+}
+
+/// [`load_urdf`]; `strict` refuses what it would accept with a warning.
+pub fn load_urdf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
     let file = Some(path.display().to_string());
     let fail = |kind: ErrorKind| ModelErrors {
         file: file.clone(),
@@ -38,7 +51,7 @@ pub fn load_urdf(path: &Path) -> Result<Model, ModelErrors> {
         let bytes = std::fs::metadata(path).map_or(text.len() as u64, |m| m.len());
         return Err(fail(ErrorKind::TooLarge { bytes }));
     }
-    build(&text).map_err(|errors| ModelErrors { file, errors })
+    build(&text, strict).map_err(|errors| ModelErrors { file, errors })
 }
 
 /// The unchecked description of URDF text, before [`Description::build`]: for
@@ -52,10 +65,10 @@ pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
     Ok(desc)
 }
 
-fn build(text: &str) -> Result<Model, Vec<ModelError>> {
+fn build(text: &str, strict: bool) -> Result<Model, Vec<ModelError>> {
     let (desc, robot_line, unsupported) = read(text)?;
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
-    let mut errors = match desc.build_with(SiblingOrder::Name) {
+    let mut errors = match desc.build_checked(SiblingOrder::Name, strict) {
         Ok(model) if unsupported.is_empty() => return Ok(model),
         Ok(_) => Vec::new(),
         Err(errors) => errors,

@@ -545,7 +545,7 @@ fn rpy_near_a_quarter_turn_is_taken_as_written() {
 #[test]
 fn inertia_not_positive_definite() {
     let e = single(
-        &one_body(&link_with("a", "1", ["1", "1", "0"])),
+        &one_body(&link_with("a", "1", ["1", "1", "-0.01"])),
         Element::Link("a".into()),
         3,
     );
@@ -1141,4 +1141,143 @@ fn negative_friction() {
         }
     );
     assert!(e.to_string().contains("give values ≥ 0"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------
+// CAD rounding of inertias
+
+/// A finger of three flat links (a plate has `J3 = J1 + J2` exactly) whose largest
+/// moments are 2.3e-6, 3.5e-6 and 7.3e-6 kg·m², written with four significant digits
+/// as CAD exporters do, so that rounding breaks the triangle inequality (the first
+/// two) or positive definiteness (the third, a rod whose zero moment came out
+/// negative). `third` replaces the third link's moments.
+fn cad_finger(third: [&str; 3]) -> String {
+    robot(&[
+        r#"<link name="palm"/>"#,
+        &link_with("f1", "0.01", ["9.137e-7", "1.386e-6", "2.300e-6"]),
+        &link_with("f2", "0.01", ["1.234e-6", "2.265e-6", "3.500e-6"]),
+        &link_with("f3", "0.01", third),
+        &joint("j1", "continuous", "palm", "f1", ""),
+        &joint("j2", "continuous", "f1", "f2", ""),
+        &joint("j3", "continuous", "f2", "f3", ""),
+    ])
+}
+
+#[test]
+fn cad_rounding_within_the_tolerance_is_accepted_with_warnings() {
+    use dyngen_model::{inertia_violation, INERTIA_TOLERANCE};
+    let text = cad_finger(["-2.0e-10", "7.300e-6", "7.300e-6"]);
+    let model = parse_urdf(&text).unwrap();
+    let warned: Vec<(&Element, Option<usize>)> = model.warnings.iter().map(|w| (&w.element, w.line)).collect();
+    assert_eq!(
+        warned,
+        [
+            (&Element::Link("f1".into()), Some(3)),
+            (&Element::Link("f2".into()), Some(4)),
+            (&Element::Link("f3".into()), Some(5)),
+        ]
+    );
+    let violations: Vec<f64> = model
+        .warnings
+        .iter()
+        .map(|w| match w.kind {
+            ErrorKind::TriangleInequality(ev) | ErrorKind::NotPositiveDefinite(ev) => inertia_violation(ev),
+            ref k => panic!("{k:?}"),
+        })
+        .collect();
+    // 3e-10 / 2.3e-6, 1e-9 / 3.5e-6, 2e-10 / 7.3e-6: parts in ten thousand or less.
+    for (v, expected) in violations.iter().zip([1.304e-4, 2.857e-4, 2.740e-5]) {
+        assert!((v / expected - 1.0).abs() < 1e-3, "{violations:?}");
+        assert!(*v < INERTIA_TOLERANCE);
+    }
+    assert!(matches!(model.warnings[2].kind, ErrorKind::NotPositiveDefinite(_)));
+    let message = model.warnings[0].warning_message();
+    assert!(
+        message.starts_with("line 3: link `f1`: principal moments")
+            && message.contains("break the triangle inequality")
+            && message.contains("accepted as written: within the relative tolerance of 1e-3 for CAD rounding"),
+        "{message}"
+    );
+    // Kept as written (as Pinocchio reads them); the nearest physical model moves
+    // each moment by at most the violation.
+    assert_eq!(model.bodies[0].inertial.inertia[0][0], 9.137e-7);
+    let physical = model.nearest_physical();
+    assert!(physical.warnings.is_empty());
+    for (body, fixed) in model.bodies.iter().zip(&physical.bodies) {
+        let (ev, _) = fixed.inertial.principal_axes();
+        assert!(inertia_violation(ev) < 1e-12, "{ev:?}");
+        assert!(dyngen_model::check_inertial(&fixed.inertial).is_ok(), "{ev:?}");
+        for r in 0..3 {
+            for c in 0..3 {
+                let d = (fixed.inertial.inertia[r][c] - body.inertial.inertia[r][c]).abs();
+                assert!(d <= 1.1e-9, "{} moved by {d:e}", body.name);
+            }
+        }
+        assert_eq!(fixed.inertial.mass, body.inertial.mass);
+        assert_eq!(fixed.inertial.com, body.inertial.com);
+    }
+    // A strict read refuses every one of them, as errors with their lines.
+    let e = dyngen_model::parse_urdf_with(&text, true).unwrap_err();
+    let lines: Vec<Option<usize>> = e.errors.iter().map(|e| e.line).collect();
+    assert_eq!(lines, [Some(3), Some(4), Some(5)]);
+}
+
+#[test]
+fn violations_beyond_the_tolerance_stay_errors() {
+    // The same 7.3e-6 link with a moment off by 4 %: a mistake, not rounding.
+    let text = cad_finger(["3.000e-6", "4.000e-6", "7.300e-6"]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 1, "{errs:#?}");
+    assert_named(&errs[0], &Element::Link("f3".into()), 5);
+    assert!(matches!(errs[0].kind, ErrorKind::TriangleInequality(_)), "{errs:?}");
+    // A clearly negative moment too.
+    let errs = errors(&cad_finger(["-1e-7", "7.300e-6", "7.300e-6"]));
+    assert!(matches!(errs[0].kind, ErrorKind::NotPositiveDefinite(_)), "{errs:?}");
+}
+
+#[test]
+fn nearest_physical_moments_move_least() {
+    use dyngen_model::{inertia_violation, nearest_physical_moments};
+    // Triangle: each moment moves by a third of the excess, toward J3 = J1 + J2.
+    let j = nearest_physical_moments([1.0, 2.0, 3.3]);
+    assert!((j[0] - 1.1).abs() < 1e-15 && (j[1] - 2.1).abs() < 1e-15 && (j[2] - 3.2).abs() < 1e-15);
+    assert_eq!(inertia_violation(j), 0.0);
+    // A negative moment is raised to a tiny positive one.
+    let j = nearest_physical_moments([-1e-9, 1.0, 1.0]);
+    assert!(j[0] > 0.0 && j[0] <= 1e-9 && j[1] == 1.0 && j[2] == 1.0, "{j:?}");
+    // Physical moments are left alone.
+    assert_eq!(nearest_physical_moments([1.0, 2.0, 3.0]), [1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn values_beyond_any_machine_are_errors_not_overflows() {
+    let e = single(
+        &one_body(&link_with("a", "1e308", ["1", "1", "1"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert_eq!(
+        e.kind,
+        ErrorKind::OutOfRange {
+            what: "mass",
+            value: 1e308
+        }
+    );
+    assert!(
+        e.to_string().contains("mass holds 1e308, beyond ±1e9 in SI units"),
+        "{e}"
+    );
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", r#"<origin xyz="0 0 -2e10"/>"#),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(
+        e.kind,
+        ErrorKind::OutOfRange {
+            what: "origin",
+            value: -2e10
+        }
+    );
 }

@@ -250,21 +250,39 @@ struct Tally {
     refused: u64,
 }
 
+impl Tally {
+    /// Over a run of some size, more than `1/accepted` of the cases accepted and more
+    /// than `1/refused` refused: damage that always or never breaks the input would
+    /// leave a check idle.
+    fn assert_mixed(&self, accepted: u64, refused: u64) {
+        let total = self.accepted + self.refused;
+        if total >= 1000 {
+            assert!(
+                self.accepted > total / accepted && self.refused > total / refused,
+                "{self:?}"
+            );
+        }
+    }
+}
+
 /// Runs `cases` inputs made from `seeds` by `make`, each through `front_end` under
 /// `catch_unwind`: a panic, or an accepted input that fails `front_end`'s own
 /// finiteness check, fails the test with the seed and the input.
 fn fuzz(
     what: &str,
+    (part, parts): (u64, u64),
     seeds: &[String],
     make: impl Fn(&str, &mut ChaCha8Rng) -> String,
     front_end: impl Fn(&str) -> Result<bool, String>,
 ) -> Tally {
     let mut tally = Tally::default();
-    let first = first_seed();
+    let per_part = cases().div_ceil(parts);
+    let first = first_seed() + part * per_part;
+    let last = (first_seed() + cases()).min(first + per_part);
     quiet_panics_while_fuzzing();
     FUZZING.with(|f| f.set(true));
     let mut failure = None;
-    for case in first..first + cases() {
+    for case in first..last {
         let mut rng = ChaCha8Rng::seed_from_u64(case);
         let seed = &seeds[rng.gen_range(0..seeds.len())];
         let input = make(seed, &mut rng);
@@ -288,7 +306,7 @@ fn fuzz(
         }
     }
     FUZZING.with(|f| f.set(false));
-    eprintln!("{what}: {} cases, {tally:?}", cases());
+    eprintln!("{what}: cases {first}..{last}, {tally:?}");
     tally
 }
 
@@ -306,11 +324,13 @@ fn urdf_seeds() -> Vec<String> {
     .collect()
 }
 
-#[test]
-fn damaged_urdfs_give_errors_or_valid_models() {
+/// One part of the URDF cases: parsing is the slowest front end, so its cases are
+/// split over tests that run in parallel.
+fn fuzz_urdfs(part: u64) {
     let seeds = urdf_seeds();
     let tally = fuzz(
         "URDF",
+        (part, URDF_PARTS),
         &seeds,
         |s, rng| damaged::<Elements>(s, rng, "<a>", "</a>"),
         |text| match dyngen_model::parse_urdf(text) {
@@ -322,10 +342,29 @@ fn damaged_urdfs_give_errors_or_valid_models() {
         },
     );
     // The mutations must leave some files valid, or the check of models is idle.
-    assert!(
-        tally.accepted > cases() / 20 && tally.refused > cases() / 5,
-        "{tally:?}"
-    );
+    tally.assert_mixed(20, 5);
+}
+
+const URDF_PARTS: u64 = 4;
+
+#[test]
+fn damaged_urdfs_give_errors_or_valid_models_1() {
+    fuzz_urdfs(0);
+}
+
+#[test]
+fn damaged_urdfs_give_errors_or_valid_models_2() {
+    fuzz_urdfs(1);
+}
+
+#[test]
+fn damaged_urdfs_give_errors_or_valid_models_3() {
+    fuzz_urdfs(2);
+}
+
+#[test]
+fn damaged_urdfs_give_errors_or_valid_models_4() {
+    fuzz_urdfs(3);
 }
 
 /// The `robot!` invocations of the shipped DSL robots: the text between the braces.
@@ -346,6 +385,7 @@ fn damaged_dsl_inputs_give_errors_or_valid_models() {
     let seeds = dsl_seeds();
     let tally = fuzz(
         "robot! DSL",
+        (0, 1),
         &seeds,
         |s, rng| damaged::<Lines>(s, rng, "[", "]"),
         |text| {
@@ -370,10 +410,7 @@ fn damaged_dsl_inputs_give_errors_or_valid_models() {
             }
         },
     );
-    assert!(
-        tally.accepted > cases() / 20 && tally.refused > cases() / 5,
-        "{tally:?}"
-    );
+    tally.assert_mixed(20, 5);
 }
 
 /// A two-joint log in dyngen's schema, and the same with semicolons and a recipe
@@ -399,6 +436,7 @@ fn damaged_csv_logs_give_errors_or_finite_trajectories() {
     let seeds = csv_seeds();
     let tally = fuzz(
         "CSV",
+        (0, 1),
         &seeds,
         |s, rng| damaged::<Lines>(s, rng, "\"", "\""),
         |text| {
@@ -436,8 +474,5 @@ fn damaged_csv_logs_give_errors_or_finite_trajectories() {
             Ok(true)
         },
     );
-    assert!(
-        tally.accepted > cases() / 20 && tally.refused > cases() / 20,
-        "{tally:?}"
-    );
+    tally.assert_mixed(20, 20);
 }

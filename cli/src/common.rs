@@ -1,7 +1,7 @@
 //! What every subcommand shares: loading a URDF, the gravity option, progress bars.
 
 use crate::error::CliError;
-use dyngen_model::Model;
+use dyngen_model::{Model, ModelError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
@@ -10,15 +10,20 @@ use std::time::Duration;
 /// A subcommand's result: the error is printed after `error: ` and sets the exit code.
 pub type Result<T> = std::result::Result<T, CliError>;
 
-/// `--gravity gx gy gz`.
+/// How the URDF is read: `--gravity gx gy gz`, `--strict`.
 #[derive(Clone, Debug, clap::Args)]
-pub struct GravityArg {
+pub struct ModelArgs {
     /// Gravity in the base frame, m/s² (default: the URDF's model default, 0 0 -9.81).
     #[arg(long, num_args = 3, value_names = ["GX", "GY", "GZ"], allow_negative_numbers = true)]
     pub gravity: Option<Vec<f64>>,
+    /// Refuse inertias that break positive definiteness or the triangle inequality by
+    /// less than the tolerance for CAD rounding (1e-3 of the largest principal moment),
+    /// which are otherwise accepted as written with a warning.
+    #[arg(long)]
+    pub strict: bool,
 }
 
-impl GravityArg {
+impl ModelArgs {
     pub fn get(&self) -> Result<Option<[f64; 3]>> {
         match &self.gravity {
             None => Ok(None),
@@ -31,10 +36,19 @@ impl GravityArg {
 }
 
 /// Reads, parses and checks the URDF at `path` (all errors as `file:line: message`),
-/// then sets the gravity when given.
-pub fn load_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
+/// prints its warnings (`strict`: refuses them), then sets the gravity when given.
+pub fn load_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Result<Model> {
     // The model's errors already read `file:line: message`.
-    let mut model = dyngen_model::load_urdf(path).map_err(|e| CliError::Input(e.to_string()))?;
+    let mut model = dyngen_model::load_urdf_with(path, strict).map_err(|e| CliError::Input(e.to_string()))?;
+    for w in &model.warnings {
+        let at = w.line.map(|l| format!(":{l}")).unwrap_or_default();
+        let message = ModelError {
+            line: None,
+            ..w.clone()
+        }
+        .warning_message();
+        eprintln!("warning: {}{at}: {message}", path.display());
+    }
     if let Some(g) = gravity {
         model.gravity = g;
     }
@@ -42,8 +56,8 @@ pub fn load_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
 }
 
 /// Like [`load_model`], and refuses a model without moving joints.
-pub fn load_moving_model(path: &Path, gravity: Option<[f64; 3]>) -> Result<Model> {
-    let model = load_model(path, gravity)?;
+pub fn load_moving_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Result<Model> {
+    let model = load_model(path, gravity, strict)?;
     if model.dof() == 0 {
         return Err(CliError::input(path, "the robot has no moving joints"));
     }

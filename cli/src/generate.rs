@@ -1,7 +1,7 @@
 //! `dyngen generate`: what `build.rs` (`dyngen_codegen::Config::compile_urdf`) does,
 //! to a file or stdout, through the same `Config`.
 
-use crate::common::{check_overwrite, load_model, with_spinner, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_model, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use dyngen_codegen::Config;
 use std::path::PathBuf;
@@ -36,14 +36,14 @@ pub struct GenerateArgs {
     pub max_statements: Option<usize>,
 
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 }
 
 pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
     if let Some(out) = &args.output {
         check_overwrite(out, args.force)?;
     }
-    let model = load_model(&args.urdf, None)?;
+    let model = load_model(&args.urdf, None, args.gravity.strict)?;
     let mut config = Config::new();
     if let Some(g) = args.gravity.get()? {
         config.gravity(g);

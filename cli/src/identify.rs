@@ -2,7 +2,7 @@
 //! principal parameters from joint torques, or the principal parameters of every body
 //! by MIM from joint wrenches.
 
-use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::pipeline::{
@@ -229,7 +229,7 @@ pub struct RecordingArgs {
     pub raw_states: bool,
 
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 
     #[command(flatten)]
     pub recipe: RecipeArgs,
@@ -418,7 +418,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     let options = args.options();
     options.check().map_err(|e| pipeline_error(&args.data, e))?;
     check_outputs(args)?;
-    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?, args.recording.gravity.strict)?;
     let n = model.dof();
     let traj = args.recording.load(&args.data, n)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {

@@ -1,6 +1,6 @@
 //! `dyngen info`: what dyngen sees in a URDF.
 
-use crate::common::{load_model, with_spinner, GravityArg, Progress, Result};
+use crate::common::{load_model, with_spinner, ModelArgs, Progress, Result};
 use dyngen_codegen::{analyse_model, generate, Options};
 use dyngen_model::graph::{incidence, path_matrix};
 use dyngen_model::Model;
@@ -19,7 +19,7 @@ pub struct InfoArgs {
     pub urdf: PathBuf,
 
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 
     /// Skip the operation counts (they need a full code generation, which takes a
     /// few seconds for a 6–7 DOF arm; the base parameters do not).
@@ -28,7 +28,7 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
-    let model = load_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
     let mut out = topology(&model, &args.urdf);
     let n = model.dof();
     writeln!(out).ok();

@@ -2,7 +2,7 @@
 //! along the joint motion of a CSV file (on simulated parameter draws), `predict`
 //! the principal parameters from measured data.
 
-use crate::common::{check_overwrite, load_moving_model, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
@@ -92,7 +92,7 @@ pub struct TrainArgs {
     #[arg(long, value_name = "FILE")]
     pub loss_svg: Option<PathBuf>,
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 }
 
 #[derive(Debug, Args)]
@@ -121,7 +121,7 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FILE")]
     pub recipe: Option<PathBuf>,
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 }
 
 pub fn run(args: &NimArgs, progress: &Progress) -> Result<()> {
@@ -167,12 +167,14 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         }
         check_overwrite(svg, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
     let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
     let motion = SampledMotion::from_data(&traj)
         .ok_or_else(|| CliError::input(&args.motion, "the motion has no velocities or accelerations"))?;
     let robot = Reference::new(&model);
-    let nominal = dyngen_model::principal_params(&model);
+    // Draws around the nominal parameters must be consistent: a CAD-rounded
+    // inertia accepted with a warning is moved to the nearest physical one first.
+    let nominal = dyngen_model::principal_params(&model.nearest_physical());
     let recording = record_trajectory(&robot, &model.standard_params(), &motion, motion.times());
 
     let mut config = NimConfig {
@@ -314,7 +316,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
     if let Some(path) = &args.params_json {
         check_overwrite(path, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
     let nim = Nim::load(&args.nim).map_err(|e| nim_file_error(&args.nim, e, false))?;
     let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     if nim.body_names != body_names {

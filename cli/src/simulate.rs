@@ -1,6 +1,6 @@
 //! `dyngen simulate`: an identification experiment on the nominal parameters, as CSV.
 
-use crate::common::{check_overwrite, load_moving_model, with_spinner, GravityArg, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{
@@ -156,7 +156,7 @@ pub struct SimulateArgs {
     pub evaluations: usize,
 
     #[command(flatten)]
-    pub gravity: GravityArg,
+    pub gravity: ModelArgs,
 }
 
 fn check_args(args: &SimulateArgs) -> Result<()> {
@@ -193,7 +193,7 @@ fn check_args(args: &SimulateArgs) -> Result<()> {
 pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     check_args(args)?;
     check_overwrite(&args.output, args.force)?;
-    let model = load_moving_model(&args.urdf, args.gravity.get()?)?;
+    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
     let robot = Reference::new(&model);
     let params = model.standard_params();
 

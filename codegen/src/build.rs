@@ -59,6 +59,7 @@ pub struct Config {
     out_dir: Option<PathBuf>,
     file_name: Option<String>,
     gravity: Option<[f64; 3]>,
+    strict: bool,
     options: Options,
 }
 
@@ -85,6 +86,15 @@ impl Config {
         self
     }
 
+    /// Refuse inertias that break positive definiteness or the triangle inequality
+    /// within the tolerance for CAD rounding
+    /// ([`INERTIA_TOLERANCE`](dyngen_model::INERTIA_TOLERANCE)); by default they are
+    /// accepted as written and each printed as a `cargo:warning`.
+    pub fn strict(&mut self, strict: bool) -> &mut Config {
+        self.strict = strict;
+        self
+    }
+
     /// Statements per generated function before it is split into parts (default 1200).
     pub fn max_statements(&mut self, n: usize) -> &mut Config {
         self.options.max_statements = n.max(1);
@@ -99,7 +109,10 @@ impl Config {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
         }
-        let model = dyngen_model::load_urdf(&urdf).map_err(Error::Model)?;
+        let model = dyngen_model::load_urdf_with(&urdf, self.strict).map_err(Error::Model)?;
+        for w in &model.warnings {
+            println!("cargo:warning={}: {}", urdf.display(), w.warning_message());
+        }
         let source = urdf
             .file_name()
             .map(|s| s.to_string_lossy().into_owned())

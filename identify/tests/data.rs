@@ -310,6 +310,22 @@ fn error_missing_header() {
 }
 
 #[test]
+fn error_semicolon_or_tab_separated_header() {
+    for (sep, name) in [(";", "`;`"), ("\t", "tab")] {
+        let text = "t,q1,tau1\n0,0,0\n0.01,0,0\n".replace(',', sep);
+        let e = read_err(&text, None);
+        assert!(matches!(e, DataError::Separator { line: 1, fields: 3, .. }), "{e:?}");
+        assert_eq!(e.line(), Some(1));
+        assert_message(
+            &e,
+            &[&format!(
+                "line 1: no `,` separates the fields, but a {name} splits the line into 3"
+            )],
+        );
+    }
+}
+
+#[test]
 fn error_malformed_utf8() {
     let e = from_reader(&b"t,q1,tau1\n0,0,0\n1,\xff,1\n"[..], None).unwrap_err();
     assert!(matches!(e, DataError::Malformed { line: Some(3), .. }), "{e:?}");

@@ -68,6 +68,60 @@ fn finite_mat(m: &[[f64; 3]; 3]) -> bool {
     m.iter().all(finite3)
 }
 
+/// Relative tolerance for CAD rounding: principal moments `J1 ≤ J2 ≤ J3` (about the
+/// centre of mass) that break positive definiteness (`J1 ≤ 0`) or the triangle
+/// inequality (`J3 > J1 + J2`) by at most this fraction of the largest moment
+/// ([`inertia_violation`]) are accepted with a warning, as written; a strict build
+/// refuses them. CAD tools export inertias with a few significant digits, and
+/// thin parts sit on the triangle boundary, so their files break it by parts in ten
+/// thousand: 1e-3 accepts that rounding (Pinocchio loads such files without a word)
+/// while any real mistake (a moment off by a factor, a swapped entry) stays an
+/// error. Where consistency is needed, use [`Inertial::nearest_physical`].
+pub const INERTIA_TOLERANCE: f64 = 1e-3;
+
+/// How far principal moments `ev` (ascending) are from a physical inertia, as a
+/// fraction of the largest magnitude: the larger of `−J1` and `J3 − J1 − J2`, over
+/// `max |J|`; 0 when both hold (a zero tensor counts as physical).
+pub fn inertia_violation(ev: [f64; 3]) -> f64 {
+    let scale = ev.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return if scale == 0.0 { 0.0 } else { f64::INFINITY };
+    }
+    let worst = (-ev[0]).max(ev[2] - ev[0] - ev[1]);
+    if worst > 0.0 {
+        worst / scale
+    } else {
+        0.0
+    }
+}
+
+/// The physically consistent moments nearest to `ev` (ascending): negative or zero
+/// moments raised to `1e-9 · max |J|`, then, if `J3 > J1 + J2`, the moments projected
+/// onto `J3 = J1 + J2` (each moved by `(J3 − J1 − J2) / 3`, the least change in the
+/// Euclidean norm; order is kept).
+pub fn nearest_physical_moments(ev: [f64; 3]) -> [f64; 3] {
+    let scale = ev.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let floor = 1e-9 * scale;
+    let mut j = ev.map(|x| x.max(floor));
+    let excess = j[2] - j[0] - j[1];
+    if excess > 0.0 {
+        let d = excess / 3.0;
+        j = [j[0] + d, j[1] + d, j[2] - d];
+    }
+    j
+}
+
+/// Whether a failed inertia check is within [`INERTIA_TOLERANCE`]: only a not
+/// positive definite or triangle-breaking inertia can be, never a bad mass.
+fn within_tolerance(kind: &ErrorKind) -> bool {
+    match kind {
+        ErrorKind::NotPositiveDefinite(ev) | ErrorKind::TriangleInequality(ev) => {
+            inertia_violation(*ev) <= INERTIA_TOLERANCE
+        }
+        _ => false,
+    }
+}
+
 /// Checks one body's inertial: finite, mass > 0, inertia about the centre of mass
 /// positive definite and satisfying the triangle inequalities.
 pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
@@ -100,17 +154,25 @@ pub fn check_physical(inertial: &Inertial) -> Result<(), ErrorKind> {
     check_triangle(ev)
 }
 
+/// Largest magnitude of any number of a description in SI units (a length in m, a
+/// mass in kg, an inertia in kg·m², gravity, friction): far beyond any machine, and
+/// small enough that the products the dynamics form stay finite. A larger value is
+/// a unit mistake or a damaged file.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
+/// Finite and within [`MAX_MAGNITUDE`], or the error naming `what`.
+fn check_value(what: &'static str, values: &[f64]) -> Result<(), ErrorKind> {
+    match values.iter().find(|x| x.is_nan() || x.abs() > MAX_MAGNITUDE) {
+        Some(x) if x.is_finite() => Err(ErrorKind::OutOfRange { what, value: *x }),
+        Some(_) => Err(ErrorKind::NonFiniteValue(what)),
+        None => Ok(()),
+    }
+}
+
 fn check_finite(inertial: &Inertial) -> Result<(), ErrorKind> {
-    if !inertial.mass.is_finite() {
-        return Err(ErrorKind::NonFiniteValue("mass"));
-    }
-    if !finite3(&inertial.com) {
-        return Err(ErrorKind::NonFiniteValue("centre of mass"));
-    }
-    if !finite_mat(&inertial.inertia) {
-        return Err(ErrorKind::NonFiniteValue("inertia"));
-    }
-    Ok(())
+    check_value("mass", &[inertial.mass])?;
+    check_value("centre of mass", &inertial.com)?;
+    check_value("inertia", inertial.inertia.as_flattened())
 }
 
 /// Principal moments `ev` (ascending) of a real body: the largest is at most the sum
@@ -139,8 +201,19 @@ impl Description {
 
     /// [`Description::build`] with siblings numbered in the given order.
     pub fn build_with(&self, order: SiblingOrder) -> Result<Model, Vec<ModelError>> {
+        self.build_checked(order, false)
+    }
+
+    /// [`Description::build_with`]; `strict` refuses inertias that break physical
+    /// consistency within [`INERTIA_TOLERANCE`] instead of accepting them with a
+    /// warning in [`Model::warnings`].
+    pub fn build_checked(&self, order: SiblingOrder, strict: bool) -> Result<Model, Vec<ModelError>> {
         let mut errors = Vec::new();
         let err = |element: Element, line: Option<usize>, kind: ErrorKind| ModelError { element, line, kind };
+
+        if let Err(kind) = check_value("gravity", &self.gravity) {
+            errors.push(err(Element::Robot, None, kind));
+        }
 
         // Names.
         let mut link_index: HashMap<&str, usize> = HashMap::new();
@@ -170,19 +243,21 @@ impl Description {
             if let DeclaredJointType::Unsupported(t) = &j.kind {
                 errors.push(err(el(), j.line, ErrorKind::UnsupportedJointType(t.clone())));
             }
-            if !finite3(&j.origin.translation) || !finite_mat(&j.origin.rotation) {
+            if !finite_mat(&j.origin.rotation) {
                 errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("origin")));
+            } else if let Err(kind) = check_value("origin", &j.origin.translation) {
+                errors.push(err(el(), j.line, kind));
             }
             if let DeclaredJointType::Moving(_) = j.kind {
-                if !finite3(&j.axis) {
-                    errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("axis")));
+                if let Err(kind) = check_value("axis", &j.axis) {
+                    errors.push(err(el(), j.line, kind));
                 } else if math::norm(&j.axis) < 1e-12 {
                     errors.push(err(el(), j.line, ErrorKind::ZeroAxis));
                 }
             }
             let d = j.dynamics;
-            if !(d.damping.is_finite() && d.friction.is_finite()) {
-                errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("<dynamics>")));
+            if let Err(kind) = check_value("<dynamics>", &[d.damping, d.friction]) {
+                errors.push(err(el(), j.line, kind));
             } else if d.damping < 0.0 || d.friction < 0.0 {
                 errors.push(err(
                     el(),
@@ -220,7 +295,18 @@ impl Description {
             }
         }
         let roots: Vec<usize> = (0..self.links.len()).filter(|&c| parent_joint[c].is_empty()).collect();
-        if roots.len() > 1 {
+        // A joint naming a link that does not exist, or two links of one name, leave
+        // links without their parent joint: the roots and loops that follow from that
+        // are not the user's mistake, the name is.
+        let names_wrong = errors.iter().any(|e| {
+            matches!(
+                e.kind,
+                ErrorKind::UnknownChildLink(_) | ErrorKind::UnknownParentLink(_) | ErrorKind::DuplicateLink
+            )
+        });
+        if names_wrong {
+            // Reported above.
+        } else if roots.len() > 1 {
             let names = roots.iter().map(|&r| self.links[r].name.clone()).collect();
             errors.push(err(Element::Robot, None, ErrorKind::SeveralRoots(names)));
         } else if roots.is_empty() && !self.links.is_empty() {
@@ -264,7 +350,9 @@ impl Description {
             base: self.links[root].name.clone(),
             joints: Vec::new(),
             bodies: Vec::new(),
+            warnings: Vec::new(),
         };
+        let mut warnings = Vec::new();
         let mut body_inertial: Vec<Option<Inertial>> = Vec::new();
         let mut visited = vec![false; self.joints.len()];
         // (joint, body owning its parent link, placement of that link in the body frame)
@@ -312,7 +400,12 @@ impl Description {
                     if !is_massless_marker(inertial) {
                         if let Err(kind) = check_physical(inertial) {
                             let l = &self.links[link];
-                            errors.push(err(Element::Link(l.name.clone()), l.line, kind));
+                            let e = err(Element::Link(l.name.clone()), l.line, kind);
+                            if !strict && within_tolerance(&e.kind) {
+                                warnings.push(e);
+                            } else {
+                                errors.push(e);
+                            }
                         }
                     }
                 }
@@ -340,11 +433,17 @@ impl Description {
                         // Per-link value errors were reported above; report the
                         // combined body only when each part was fine on its own.
                         let reported = |n: &String| *n == body.name || body.merged.contains(n);
-                        if !errors
-                            .iter()
-                            .any(|e| matches!(&e.element, Element::Link(n) if reported(n)))
-                        {
-                            errors.push(err(Element::Link(body.name.clone()), line, kind));
+                        let reported_in = |list: &[ModelError]| {
+                            list.iter()
+                                .any(|e| matches!(&e.element, Element::Link(n) if reported(n)))
+                        };
+                        let e = err(Element::Link(body.name.clone()), line, kind);
+                        if !reported_in(&errors) {
+                            if strict || !within_tolerance(&e.kind) {
+                                errors.push(e);
+                            } else if !reported_in(&warnings) {
+                                warnings.push(e);
+                            }
                         }
                     }
                     body.inertial = *i;
@@ -355,6 +454,7 @@ impl Description {
         if !errors.is_empty() {
             return Err(errors);
         }
+        model.warnings = warnings;
         Ok(model)
     }
 

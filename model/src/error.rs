@@ -39,6 +39,27 @@ pub enum ErrorKind {
     Parse(String),
     /// The file still contains xacro macros.
     Xacro,
+    /// The file is larger than [`MAX_FILE_BYTES`](crate::urdf::MAX_FILE_BYTES).
+    TooLarge {
+        bytes: u64,
+    },
+    /// Elements nested deeper than [`MAX_DEPTH`](crate::xml::MAX_DEPTH); `tag` is the
+    /// first element past the limit.
+    TooDeep {
+        tag: String,
+    },
+    /// A numeric attribute that is not a number, or not the count of numbers its
+    /// element needs: `<origin rpy="0 1.57">`, `<mass value="heavy">`.
+    BadNumber {
+        /// Element and attribute, as `origin rpy`.
+        attribute: String,
+        value: String,
+        /// How many numbers the attribute holds (1 or 3).
+        expected: usize,
+    },
+    /// A `<mimic>` joint: it follows another joint (named here), which a tree of
+    /// independent joints cannot express.
+    MimicJoint(String),
     UnknownParentLink(String),
     UnknownChildLink(String),
     DuplicateLink,
@@ -54,6 +75,11 @@ pub enum ErrorKind {
     UnsupportedJointType(String),
     ZeroAxis,
     NonFiniteValue(&'static str),
+    /// A finite value beyond [`MAX_MAGNITUDE`](crate::desc::MAX_MAGNITUDE).
+    OutOfRange {
+        what: &'static str,
+        value: f64,
+    },
     MissingInertial,
     NonPositiveMass(f64),
     NotPositiveDefinite([f64; 3]),
@@ -89,6 +115,35 @@ impl fmt::Display for ErrorKind {
                 f,
                 "the file contains xacro macros; expand it first (`xacro robot.urdf.xacro > robot.urdf`)"
             ),
+            ErrorKind::TooLarge { bytes } => write!(
+                f,
+                "the file has {bytes} bytes, more than the {} MiB a robot description may have",
+                crate::urdf::MAX_FILE_BYTES >> 20
+            ),
+            ErrorKind::TooDeep { tag } => write!(
+                f,
+                "<{tag}> is nested more than {} elements deep; a URDF needs fewer than 10 levels",
+                crate::xml::MAX_DEPTH
+            ),
+            ErrorKind::BadNumber {
+                attribute,
+                value,
+                expected,
+            } => {
+                let (element, name) = attribute.split_once(' ').unwrap_or((attribute.as_str(), ""));
+                match expected {
+                    1 => write!(f, "<{element} {name}=\"{value}\"> is not a number; write one number such as `0.5`"),
+                    n => write!(
+                        f,
+                        "<{element} {name}=\"{value}\"> is not {n} numbers; write {n} numbers separated by spaces, such as `0 0 0.5`"
+                    ),
+                }
+            }
+            ErrorKind::MimicJoint(leader) => write!(
+                f,
+                "mimics joint `{leader}` (<mimic>), which is not supported: the dynamics would treat it as an \
+                 independent joint; remove the <mimic> element to model it as one, or lock it with type=\"fixed\""
+            ),
             ErrorKind::UnknownParentLink(p) => {
                 write!(f, "parent link `{p}` does not exist; a joint's parent must name a <link> of this robot")
             }
@@ -115,6 +170,11 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
             ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),
+            ErrorKind::OutOfRange { what, value } => write!(
+                f,
+                "{what} holds {value:e}, beyond ±{:e} in SI units (m, kg, kg·m²); check the unit",
+                crate::desc::MAX_MAGNITUDE
+            ),
             ErrorKind::MissingInertial => write!(
                 f,
                 "this moving body has no <inertial> (nor any fixed-attached link with one); give it a mass and inertia"
@@ -140,6 +200,18 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
         }
+    }
+}
+
+impl ModelError {
+    /// The message of a problem accepted with a warning ([`Model::warnings`](crate::Model)):
+    /// what is wrong, and why it was let through.
+    pub fn warning_message(&self) -> String {
+        format!(
+            "{self}; accepted as written: within the relative tolerance of {:e} for CAD rounding (the nearest \
+             physical inertia is used where consistency is needed; a strict build refuses it)",
+            crate::desc::INERTIA_TOLERANCE
+        )
     }
 }
 

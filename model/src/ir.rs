@@ -172,6 +172,25 @@ impl Inertial {
     pub fn principal_axes(&self) -> (Vec3, Mat3) {
         math::symmetric_eigen(&self.inertia)
     }
+
+    /// The nearest physically consistent inertial: same mass, centre of mass and
+    /// principal axes, principal moments moved by
+    /// [`nearest_physical_moments`](crate::desc::nearest_physical_moments). Itself
+    /// (to rounding) when already consistent.
+    pub fn nearest_physical(&self) -> Inertial {
+        let (ev, axes) = self.principal_axes();
+        if crate::desc::inertia_violation(ev) == 0.0 {
+            return *self;
+        }
+        let j = crate::desc::nearest_physical_moments(ev);
+        let mut inertia = [[0.0; 3]; 3];
+        for (r, row) in inertia.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = (0..3).map(|k| axes[r][k] * j[k] * axes[c][k]).sum();
+            }
+        }
+        Inertial { inertia, ..*self }
+    }
 }
 
 /// What a joint does besides moving its body, as the description gives it (URDF
@@ -220,9 +239,26 @@ pub struct Model {
     pub base: String,
     pub joints: Vec<Joint>,
     pub bodies: Vec<Body>,
+    /// What the front end accepted but the user should know: inertias that break
+    /// physical consistency within [`INERTIA_TOLERANCE`](crate::desc::INERTIA_TOLERANCE)
+    /// (CAD rounding), kept as written. Empty for a strict build.
+    pub warnings: Vec<crate::ModelError>,
 }
 
 impl Model {
+    /// The model with every body's inertial replaced by its
+    /// [`Inertial::nearest_physical`]: for what needs physical consistency (draws of
+    /// consistent parameters around the nominal ones) when the description was
+    /// accepted with [`Model::warnings`] about CAD rounding. Identical otherwise.
+    pub fn nearest_physical(&self) -> Model {
+        let mut model = self.clone();
+        for body in &mut model.bodies {
+            body.inertial = body.inertial.nearest_physical();
+        }
+        model.warnings.clear();
+        model
+    }
+
     /// Number of moving bodies, joints and degrees of freedom (all equal).
     pub fn dof(&self) -> usize {
         self.joints.len()

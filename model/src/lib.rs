@@ -37,10 +37,11 @@ pub mod xml;
 
 pub use base::{BaseParams, Parameterisation};
 pub use desc::{
-    check_inertial, check_physical, DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY,
+    check_inertial, check_physical, inertia_violation, nearest_physical_moments, DeclaredJointType, Description,
+    JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY, INERTIA_TOLERANCE,
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
-pub use urdf::{load_urdf, parse_urdf};
+pub use urdf::{load_urdf, load_urdf_with, parse_urdf, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

@@ -8,12 +8,15 @@ pub type Mat3 = [[f64; 3]; 3];
 
 pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
-/// `sin` and `cos` of an angle, exact (0, ±1) when the angle is a multiple of π/2
-/// to within 1e-12 rad, so that axis-aligned placements fold to exact constants.
+/// `sin` and `cos` of an angle, exact (0, ±1) when the angle is the `f64` nearest
+/// to a quarter turn `kπ/2` (|k| ≤ 4: `FRAC_PI_2`, `PI`, …), so that axis-aligned
+/// placements fold to exact constants. Any other value is taken as written: a
+/// URDF's `3.14159265359` is not π, and snapping it would move the robot by 2e-13
+/// rad away from what every other tool computes.
 pub fn sin_cos_exact(angle: f64) -> (f64, f64) {
-    let quarter = angle / std::f64::consts::FRAC_PI_2;
-    let k = quarter.round();
-    if (angle - k * std::f64::consts::FRAC_PI_2).abs() < 1e-12 {
+    let k = (angle / std::f64::consts::FRAC_PI_2).round();
+    // `k · FRAC_PI_2` is the f64 nearest to kπ/2 for |k| ≤ 4 (checked in the tests).
+    if k.abs() <= 4.0 && angle == k * std::f64::consts::FRAC_PI_2 {
         match (k as i64).rem_euclid(4) {
             0 => (0.0, 1.0),
             1 => (1.0, 0.0),
@@ -263,6 +266,34 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    // Values near π and π/2 that are not the constants are the point.
+    #[allow(clippy::approx_constant)]
+    fn only_exact_quarter_turns_are_snapped() {
+        use std::f64::consts::{FRAC_PI_2, PI, TAU};
+        // The f64 nearest to 3π/2 (from 50 digits of π): what `3.0 * FRAC_PI_2` gives.
+        assert_eq!(3.0 * FRAC_PI_2, 4.71238898038469);
+        assert_eq!(4.0 * FRAC_PI_2, TAU);
+        for (angle, exact) in [
+            (FRAC_PI_2, (1.0, 0.0)),
+            (PI, (0.0, -1.0)),
+            (-PI, (0.0, -1.0)),
+            (-FRAC_PI_2, (-1.0, 0.0)),
+            (4.71238898038469, (-1.0, 0.0)),
+            (TAU, (0.0, 1.0)),
+        ] {
+            assert_eq!(sin_cos_exact(angle), exact, "{angle}");
+        }
+        // Written with 12 decimals: 2.07e-13 rad from π, kept as written.
+        let (s, c) = sin_cos_exact(3.14159265359);
+        assert_eq!((s, c), 3.14159265359f64.sin_cos());
+        assert!(s < -2.0e-13 && s > -2.1e-13, "{s}");
+        // One ulp away from FRAC_PI_2 is not a quarter turn either.
+        let next = f64::from_bits(FRAC_PI_2.to_bits() + 1);
+        assert_eq!(sin_cos_exact(next), next.sin_cos());
+        assert_eq!(sin_cos_exact(1.5707963267949), 1.5707963267949f64.sin_cos());
     }
 
     #[test]

@@ -8,45 +8,81 @@ use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
 use crate::xml::{scan, SyntaxError, Tag};
+use std::io::Read as _;
 use std::path::Path;
 
+/// Largest URDF accepted, in bytes. The biggest public descriptions (humanoids with
+/// inline meshes stripped) are a few MiB; anything far larger is not a robot
+/// description, and reading it would only exhaust memory.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
 /// Parses and checks URDF text; errors carry line numbers but no file name.
+/// Inertias within [`INERTIA_TOLERANCE`](crate::desc::INERTIA_TOLERANCE) of
+/// physical are accepted as written, each with a warning in [`Model::warnings`].
 pub fn parse_urdf(text: &str) -> Result<Model, ModelErrors> {
-    build(text).map_err(|errors| ModelErrors { file: None, errors })
+    parse_urdf_with(text, false)
+}
+
+/// [`parse_urdf`]; `strict` refuses what it would accept with a warning.
+pub fn parse_urdf_with(text: &str, strict: bool) -> Result<Model, ModelErrors> {
+    build(text, strict).map_err(|errors| ModelErrors { file: None, errors })
 }
 
 /// Reads, parses and checks a URDF file; errors are prefixed with its path.
+/// Warnings as for [`parse_urdf`].
 pub fn load_urdf(path: &Path) -> Result<Model, ModelErrors> {
+    load_urdf_with(path, false)
+}
+
+/// [`load_urdf`]; `strict` refuses what it would accept with a warning.
+pub fn load_urdf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
     let file = Some(path.display().to_string());
-    let text = std::fs::read_to_string(path).map_err(|e| ModelErrors {
+    let fail = |kind: ErrorKind| ModelErrors {
         file: file.clone(),
-        errors: vec![robot_error(None, ErrorKind::Io(e.to_string()))],
-    })?;
-    build(&text).map_err(|errors| ModelErrors { file, errors })
+        errors: vec![robot_error(None, kind)],
+    };
+    let io = |e: std::io::Error| fail(ErrorKind::Io(e.to_string()));
+    let mut text = String::new();
+    // Never more than the limit in memory, whatever the metadata says.
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_string(&mut text))
+        .map_err(io)?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        let bytes = std::fs::metadata(path).map_or(text.len() as u64, |m| m.len());
+        return Err(fail(ErrorKind::TooLarge { bytes }));
+    }
+    build(&text, strict).map_err(|errors| ModelErrors { file, errors })
 }
 
 /// The unchecked description of URDF text, before [`Description::build`]: for
 /// callers that want to adjust it (gravity, say) before checking.
 pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
-    read(text)
-        .map(|(desc, _)| desc)
-        .map_err(|errors| ModelErrors { file: None, errors })
+    let fail = |errors| ModelErrors { file: None, errors };
+    let (desc, _, unsupported) = read(text).map_err(fail)?;
+    if !unsupported.is_empty() {
+        return Err(fail(unsupported));
+    }
+    Ok(desc)
 }
 
-fn build(text: &str) -> Result<Model, Vec<ModelError>> {
-    let (desc, robot_line) = read(text)?;
+fn build(text: &str, strict: bool) -> Result<Model, Vec<ModelError>> {
+    let (desc, robot_line, unsupported) = read(text)?;
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
-    desc.build_with(SiblingOrder::Name).map_err(|mut errors| {
-        // Robot-wide errors (several roots, nothing moves) point at `<robot>`.
-        for e in &mut errors {
-            if e.element == Element::Robot && e.line.is_none() {
-                e.line = robot_line;
-            }
+    let mut errors = match desc.build_checked(SiblingOrder::Name, strict) {
+        Ok(model) if unsupported.is_empty() => return Ok(model),
+        Ok(_) => Vec::new(),
+        Err(errors) => errors,
+    };
+    // Robot-wide errors (several roots, nothing moves) point at `<robot>`.
+    for e in &mut errors {
+        if e.element == Element::Robot && e.line.is_none() {
+            e.line = robot_line;
         }
-        // In file order, as a compiler lists them; the sort is stable for ties.
-        errors.sort_by_key(|e| e.line.unwrap_or(usize::MAX));
-        errors
-    })
+    }
+    errors.extend(unsupported);
+    // In file order, as a compiler lists them; the sort is stable for ties.
+    errors.sort_by_key(|e| e.line.unwrap_or(usize::MAX));
+    Err(errors)
 }
 
 fn robot_error(line: Option<usize>, kind: ErrorKind) -> ModelError {
@@ -57,13 +93,43 @@ fn robot_error(line: Option<usize>, kind: ErrorKind) -> ModelError {
     }
 }
 
+/// What [`read`] gives: the description, the line of `<robot>`, and what the file
+/// asks for that the description cannot hold (mimic joints), reported with the
+/// checks of the description.
+type ReadOutcome = (Description, Option<usize>, Vec<ModelError>);
+
 /// Reads URDF text into a description and the line of its `<robot>` element.
-fn read(text: &str) -> Result<(Description, Option<usize>), Vec<ModelError>> {
+fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(vec![robot_error(
+            None,
+            ErrorKind::TooLarge {
+                bytes: text.len() as u64,
+            },
+        )]);
+    }
     let outline = scan(text);
-    if let Ok(tags) = &outline {
-        if let Some(line) = xacro_line(tags) {
-            return Err(vec![robot_error(Some(line), ErrorKind::Xacro)]);
+    let mut unsupported = Vec::new();
+    match &outline {
+        Ok(tags) => {
+            if let Some(line) = xacro_line(tags) {
+                return Err(vec![robot_error(Some(line), ErrorKind::Xacro)]);
+            }
+            // urdf-rs stops at the first unreadable number without a position.
+            let numbers = number_errors(tags);
+            if !numbers.is_empty() {
+                return Err(numbers);
+            }
+            unsupported = mimic_errors(tags);
         }
+        // Past the depth limit the text must not reach urdf-rs, whose recursive
+        // descent would overflow the stack.
+        Err(SyntaxError {
+            line,
+            too_deep: Some(tag),
+            ..
+        }) => return Err(vec![robot_error(Some(*line), ErrorKind::TooDeep { tag: tag.clone() })]),
+        Err(_) => {}
     }
     let dynamics_only = match &outline {
         Ok(tags) => without_geometry(text, tags),
@@ -141,7 +207,90 @@ fn read(text: &str) -> Result<(Description, Option<usize>), Vec<ModelError>> {
         links,
         joints,
     };
-    Ok((desc, outline.robot_line))
+    Ok((desc, outline.robot_line, unsupported))
+}
+
+/// The numeric attributes of the elements dyngen reads, with how many numbers each
+/// holds. Geometry (`<visual>`, `<collision>`) is not read, so not checked.
+fn numeric_attributes(owner: &str, element: &str) -> &'static [(&'static str, usize)] {
+    match (owner, element) {
+        (_, "origin") => &[("xyz", 3), ("rpy", 3)],
+        ("link", "mass") => &[("value", 1)],
+        ("link", "inertia") => &[("ixx", 1), ("ixy", 1), ("ixz", 1), ("iyy", 1), ("iyz", 1), ("izz", 1)],
+        ("joint", "axis") => &[("xyz", 3)],
+        ("joint", "limit") => &[("lower", 1), ("upper", 1), ("effort", 1), ("velocity", 1)],
+        ("joint", "dynamics") => &[("damping", 1), ("friction", 1)],
+        ("joint", "calibration") => &[("rising", 1), ("falling", 1)],
+        ("joint", "safety_controller") => &[
+            ("soft_lower_limit", 1),
+            ("soft_upper_limit", 1),
+            ("k_position", 1),
+            ("k_velocity", 1),
+        ],
+        _ => &[],
+    }
+}
+
+/// The `<link>` or `<joint>` directly under `<robot>` that a numeric element belongs
+/// to: its parent for a joint's elements, its grandparent through `<inertial>` for a
+/// link's.
+fn owner_of<'t>(tags: &'t [Tag], tag: &Tag) -> Option<&'t Tag> {
+    let is_top = |t: &Tag| t.parent.is_some_and(|p| tags[p].parent.is_none());
+    let parent = &tags[tag.parent?];
+    if parent.name == "joint" && is_top(parent) {
+        return Some(parent);
+    }
+    let owner = &tags[parent.parent?];
+    (parent.name == "inertial" && owner.name == "link" && is_top(owner)).then_some(owner)
+}
+
+fn element_of(owner: &Tag) -> Element {
+    let name = owner.attr("name").unwrap_or_default().to_string();
+    match owner.name.as_str() {
+        "link" => Element::Link(name),
+        _ => Element::Joint(name),
+    }
+}
+
+/// Every numeric attribute that does not hold the numbers its element needs, with
+/// its line and the link or joint it belongs to. Numbers as Rust and urdfdom read
+/// them (`nan` and `inf` are numbers here; the model's checks refuse them).
+fn number_errors(tags: &[Tag]) -> Vec<ModelError> {
+    let mut errors = Vec::new();
+    for tag in tags {
+        let Some(owner) = owner_of(tags, tag) else { continue };
+        for &(attribute, expected) in numeric_attributes(&owner.name, &tag.name) {
+            let Some(value) = tag.attr(attribute) else { continue };
+            let words: Vec<&str> = value.split_whitespace().collect();
+            if words.len() != expected || words.iter().any(|w| w.parse::<f64>().is_err()) {
+                errors.push(ModelError {
+                    element: element_of(owner),
+                    line: Some(tag.line),
+                    kind: ErrorKind::BadNumber {
+                        attribute: format!("{} {attribute}", tag.name),
+                        value: value.to_string(),
+                        expected,
+                    },
+                });
+            }
+        }
+    }
+    errors
+}
+
+/// A `<mimic>` in a joint: reported rather than read as an independent joint.
+fn mimic_errors(tags: &[Tag]) -> Vec<ModelError> {
+    tags.iter()
+        .filter(|t| t.name == "mimic")
+        .filter_map(|t| {
+            let owner = owner_of(tags, t).filter(|o| o.name == "joint")?;
+            Some(ModelError {
+                element: element_of(owner),
+                line: Some(t.line),
+                kind: ErrorKind::MimicJoint(t.attr("joint").unwrap_or_default().to_string()),
+            })
+        })
+        .collect()
 }
 
 /// Turns a failure of urdf-rs into errors. urdf-rs stops at the first problem and

@@ -31,9 +31,18 @@ impl Tag {
 pub struct SyntaxError {
     pub line: usize,
     pub message: String,
+    /// The element that went past [`MAX_DEPTH`], if that is the error: then no
+    /// other parser may be given the text.
+    pub too_deep: Option<String>,
 }
 
-/// Scans `text` into its start tags, checking only that tags are closed and nested.
+/// Deepest element nesting [`scan`] accepts. A URDF nests five or six levels
+/// (`robot/link/visual/geometry/mesh`); the limit keeps the recursive parsers that
+/// read the text after the scan far from the end of their stack.
+pub const MAX_DEPTH: usize = 256;
+
+/// Scans `text` into its start tags, checking only that tags are closed and nested
+/// (at most [`MAX_DEPTH`] deep).
 pub fn scan(text: &str) -> Result<Vec<Tag>, SyntaxError> {
     let mut tags: Vec<Tag> = Vec::new();
     // Open elements: (name, tag index).
@@ -44,7 +53,11 @@ pub fn scan(text: &str) -> Result<Vec<Tag>, SyntaxError> {
         pos += offset;
         let line = lines.line_at(pos);
         let rest = &text[pos..];
-        let fail = |message: String| SyntaxError { line, message };
+        let fail = |message: String| SyntaxError {
+            line,
+            message,
+            too_deep: None,
+        };
         let skip_to = |end: &str, what: &str| {
             rest.find(end)
                 .map(|k| pos + k + end.len())
@@ -93,6 +106,15 @@ pub fn scan(text: &str) -> Result<Vec<Tag>, SyntaxError> {
                 parent,
             });
             if !self_closing {
+                if open.len() >= MAX_DEPTH {
+                    return Err(SyntaxError {
+                        line,
+                        message: format!(
+                            "<{name}> is nested more than {MAX_DEPTH} elements deep; a URDF needs fewer than 10 levels"
+                        ),
+                        too_deep: Some(name),
+                    });
+                }
                 open.push((name, k));
             }
             pos += len;
@@ -102,10 +124,12 @@ pub fn scan(text: &str) -> Result<Vec<Tag>, SyntaxError> {
         Some((name, k)) => Err(SyntaxError {
             line: tags_line(&tags, k),
             message: format!("<{name}> is never closed"),
+            too_deep: None,
         }),
         None if tags.is_empty() => Err(SyntaxError {
             line: 1,
             message: "no XML element found".into(),
+            too_deep: None,
         }),
         None => Ok(tags),
     }
@@ -235,6 +259,21 @@ mod tests {
         assert_eq!((e.line, e.message.as_str()), (2, "comment is never closed"));
         let e = scan("<robot>\n<link name='a\n/></robot>").unwrap_err();
         assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn scan_refuses_deep_nesting_without_recursion() {
+        let ok = format!("{}{}", "<a>".repeat(MAX_DEPTH), "</a>".repeat(MAX_DEPTH));
+        assert!(scan(&ok).is_ok());
+        let deep = format!("<robot>\n{}{}", "<a>".repeat(20_000), "</a>".repeat(20_000));
+        let e = scan(&deep).unwrap_err();
+        assert_eq!(e.too_deep.as_deref(), Some("a"));
+        assert_eq!(e.line, 2);
+        assert!(
+            e.message.contains("nested more than 256 elements deep"),
+            "{}",
+            e.message
+        );
     }
 
     #[test]

@@ -86,17 +86,23 @@ fn unknown_child_link() {
         &link("a"),
         &joint("j", "continuous", "base", "nope", ""),
     ]);
-    let errs = errors(&text);
-    // `a` then has no parent joint, so it is a second root (reported first, on line 1).
-    assert_eq!(errs.len(), 2, "{errs:#?}");
-    assert_eq!(errs[0].kind, ErrorKind::SeveralRoots(vec!["base".into(), "a".into()]));
-    assert_named(&errs[1], &Element::Joint("j".into()), 4);
-    assert_eq!(errs[1].kind, ErrorKind::UnknownChildLink("nope".into()));
-    assert!(
-        errs[1].to_string().contains("child link `nope` does not exist"),
-        "{}",
-        errs[1]
-    );
+    // `a` then has no parent joint; the name is the mistake, not a second root.
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnknownChildLink("nope".into()));
+    assert!(e.to_string().contains("child link `nope` does not exist"), "{e}");
+}
+
+#[test]
+fn unknown_parent_link_in_a_chain_is_not_a_missing_root() {
+    // Every link has a parent joint, one of them from a misspelt link.
+    let text = robot(&[
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "bsae", "a", ""),
+        &joint("jb", "continuous", "a", "b", ""),
+    ]);
+    let e = single(&text, Element::Joint("ja".into()), 4);
+    assert_eq!(e.kind, ErrorKind::UnknownParentLink("bsae".into()));
 }
 
 #[test]
@@ -193,6 +199,19 @@ fn duplicate_names() {
     };
     assert_named(find(ErrorKind::DuplicateLink), &Element::Link("a".into()), 4);
     assert_named(find(ErrorKind::DuplicateJoint), &Element::Joint("j".into()), 6);
+}
+
+#[test]
+fn duplicate_link_is_not_reported_as_a_second_root() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let e = single(&text, Element::Link("a".into()), 4);
+    assert_eq!(e.kind, ErrorKind::DuplicateLink);
+    assert!(e.to_string().contains("defined more than once"), "{e}");
 }
 
 #[test]
@@ -332,20 +351,201 @@ fn non_finite_mass() {
 }
 
 #[test]
-fn unreadable_number_is_a_parse_error() {
-    let errs = errors(&one_body(&link_with("a", "heavy", ["1", "1", "1"])));
-    assert_eq!(errs.len(), 1);
-    assert!(
-        matches!(&errs[0].kind, ErrorKind::Parse(m) if m.contains("invalid float")),
-        "{errs:?}"
+fn unreadable_number_names_the_element_and_line() {
+    let e = single(
+        &one_body(&link_with("a", "heavy", ["1", "1", "1"])),
+        Element::Link("a".into()),
+        3,
     );
-    assert!(errs[0].to_string().starts_with("robot: not valid URDF"), "{}", errs[0]);
+    assert_eq!(
+        e.kind,
+        ErrorKind::BadNumber {
+            attribute: "mass value".into(),
+            value: "heavy".into(),
+            expected: 1
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "line 3: link `a`: <mass value=\"heavy\"> is not a number; write one number such as `0.5`"
+    );
+}
+
+#[test]
+fn wrong_count_or_unreadable_vectors_name_the_element_and_line() {
+    let cases = [
+        (r#"<origin xyz="0 0 1" rpy="0 1.57"/>"#, "origin rpy", "0 1.57", 3),
+        (r#"<origin xyz="0 0 1 0"/>"#, "origin xyz", "0 0 1 0", 3),
+        (r#"<origin xyz="0, 0, 1"/>"#, "origin xyz", "0, 0, 1", 3),
+        (r#"<axis xyz="z"/>"#, "axis xyz", "z", 3),
+        (
+            r#"<limit lower="-1" upper="one" effort="1" velocity="1"/>"#,
+            "limit upper",
+            "one",
+            1,
+        ),
+        (r#"<dynamics damping="0.1 0.2"/>"#, "dynamics damping", "0.1 0.2", 1),
+    ];
+    for (extra, attribute, value, expected) in cases {
+        let text = robot(&[
+            r#"<link name="base"/>"#,
+            &link("a"),
+            &joint("j", "revolute", "base", "a", extra),
+        ]);
+        let e = single(&text, Element::Joint("j".into()), 4);
+        assert_eq!(
+            e.kind,
+            ErrorKind::BadNumber {
+                attribute: attribute.into(),
+                value: value.into(),
+                expected
+            },
+            "{extra}"
+        );
+        assert!(e.to_string().contains(&format!("=\"{value}\"> is not")), "{e}");
+    }
+    // Inertia values and the inertial origin, all reported at once.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        r#"<link name="a"><inertial><origin rpy="0 0"/><mass value="1"/>"#,
+        r#"<inertia ixx="1e-3" iyy="x" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_named(&errs[0], &Element::Link("a".into()), 3);
+    assert_named(&errs[1], &Element::Link("a".into()), 4);
+    assert!(
+        errs[1].to_string().contains("<inertia iyy=\"x\"> is not a number"),
+        "{}",
+        errs[1]
+    );
+    // Geometry is not read, so its numbers are not checked.
+    let text = robot(&[
+        r#"<link name="base"><visual><origin xyz="bogus"/><geometry><box size="1 1"/></geometry></visual></link>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    assert_eq!(parse_urdf(&text).map(|m| m.dof()), Ok(1));
+}
+
+#[test]
+fn mimic_joint_is_reported() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint(
+            "jb",
+            "continuous",
+            "base",
+            "b",
+            r#"<mimic joint="ja" multiplier="-1"/>"#,
+        ),
+    ]);
+    let e = single(&text, Element::Joint("jb".into()), 6);
+    assert_eq!(e.kind, ErrorKind::MimicJoint("ja".into()));
+    assert!(
+        e.to_string()
+            .contains("mimics joint `ja` (<mimic>), which is not supported"),
+        "{e}"
+    );
+    // Also when the description alone is asked for, and beside other errors.
+    assert!(urdf_description(&text).is_err());
+    let text = text.replace(r#"<link name="b">"#, r#"<link name="b_">"#);
+    let errs = errors(&text);
+    assert!(
+        errs.iter().any(|e| e.kind == ErrorKind::MimicJoint("ja".into())),
+        "{errs:#?}"
+    );
+    assert!(
+        errs.iter().any(|e| e.kind == ErrorKind::UnknownChildLink("b".into())),
+        "{errs:#?}"
+    );
+}
+
+#[test]
+fn nesting_beyond_the_limit_is_an_error_not_a_stack_overflow() {
+    let depth = 20_000;
+    let text = format!(
+        "<robot name=\"r\">\n<link name=\"base\">\n{}{}</link>\n</robot>\n",
+        "<a>".repeat(depth),
+        "</a>".repeat(depth)
+    );
+    let e = single(&text, Element::Robot, 3);
+    assert_eq!(e.kind, ErrorKind::TooDeep { tag: "a".into() });
+    assert!(
+        e.to_string().contains("<a> is nested more than 256 elements deep"),
+        "{e}"
+    );
+    // Just inside the limit, the file is read (the unknown elements are ignored).
+    let depth = dyngen_model::xml::MAX_DEPTH - 3;
+    let text = robot(&[
+        &format!(
+            "<link name=\"base\">{}{}</link>",
+            "<a>".repeat(depth),
+            "</a>".repeat(depth)
+        ),
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    assert_eq!(parse_urdf(&text).map(|m| m.dof()), Ok(1));
+}
+
+#[test]
+fn file_beyond_the_size_limit_is_an_error() {
+    let limit = dyngen_model::urdf::MAX_FILE_BYTES as usize;
+    let mut text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", ""),
+    ]);
+    text.push_str(&" ".repeat(limit + 1 - text.len()));
+    let errs = errors(&text);
+    assert_eq!(
+        errs[0].kind,
+        ErrorKind::TooLarge {
+            bytes: limit as u64 + 1
+        }
+    );
+    let file = TempFile::new("large.urdf", &text);
+    let e = load_urdf(&file.0).unwrap_err();
+    assert_eq!(
+        e.errors[0].kind,
+        ErrorKind::TooLarge {
+            bytes: limit as u64 + 1
+        }
+    );
+    assert!(e.to_string().contains("more than the 64 MiB"), "{e}");
+}
+
+#[test]
+// Values near π and π/2 that are not the constants are the point.
+#[allow(clippy::approx_constant)]
+fn rpy_near_a_quarter_turn_is_taken_as_written() {
+    let urdf = |rpy: &str| {
+        robot(&[
+            r#"<link name="base"/>"#,
+            &link("a"),
+            &joint("j", "continuous", "base", "a", &format!(r#"<origin rpy="{rpy}"/>"#)),
+        ])
+    };
+    let rotation = |rpy: &str| parse_urdf(&urdf(rpy)).unwrap().joints[0].origin.rotation;
+    // As written: 2.07e-13 rad short of π, as Pinocchio reads it.
+    let r = rotation("3.14159265359 0 0");
+    let (s, c) = 3.14159265359f64.sin_cos();
+    assert_eq!((r[2][1], r[1][1]), (s, c));
+    assert!(r[2][1] != 0.0);
+    // The f64 nearest π is a half turn, exactly.
+    let r = rotation("3.141592653589793 0 0");
+    assert_eq!((r[2][1], r[1][1]), (0.0, -1.0));
 }
 
 #[test]
 fn inertia_not_positive_definite() {
     let e = single(
-        &one_body(&link_with("a", "1", ["1", "1", "0"])),
+        &one_body(&link_with("a", "1", ["1", "1", "-0.01"])),
         Element::Link("a".into()),
         3,
     );
@@ -941,4 +1141,143 @@ fn negative_friction() {
         }
     );
     assert!(e.to_string().contains("give values ≥ 0"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------
+// CAD rounding of inertias
+
+/// A finger of three flat links (a plate has `J3 = J1 + J2` exactly) whose largest
+/// moments are 2.3e-6, 3.5e-6 and 7.3e-6 kg·m², written with four significant digits
+/// as CAD exporters do, so that rounding breaks the triangle inequality (the first
+/// two) or positive definiteness (the third, a rod whose zero moment came out
+/// negative). `third` replaces the third link's moments.
+fn cad_finger(third: [&str; 3]) -> String {
+    robot(&[
+        r#"<link name="palm"/>"#,
+        &link_with("f1", "0.01", ["9.137e-7", "1.386e-6", "2.300e-6"]),
+        &link_with("f2", "0.01", ["1.234e-6", "2.265e-6", "3.500e-6"]),
+        &link_with("f3", "0.01", third),
+        &joint("j1", "continuous", "palm", "f1", ""),
+        &joint("j2", "continuous", "f1", "f2", ""),
+        &joint("j3", "continuous", "f2", "f3", ""),
+    ])
+}
+
+#[test]
+fn cad_rounding_within_the_tolerance_is_accepted_with_warnings() {
+    use dyngen_model::{inertia_violation, INERTIA_TOLERANCE};
+    let text = cad_finger(["-2.0e-10", "7.300e-6", "7.300e-6"]);
+    let model = parse_urdf(&text).unwrap();
+    let warned: Vec<(&Element, Option<usize>)> = model.warnings.iter().map(|w| (&w.element, w.line)).collect();
+    assert_eq!(
+        warned,
+        [
+            (&Element::Link("f1".into()), Some(3)),
+            (&Element::Link("f2".into()), Some(4)),
+            (&Element::Link("f3".into()), Some(5)),
+        ]
+    );
+    let violations: Vec<f64> = model
+        .warnings
+        .iter()
+        .map(|w| match w.kind {
+            ErrorKind::TriangleInequality(ev) | ErrorKind::NotPositiveDefinite(ev) => inertia_violation(ev),
+            ref k => panic!("{k:?}"),
+        })
+        .collect();
+    // 3e-10 / 2.3e-6, 1e-9 / 3.5e-6, 2e-10 / 7.3e-6: parts in ten thousand or less.
+    for (v, expected) in violations.iter().zip([1.304e-4, 2.857e-4, 2.740e-5]) {
+        assert!((v / expected - 1.0).abs() < 1e-3, "{violations:?}");
+        assert!(*v < INERTIA_TOLERANCE);
+    }
+    assert!(matches!(model.warnings[2].kind, ErrorKind::NotPositiveDefinite(_)));
+    let message = model.warnings[0].warning_message();
+    assert!(
+        message.starts_with("line 3: link `f1`: principal moments")
+            && message.contains("break the triangle inequality")
+            && message.contains("accepted as written: within the relative tolerance of 1e-3 for CAD rounding"),
+        "{message}"
+    );
+    // Kept as written (as Pinocchio reads them); the nearest physical model moves
+    // each moment by at most the violation.
+    assert_eq!(model.bodies[0].inertial.inertia[0][0], 9.137e-7);
+    let physical = model.nearest_physical();
+    assert!(physical.warnings.is_empty());
+    for (body, fixed) in model.bodies.iter().zip(&physical.bodies) {
+        let (ev, _) = fixed.inertial.principal_axes();
+        assert!(inertia_violation(ev) < 1e-12, "{ev:?}");
+        assert!(dyngen_model::check_inertial(&fixed.inertial).is_ok(), "{ev:?}");
+        for r in 0..3 {
+            for c in 0..3 {
+                let d = (fixed.inertial.inertia[r][c] - body.inertial.inertia[r][c]).abs();
+                assert!(d <= 1.1e-9, "{} moved by {d:e}", body.name);
+            }
+        }
+        assert_eq!(fixed.inertial.mass, body.inertial.mass);
+        assert_eq!(fixed.inertial.com, body.inertial.com);
+    }
+    // A strict read refuses every one of them, as errors with their lines.
+    let e = dyngen_model::parse_urdf_with(&text, true).unwrap_err();
+    let lines: Vec<Option<usize>> = e.errors.iter().map(|e| e.line).collect();
+    assert_eq!(lines, [Some(3), Some(4), Some(5)]);
+}
+
+#[test]
+fn violations_beyond_the_tolerance_stay_errors() {
+    // The same 7.3e-6 link with a moment off by 4 %: a mistake, not rounding.
+    let text = cad_finger(["3.000e-6", "4.000e-6", "7.300e-6"]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 1, "{errs:#?}");
+    assert_named(&errs[0], &Element::Link("f3".into()), 5);
+    assert!(matches!(errs[0].kind, ErrorKind::TriangleInequality(_)), "{errs:?}");
+    // A clearly negative moment too.
+    let errs = errors(&cad_finger(["-1e-7", "7.300e-6", "7.300e-6"]));
+    assert!(matches!(errs[0].kind, ErrorKind::NotPositiveDefinite(_)), "{errs:?}");
+}
+
+#[test]
+fn nearest_physical_moments_move_least() {
+    use dyngen_model::{inertia_violation, nearest_physical_moments};
+    // Triangle: each moment moves by a third of the excess, toward J3 = J1 + J2.
+    let j = nearest_physical_moments([1.0, 2.0, 3.3]);
+    assert!((j[0] - 1.1).abs() < 1e-15 && (j[1] - 2.1).abs() < 1e-15 && (j[2] - 3.2).abs() < 1e-15);
+    assert_eq!(inertia_violation(j), 0.0);
+    // A negative moment is raised to a tiny positive one.
+    let j = nearest_physical_moments([-1e-9, 1.0, 1.0]);
+    assert!(j[0] > 0.0 && j[0] <= 1e-9 && j[1] == 1.0 && j[2] == 1.0, "{j:?}");
+    // Physical moments are left alone.
+    assert_eq!(nearest_physical_moments([1.0, 2.0, 3.0]), [1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn values_beyond_any_machine_are_errors_not_overflows() {
+    let e = single(
+        &one_body(&link_with("a", "1e308", ["1", "1", "1"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert_eq!(
+        e.kind,
+        ErrorKind::OutOfRange {
+            what: "mass",
+            value: 1e308
+        }
+    );
+    assert!(
+        e.to_string().contains("mass holds 1e308, beyond ±1e9 in SI units"),
+        "{e}"
+    );
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &joint("j", "continuous", "base", "a", r#"<origin xyz="0 0 -2e10"/>"#),
+    ]);
+    let e = single(&text, Element::Joint("j".into()), 4);
+    assert_eq!(
+        e.kind,
+        ErrorKind::OutOfRange {
+            what: "origin",
+            value: -2e10
+        }
+    );
 }

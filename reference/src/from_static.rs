@@ -8,6 +8,7 @@ use dyngen_model::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Mode
 /// The runtime model of a generated robot's `MODEL`.
 pub fn model_from_static(m: &RobotModel) -> Model {
     Model {
+        warnings: Vec::new(),
         name: m.name.to_string(),
         gravity: m.gravity,
         base: m.base.to_string(),

@@ -197,6 +197,14 @@ pub enum DataError {
         rows: usize,
         dropped: usize,
     },
+    /// The first line does not split at the delimiter in use but does at another:
+    /// the file is, say, semicolon-separated and read as comma-separated.
+    Separator {
+        line: u64,
+        used: super::Delimiter,
+        found: super::Delimiter,
+        fields: usize,
+    },
     /// Several errors found in one pass (at most [`MAX_ERRORS`](super::MAX_ERRORS));
     /// `truncated` when reading stopped there.
     Multiple { errors: Vec<DataError>, truncated: bool },
@@ -229,7 +237,8 @@ impl DataError {
             | DataError::NotANumberIn { line, .. }
             | DataError::NonFiniteIn { line, .. }
             | DataError::OutOfRange { line, .. }
-            | DataError::TimeNotIncreasing { line, .. } => Some(*line),
+            | DataError::TimeNotIncreasing { line, .. }
+            | DataError::Separator { line, .. } => Some(*line),
             DataError::Recipe(e) => e.line(),
             DataError::NonFinite { at, .. }
             | DataError::NonMonotonicTime { at, .. }
@@ -402,6 +411,23 @@ impl fmt::Display for DataError {
                 "{found} sample(s) left of {rows} row(s) read ({dropped} dropped as duplicates, outside the \
                  windows or by decimation); {purpose} needs at least {needed}"
             ),
+            DataError::Separator { line, used, found, fields } => {
+                let mark = |d: super::Delimiter| match d {
+                    super::Delimiter::Comma => "`,`",
+                    super::Delimiter::Semicolon => "`;`",
+                    super::Delimiter::Tab => "tab",
+                    super::Delimiter::Whitespace => "space",
+                };
+                let name = found.name();
+                write!(
+                    f,
+                    "line {line}: no {} separates the fields, but a {} splits the line into {fields}: the file looks \
+                     {name}-separated; read it with `delimiter = {name}` in a recipe (`--delimiter {name}` on the \
+                     command line)",
+                    mark(*used),
+                    mark(*found),
+                )
+            }
             DataError::Multiple { errors, truncated } => {
                 write!(f, "{} errors", errors.len())?;
                 if *truncated {

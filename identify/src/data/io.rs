@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 
 use super::error::{DataError, Location};
 use super::lines::LineIndex;
+use super::recipe::Delimiter;
 use super::trajectory::Trajectory;
 use dyngen::Wrench;
 
@@ -278,6 +279,21 @@ pub(super) fn parse_header(names: &csv::StringRecord, line: u64, dof: Option<usi
     })
 }
 
+/// The error of a first line that does not fit, replaced by a hint about the
+/// separator when another one would have split that line: its many column errors
+/// would only say the same thing less clearly.
+pub(super) fn separator_hint(e: DataError, line: u64, used: Delimiter, other: Option<(Delimiter, usize)>) -> DataError {
+    match other {
+        Some((found, fields)) => DataError::Separator {
+            line,
+            used,
+            found,
+            fields,
+        },
+        None => e,
+    }
+}
+
 /// Converts a csv-layer failure; `line` maps a byte offset to its file line.
 fn csv_error(e: csv::Error, path: Option<&Path>, line: impl FnOnce(u64) -> u64) -> DataError {
     let line = e.position().map(|p| line(p.byte()));
@@ -336,7 +352,14 @@ fn read(reader: impl Read, dof: Option<usize>, path: Option<&Path>) -> Result<Tr
             break line;
         }
     };
-    let header = parse_header(&record, header_line, dof)?;
+    let header = parse_header(&record, header_line, dof).map_err(|e| {
+        // One field that a semicolon or tab would split: the wrong separator.
+        let other = match record.iter().collect::<Vec<_>>()[..] {
+            [only] => Delimiter::guess_other(only.as_bytes(), Delimiter::Comma),
+            _ => None,
+        };
+        separator_hint(e, header_line, Delimiter::Comma, other)
+    })?;
     let n = header.dof;
     let width = header.columns.len();
 

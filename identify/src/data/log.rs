@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 use super::derivatives::{hermite, intervals, SAMPLING_TOLERANCE};
 use super::error::{DataError, Field, MAX_ABS_VALUE};
-use super::io::{parse_header, Errors, Kind, WRENCH_PREFIXES};
+use super::io::{parse_header, separator_hint, Errors, Kind, WRENCH_PREFIXES};
 use super::recipe::{ColumnRef, Delimiter, Recipe, RecipeError, Sampling, Stale, TimeOrigin};
 use super::trajectory::{column, set_column, Trajectory};
 use dyngen::Wrench;
@@ -337,15 +337,9 @@ struct Fields<'a> {
 
 impl<'a> Fields<'a> {
     fn new(line: &'a [u8], delimiter: Delimiter) -> Self {
-        let separator = match delimiter {
-            Delimiter::Comma => Some(b','),
-            Delimiter::Semicolon => Some(b';'),
-            Delimiter::Tab => Some(b'\t'),
-            Delimiter::Whitespace => None,
-        };
         Fields {
             rest: Some(line),
-            separator,
+            separator: delimiter.byte(),
         }
     }
 }
@@ -902,7 +896,7 @@ fn read(reader: impl Read, recipe: &Recipe, dof: Option<usize>, path: Option<&Pa
     let mut plan: Option<Plan> = None;
     let mut names: Option<Vec<String>> = None;
     if recipe.header {
-        let (line, header) = loop {
+        let (line, header, other) = loop {
             match lines.next_line().map_err(io_error)? {
                 None => return Err(DataError::Empty),
                 Some((_, bytes)) if is_blank(bytes) => {}
@@ -913,15 +907,17 @@ fn read(reader: impl Read, recipe: &Recipe, dof: Option<usize>, path: Option<&Pa
                         fields
                             .map(|f| String::from_utf8_lossy(f).into_owned())
                             .collect::<Vec<_>>(),
+                        Delimiter::guess_other(bytes, recipe.delimiter),
                     );
                 }
             }
         };
-        plan = Some(if recipe.columns.is_default() {
-            Plan::named(recipe, &header, line, dof)?
+        let named = if recipe.columns.is_default() {
+            Plan::named(recipe, &header, line, dof)
         } else {
-            Plan::explicit(recipe, Some(&header), header.len(), line, dof)?
-        });
+            Plan::explicit(recipe, Some(&header), header.len(), line, dof)
+        };
+        plan = Some(named.map_err(|e| separator_hint(e, line, recipe.delimiter, other))?);
         names = Some(header);
     }
 
@@ -947,11 +943,13 @@ fn read(reader: impl Read, recipe: &Recipe, dof: Option<usize>, path: Option<&Pa
         rows += 1;
         if plan.is_none() {
             let width = Fields::new(bytes, recipe.delimiter).count();
-            plan = Some(if recipe.columns.is_default() {
-                Plan::positional(recipe, width, line, dof)?
+            let positional = if recipe.columns.is_default() {
+                Plan::positional(recipe, width, line, dof)
             } else {
-                Plan::explicit(recipe, None, width, line, dof)?
-            });
+                Plan::explicit(recipe, None, width, line, dof)
+            };
+            let other = Delimiter::guess_other(bytes, recipe.delimiter);
+            plan = Some(positional.map_err(|e| separator_hint(e, line, recipe.delimiter, other))?);
         }
         let Some(plan) = plan.as_ref() else { break };
         let state = state.get_or_insert_with(|| new_state(plan));
@@ -1200,6 +1198,29 @@ mod tests {
         assert_eq!(log.trajectory.velocities().unwrap(), &[5.0, 6.0, 5.0, 6.0]);
         assert_eq!(log.trajectory.torques(), &[1.0, 2.0, 1.1, 2.1]);
         assert_eq!(log.trajectory.location(1), crate::data::Location::Line(2));
+    }
+
+    #[test]
+    fn a_line_the_delimiter_does_not_split_gets_a_separator_hint() {
+        let hint = |delimiter: &str, found: &str, fields: usize| {
+            format!(
+                "line 1: no {delimiter} separates the fields, but a {found} splits the line into {fields}: the file \
+                 looks"
+            )
+        };
+        let csv = "t;q1;q2;tau1;tau2\n0;0;0;0;0\n0.01;0;0;0;0\n";
+        assert!(load_err("", csv, None).starts_with(&hint("`,`", "`;`", 5)));
+        assert!(load_err("", &csv.replace(';', "\t"), None).starts_with(&hint("`,`", "tab", 5)));
+        // Without a header, from the first row; and a comma file read as semicolons.
+        assert!(
+            load_err("header = false", &csv[csv.find('\n').unwrap() + 1..], None).starts_with(&hint("`,`", "`;`", 5))
+        );
+        let e = load_err("delimiter = semicolon", &csv.replace(';', ","), None);
+        assert!(e.starts_with(&hint("`;`", "`,`", 5)), "{e}");
+        assert!(e.ends_with("read it with `delimiter = comma` in a recipe (`--delimiter comma` on the command line)"));
+        // A header the delimiter splits keeps its own errors.
+        let e = load_err("", "t,q1;x,tau1\n0,0,0\n", None);
+        assert!(e.contains("unknown column `q1;x`"), "{e}");
     }
 
     #[test]

@@ -16,6 +16,50 @@ pub enum Delimiter {
     Whitespace,
 }
 
+impl Delimiter {
+    /// The recipe value naming this delimiter.
+    pub fn name(self) -> &'static str {
+        match self {
+            Delimiter::Comma => "comma",
+            Delimiter::Semicolon => "semicolon",
+            Delimiter::Tab => "tab",
+            Delimiter::Whitespace => "whitespace",
+        }
+    }
+
+    /// The separator byte; `None` for runs of whitespace.
+    pub(super) fn byte(self) -> Option<u8> {
+        match self {
+            Delimiter::Comma => Some(b','),
+            Delimiter::Semicolon => Some(b';'),
+            Delimiter::Tab => Some(b'\t'),
+            Delimiter::Whitespace => None,
+        }
+    }
+
+    /// The delimiter a line not split by `used` seems to use instead, and the
+    /// number of fields it gives: one that splits the line into at least two
+    /// non-empty fields (semicolon, tab, comma, in that order). `None` when `used`
+    /// splits the line already.
+    pub(super) fn guess_other(line: &[u8], used: Delimiter) -> Option<(Delimiter, usize)> {
+        let already = match used.byte() {
+            Some(b) => line.contains(&b),
+            None => line.trim_ascii().iter().any(u8::is_ascii_whitespace),
+        };
+        if already {
+            return None;
+        }
+        [Delimiter::Semicolon, Delimiter::Tab, Delimiter::Comma]
+            .into_iter()
+            .filter(|&d| d != used)
+            .find_map(|d| {
+                let b = d.byte()?;
+                let fields = line.split(|&c| c == b).filter(|f| !f.trim_ascii().is_empty()).count();
+                (fields >= 2).then_some((d, fields))
+            })
+    }
+}
+
 /// Unit of the time column; time stamps are converted to seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TimeUnit {

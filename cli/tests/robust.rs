@@ -1,0 +1,89 @@
+//! Damaged and unusual inputs through the command line: each is refused with a
+//! message naming the culprit, never a crash or a silent wrong result.
+
+mod common;
+
+use common::{assert_exit, assert_ok, pendulum, run, stderr, temp_dir};
+
+#[test]
+fn deeply_nested_xml_is_refused_not_a_stack_overflow() {
+    let dir = temp_dir("dyngen-cli", "deep-xml");
+    let path = dir.join("deep.urdf");
+    let depth = 20_000;
+    let text = format!(
+        "<robot name=\"r\">\n<link name=\"base\">{}{}</link>\n</robot>\n",
+        "<a>".repeat(depth),
+        "</a>".repeat(depth)
+    );
+    std::fs::write(&path, text).unwrap();
+    assert_exit(
+        &run!("info", path),
+        3,
+        "deep.urdf:2: robot: <a> is nested more than 256 elements deep",
+    );
+}
+
+#[test]
+fn huge_and_misseparated_csv_values_are_named() {
+    let dir = temp_dir("dyngen-cli", "csv-values");
+    let urdf = pendulum(&dir, "pendulum.urdf", "1");
+    let rows: String = (0..40)
+        .map(|k| {
+            let t = 0.01 * k as f64;
+            let q = if k == 17 {
+                "1e308".to_string()
+            } else {
+                (0.3 * t).sin().to_string()
+            };
+            format!("{t},{q},0.1\n")
+        })
+        .collect();
+    let csv = dir.join("huge.csv");
+    std::fs::write(&csv, format!("t,q1,tau1\n{rows}")).unwrap();
+    assert_exit(&run!("identify", urdf, csv), 3, "line 19, column `q1`: 1e308");
+
+    let csv = dir.join("semicolons.csv");
+    std::fs::write(
+        &csv,
+        format!("t;q1;tau1\n{}", rows.replace("1e308", "0").replace(',', ";")),
+    )
+    .unwrap();
+    assert_exit(
+        &run!("identify", urdf, csv),
+        3,
+        "line 1: no `,` separates the fields, but a `;` splits the line into 3: the file looks semicolon-separated",
+    );
+}
+
+#[test]
+fn cad_rounded_inertia_is_a_warning_and_strict_refuses_it() {
+    let dir = temp_dir("dyngen-cli", "cad-rounding");
+    let path = dir.join("plate.urdf");
+    // A flat plate (J3 = J1 + J2) whose moments were rounded to four digits:
+    // 3e-10 over the sum, 1.3e-4 of the largest moment.
+    std::fs::write(
+        &path,
+        r#"<robot name="plate">
+  <link name="base"/>
+  <link name="plate"><inertial><mass value="0.01"/>
+    <inertia ixx="9.137e-7" iyy="1.386e-6" izz="2.300e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="plate"/><axis xyz="1 0 0"/></joint>
+</robot>
+"#,
+    )
+    .unwrap();
+    let o = run!("info", path);
+    assert_ok(&o);
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: ")
+            && err.contains("plate.urdf:3: link `plate`: principal moments")
+            && err.contains("accepted as written: within the relative tolerance of 1e-3 for CAD rounding"),
+        "{err}"
+    );
+    assert_exit(
+        &run!("info", path, "--strict"),
+        3,
+        "plate.urdf:3: link `plate`: principal moments",
+    );
+}

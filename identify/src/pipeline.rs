@@ -220,6 +220,9 @@ pub enum PipelineError {
     MergedLinks { body: String, merged: Vec<String> },
     /// The URDF could not be edited.
     Report(ReportError),
+    /// The torque rows do not outnumber the parameter combinations they determine:
+    /// the fit is exact whatever the noise, so there is no σ and no check of it.
+    TooFewRows { samples: usize, rows: usize, rank: usize },
 }
 
 impl fmt::Display for PipelineError {
@@ -242,6 +245,12 @@ impl fmt::Display for PipelineError {
             ),
             Self::Identify { at: Some(at), error } => write!(f, "{at}: {error}"),
             Self::Identify { at: None, error } => write!(f, "{error}"),
+            Self::TooFewRows { samples, rows, rank } => write!(
+                f,
+                "{samples} samples give {rows} torque rows for {rank} identifiable parameter combinations: none is \
+                 left to estimate the noise, so the fit is exact whatever the data hold and has no σ; record more \
+                 samples (many more than {rank} rows: a few hundred samples of an exciting motion for an arm)"
+            ),
             Self::MergedLinks { body, merged } => write!(
                 f,
                 "body `{body}` is fully identified, but its inertial includes the links [{}] attached by fixed \
@@ -399,6 +408,13 @@ fn from_torques(
         Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
     };
     let estimate = solve(&acc)?;
+    if acc.rows() <= estimate.rank {
+        return Err(PipelineError::TooFewRows {
+            samples: traj.len(),
+            rows: acc.rows(),
+            rank: estimate.rank,
+        });
+    }
     let mut warnings = Vec::new();
     if let Estimator::Tls { column_scaling } = options.estimator {
         let ols = acc.ols(opts)?;

@@ -121,7 +121,7 @@ fn corpus_generated_algorithms_match_pinocchio() {
         let nle = ids(&algo::rnea(&g, &model, Inputs::NoAcceleration).tau);
         let gravity = ids(&algo::rnea(&g, &model, Inputs::Static).tau);
         let crba: Vec<NodeId> = algo::crba(&g, &model).iter().flatten().map(|x| x.id()).collect();
-        let aba = ids(&algo::aba(&g, &model));
+        let aba = ids(&algo::aba(&g, &model, algo::Armature::None));
         let params = model.standard_params();
         let mut worst = 0.0f64;
         for (k, s) in fx.samples.iter().enumerate() {

@@ -220,9 +220,9 @@ pub enum PipelineError {
     MergedLinks { body: String, merged: Vec<String> },
     /// The URDF could not be edited.
     Report(ReportError),
-    /// The torque rows do not outnumber the parameter combinations they determine:
-    /// the fit is exact whatever the noise, so there is no σ and no check of it.
-    TooFewRows { samples: usize, rows: usize, rank: usize },
+    /// The torque rows do not outnumber the parameters: fewer equations than
+    /// unknowns, fitted exactly or nearly whatever the noise.
+    TooFewRows { samples: usize, rows: usize, params: usize },
 }
 
 impl fmt::Display for PipelineError {
@@ -245,11 +245,12 @@ impl fmt::Display for PipelineError {
             ),
             Self::Identify { at: Some(at), error } => write!(f, "{at}: {error}"),
             Self::Identify { at: None, error } => write!(f, "{error}"),
-            Self::TooFewRows { samples, rows, rank } => write!(
+            Self::TooFewRows { samples, rows, params } => write!(
                 f,
-                "{samples} samples give {rows} torque rows for {rank} identifiable parameter combinations: none is \
-                 left to estimate the noise, so the fit is exact whatever the data hold and has no σ; record more \
-                 samples (many more than {rank} rows: a few hundred samples of an exciting motion for an arm)"
+                "{samples} samples give {rows} torque rows for {params} parameters: no more equations than \
+                 unknowns, so the fit matches any data and its σ means nothing; record more than {} samples (in \
+                 practice a few hundred along an exciting motion)",
+                params / (rows / (*samples).max(1)).max(1)
             ),
             Self::MergedLinks { body, merged } => write!(
                 f,
@@ -408,11 +409,11 @@ fn from_torques(
         Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
     };
     let estimate = solve(&acc)?;
-    if acc.rows() <= estimate.rank {
+    if acc.rows() <= estimate.solution.len() {
         return Err(PipelineError::TooFewRows {
             samples: traj.len(),
             rows: acc.rows(),
-            rank: estimate.rank,
+            params: estimate.solution.len(),
         });
     }
     let mut warnings = Vec::new();

@@ -358,7 +358,7 @@ pub fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
             merged.join(", ")
         )),
         PipelineError::Report(e) => CliError::Input(e.to_string()),
-        PipelineError::TooFewRows { .. } => CliError::input(data, e),
+        PipelineError::TooFewRows { .. } | PipelineError::NonFiniteEstimate { .. } => CliError::input(data, e),
     }
 }
 

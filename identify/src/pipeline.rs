@@ -223,6 +223,10 @@ pub enum PipelineError {
     /// The torque rows do not outnumber the parameters: fewer equations than
     /// unknowns, fitted exactly or nearly whatever the noise.
     TooFewRows { samples: usize, rows: usize, params: usize },
+    /// The estimate is not finite although every input was: values so large that
+    /// the arithmetic overflowed. `largest`: the input of largest magnitude, where
+    /// it is and what it is.
+    NonFiniteEstimate { largest: (f64, Location, &'static str) },
 }
 
 impl fmt::Display for PipelineError {
@@ -245,6 +249,13 @@ impl fmt::Display for PipelineError {
             ),
             Self::Identify { at: Some(at), error } => write!(f, "{at}: {error}"),
             Self::Identify { at: None, error } => write!(f, "{error}"),
+            Self::NonFiniteEstimate {
+                largest: (value, at, what),
+            } => write!(
+                f,
+                "the estimate is not finite: the recording's values overflow the arithmetic; the largest is the \
+                 {what} {value:e} at {at} (values of a robot's motion and torques are below 1e6 in SI units)"
+            ),
             Self::TooFewRows { samples, rows, params } => write!(
                 f,
                 "{samples} samples give {rows} torque rows for {params} parameters: no more equations than \
@@ -409,6 +420,11 @@ fn from_torques(
         Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
     };
     let estimate = solve(&acc)?;
+    if !(estimate.solution.iter().all(|x| x.is_finite()) && estimate.residuals.rms.is_finite()) {
+        return Err(PipelineError::NonFiniteEstimate {
+            largest: largest_input(traj),
+        });
+    }
     if acc.rows() <= estimate.solution.len() {
         return Err(PipelineError::TooFewRows {
             samples: traj.len(),
@@ -489,6 +505,26 @@ fn from_torques(
         excluded_rows,
         stribeck,
     })
+}
+
+/// The input of `traj` of largest magnitude: its value, where it is and what it is.
+fn largest_input(traj: &Trajectory) -> (f64, Location, &'static str) {
+    let n = traj.dof();
+    let columns: [(Option<&[f64]>, &'static str); 4] = [
+        (Some(traj.positions()), "position"),
+        (traj.velocities(), "velocity"),
+        (traj.accelerations(), "acceleration"),
+        (Some(traj.torques()), "torque"),
+    ];
+    let mut best = (0.0_f64, traj.location(0), "position");
+    for (values, what) in columns {
+        for (i, &x) in values.unwrap_or(&[]).iter().enumerate() {
+            if x.abs() > best.0.abs() {
+                best = (x, traj.location(i / n), what);
+            }
+        }
+    }
+    best
 }
 
 /// The standard-form consistent estimator's options for `regressor` on `n` joints:
@@ -1133,5 +1169,24 @@ mod tests {
         let positions_only = Trajectory::new(6, vec![0.0, 0.1, 0.2], zeros(18), zeros(18)).unwrap();
         let err = identify(&robot, &positions_only, &IdentifyOptions::default()).unwrap_err();
         assert!(matches!(err, PipelineError::Data { path: None, .. }), "{err:?}");
+    }
+
+    #[test]
+    fn an_overflowing_input_is_named_not_a_nan_estimate() {
+        let model = ur5();
+        let robot = Reference::new(model);
+        let traj = recording();
+        let mut tau = traj.torques().to_vec();
+        tau[6 * 17 + 2] = 1e300;
+        let huge = traj.with_torques(tau).unwrap();
+        let err = identify(&robot, &huge, &options(Mode::Standard, Estimator::Ols)).unwrap_err();
+        let PipelineError::NonFiniteEstimate { largest } = &err else {
+            panic!("{err:?}");
+        };
+        assert_eq!(*largest, (1e300, Location::Sample(17), "torque"));
+        assert!(
+            err.to_string().contains("the largest is the torque 1e300 at sample 17"),
+            "{err}"
+        );
     }
 }

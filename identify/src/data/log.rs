@@ -719,9 +719,6 @@ struct State {
     lines: Vec<u64>,
     row: Vec<f64>,
     previous: Vec<f64>,
-    /// Where each field of the current line starts and ends (reused, one split
-    /// per line).
-    fields: Vec<(usize, usize)>,
     /// The last accepted row's time and line (decimated or not).
     last: Option<(f64, u64)>,
     origin: Option<f64>,
@@ -736,17 +733,83 @@ fn parse_field(text: &[u8]) -> Result<f64, String> {
     }
 }
 
+/// Data lines read ahead, then split and parsed on every core before their rows
+/// are taken in order (the numbers are most of the reading time).
+const BATCH_LINES: usize = 8192;
+
+/// Data lines read ahead: their bytes, and each line's number and byte range.
+#[derive(Default)]
+struct Batch {
+    bytes: Vec<u8>,
+    lines: Vec<(u64, usize, usize)>,
+}
+
+/// One line split and parsed: per field, its number (`parse_field`), or
+/// `Err(String::new())` for a field the plan does not read.
+#[derive(Clone, Copy)]
+struct ParsedLine<'a> {
+    values: &'a [Result<f64, String>],
+}
+
+/// Lines of a batch split into fields and parsed; `starts[k]..starts[k + 1]` are
+/// line `k`'s fields.
+struct Parsed {
+    values: Vec<Result<f64, String>>,
+    starts: Vec<usize>,
+}
+
+impl Parsed {
+    fn line(&self, k: usize) -> ParsedLine<'_> {
+        ParsedLine {
+            values: &self.values[self.starts[k]..self.starts[k + 1]],
+        }
+    }
+}
+
+/// Splits and parses `lines` of `bytes`: the fields `read[i]` selects (all beyond
+/// its length are skipped).
+fn parse_lines(bytes: &[u8], lines: &[(u64, usize, usize)], delimiter: Delimiter, read: &[bool]) -> Parsed {
+    let mut values = Vec::with_capacity(lines.len() * read.len());
+    let mut starts = Vec::with_capacity(lines.len() + 1);
+    starts.push(0);
+    for &(_, a, b) in lines {
+        for (i, field) in Fields::new(&bytes[a..b], delimiter).enumerate() {
+            values.push(if read.get(i).copied().unwrap_or(false) {
+                parse_field(field)
+            } else {
+                Err(String::new())
+            });
+        }
+        starts.push(values.len());
+    }
+    Parsed { values, starts }
+}
+
+/// [`parse_lines`] on the whole batch, in contiguous parts on every core.
+fn parse_batch(batch: &Batch, delimiter: Delimiter, read: &[bool]) -> Vec<Parsed> {
+    let parts = crate::accumulate::cores().min(batch.lines.len() / 1024).max(1);
+    if parts == 1 {
+        return vec![parse_lines(&batch.bytes, &batch.lines, delimiter, read)];
+    }
+    let size = batch.lines.len().div_ceil(parts);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = batch
+            .lines
+            .chunks(size)
+            .map(|lines| scope.spawn(move || parse_lines(&batch.bytes, lines, delimiter, read)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+            .collect()
+    })
+}
+
 impl State {
     /// Reads one data row into the arrays, or says why not. `Ok(false)` when the
     /// error list is full.
-    fn row(&mut self, plan: &Plan, recipe: &Recipe, line: u64, bytes: &[u8], errors: &mut Errors) -> bool {
-        let start = bytes.as_ptr() as usize;
-        self.fields.clear();
-        self.fields.extend(Fields::new(bytes, recipe.delimiter).map(|f| {
-            let at = f.as_ptr() as usize - start;
-            (at, at + f.len())
-        }));
-        let found = self.fields.len();
+    fn row(&mut self, plan: &Plan, recipe: &Recipe, line: u64, parsed: ParsedLine<'_>, errors: &mut Errors) -> bool {
+        let found = parsed.values.len();
         if found != plan.width {
             return errors.push(DataError::RowWidth {
                 line,
@@ -794,11 +857,11 @@ impl State {
 
         // Time first: rows outside the window are left unread, so that a window
         // can cut away a damaged part of a log.
-        let text = |(a, b): (usize, usize)| &bytes[a..b];
-        let raw_t = self
-            .fields
+        let raw_t = parsed
+            .values
             .get(plan.time_field)
-            .map_or(Err(String::new()), |&f| parse_field(text(f)));
+            .cloned()
+            .unwrap_or(Err(String::new()));
         if recipe.time_origin == TimeOrigin::FirstRow && self.origin.is_none() {
             if let Ok(x) = raw_t {
                 self.origin = Some(x).filter(|x| x.is_finite());
@@ -817,9 +880,9 @@ impl State {
                 return true;
             }
         }
-        for (i, &field) in self.fields.iter().enumerate() {
+        for (i, value) in parsed.values.iter().enumerate() {
             if let Target::Value { pos, scale } = plan.targets[i] {
-                if let Some(x) = check(i, parse_field(text(field)), scale, errors) {
+                if let Some(x) = check(i, value.clone(), scale, errors) {
                     self.row[pos] = x;
                 }
             }
@@ -926,35 +989,76 @@ fn read(reader: impl Read, recipe: &Recipe, dof: Option<usize>, path: Option<&Pa
     let mut data_row = 0usize;
     let mut rows = 0usize;
     let mut any_line = false;
-    while let Some((line, bytes)) = lines.next_line().map_err(io_error)? {
-        if is_blank(bytes) {
-            continue;
-        }
-        any_line = true;
-        data_row += 1;
-        if let Some(w) = recipe.rows {
-            if w.first.is_some_and(|f| data_row < f) {
+    let mut batch = Batch::default();
+    let mut read_fields: Vec<bool> = Vec::new();
+    'reading: loop {
+        // Read ahead up to a batch of data lines (blank lines and rows before the
+        // row window skipped, as they would be one by one).
+        batch.bytes.clear();
+        batch.lines.clear();
+        // A line (blank or not) read after the batch's last data line; whether the
+        // input goes on after the batch, when that is full.
+        let mut after_last = false;
+        let mut last_batch = true;
+        while let Some((line, bytes)) = lines.next_line().map_err(io_error)? {
+            if is_blank(bytes) {
+                after_last = true;
                 continue;
             }
-            if w.last.is_some_and(|l| data_row > l) {
+            any_line = true;
+            data_row += 1;
+            if let Some(w) = recipe.rows {
+                if w.first.is_some_and(|f| data_row < f) {
+                    continue;
+                }
+                if w.last.is_some_and(|l| data_row > l) {
+                    after_last = true;
+                    break;
+                }
+            }
+            rows += 1;
+            if plan.is_none() {
+                let width = Fields::new(bytes, recipe.delimiter).count();
+                let positional = if recipe.columns.is_default() {
+                    Plan::positional(recipe, width, line, dof)
+                } else {
+                    Plan::explicit(recipe, None, width, line, dof)
+                };
+                let other = Delimiter::guess_other(bytes, recipe.delimiter);
+                plan = Some(positional.map_err(|e| separator_hint(e, line, recipe.delimiter, other))?);
+            }
+            let start = batch.bytes.len();
+            batch.bytes.extend_from_slice(bytes);
+            batch.lines.push((line, start, batch.bytes.len()));
+            after_last = false;
+            if batch.lines.len() == BATCH_LINES {
+                last_batch = false;
                 break;
             }
         }
-        rows += 1;
-        if plan.is_none() {
-            let width = Fields::new(bytes, recipe.delimiter).count();
-            let positional = if recipe.columns.is_default() {
-                Plan::positional(recipe, width, line, dof)
-            } else {
-                Plan::explicit(recipe, None, width, line, dof)
-            };
-            let other = Delimiter::guess_other(bytes, recipe.delimiter);
-            plan = Some(positional.map_err(|e| separator_hint(e, line, recipe.delimiter, other))?);
+        let Some(plan) = plan.as_ref().filter(|_| !batch.lines.is_empty()) else {
+            break;
+        };
+        if read_fields.is_empty() {
+            read_fields = (0..plan.width)
+                .map(|i| i == plan.time_field || matches!(plan.targets[i], Target::Value { .. }))
+                .collect();
         }
-        let Some(plan) = plan.as_ref() else { break };
         let state = state.get_or_insert_with(|| new_state(plan));
-        if !state.row(plan, recipe, line, bytes, &mut errors) || errors.full() {
-            errors.truncated = lines.next_line().map_err(io_error)?.is_some();
+        let mut k = 0;
+        for parsed in parse_batch(&batch, recipe.delimiter, &read_fields) {
+            for j in 0..parsed.starts.len() - 1 {
+                let line = batch.lines[k].0;
+                k += 1;
+                if !state.row(plan, recipe, line, parsed.line(j), &mut errors) || errors.full() {
+                    errors.truncated = k < batch.lines.len()
+                        || after_last
+                        || (!last_batch && lines.next_line().map_err(io_error)?.is_some());
+                    break 'reading;
+                }
+            }
+        }
+        if last_batch {
             break;
         }
     }
@@ -982,7 +1086,6 @@ fn new_state(plan: &Plan) -> State {
         lines: Vec::new(),
         row: vec![0.0; len],
         previous: vec![0.0; len],
-        fields: Vec::with_capacity(plan.width),
         last: None,
         origin: None,
         accepted: 0,
@@ -1530,6 +1633,41 @@ mod tests {
             e,
             "line 2: 2 fields, expected 3 like line 1; every row needs the same columns"
         );
+    }
+
+    /// Logs longer than a batch read as they would line by line: the schema reader
+    /// gives the same trajectory, and errors past the first batch name their line.
+    #[test]
+    fn logs_longer_than_a_batch() {
+        let rows = 3 * BATCH_LINES + 17;
+        let mut csv = String::from("t,q1,q2,tau1,tau2\n");
+        for k in 0..rows {
+            let t = 0.001 * k as f64;
+            csv += &row(",", &[t, t.sin(), t.cos(), 2.0 * t, -t]);
+            if k % 1000 == 7 {
+                csv += "\n";
+            }
+        }
+        let plain = from_reader(csv.as_bytes(), Some(2)).unwrap();
+        let loaded = Recipe::default().read_from(csv.as_bytes(), Some(2)).unwrap();
+        assert_eq!(loaded.trajectory, plain);
+        assert_eq!(loaded.report.rows, rows);
+        for k in [0, BATCH_LINES - 1, BATCH_LINES, rows - 1] {
+            assert_eq!(loaded.trajectory.location(k), plain.location(k));
+        }
+        // A bad value two batches in: its line, counting the header and blank lines.
+        let bad_row = 2 * BATCH_LINES + 5;
+        let mut lines: Vec<&str> = csv.lines().collect();
+        let index = lines
+            .iter()
+            .position(|l| l.starts_with(&format!("{},", 0.001 * bad_row as f64)))
+            .unwrap();
+        let mut fields: Vec<&str> = lines[index].split(',').collect();
+        fields[1] = "oops";
+        let broken = fields.join(",");
+        lines[index] = &broken;
+        let e = load_err("", &(lines.join("\n") + "\n"), None);
+        assert_eq!(e, format!("line {}, column `q1`: `oops` is not a number", index + 1));
     }
 
     #[test]

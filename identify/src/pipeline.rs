@@ -220,7 +220,8 @@ pub enum PipelineError {
     MergedLinks { body: String, merged: Vec<String> },
     /// The URDF could not be edited.
     Report(ReportError),
-    /// The torque rows do not outnumber the parameters: fewer equations than
+    /// The torque rows taken (those left out by [`IdentifyOptions::exclude_below`]
+    /// not counted) do not outnumber the parameters: no more equations than
     /// unknowns, fitted exactly or nearly whatever the noise.
     TooFewRows { samples: usize, rows: usize, params: usize },
     /// The estimate is not finite although every input was: values so large that
@@ -425,10 +426,12 @@ fn from_torques(
             largest: largest_input(traj),
         });
     }
-    if acc.rows() <= estimate.solution.len() {
+    // The rows taken: those left out below a speed (--exclude-below) do not count.
+    let rows: usize = acc.rows_per_channel().iter().sum();
+    if rows <= estimate.solution.len() {
         return Err(PipelineError::TooFewRows {
             samples: traj.len(),
-            rows: acc.rows(),
+            rows,
             params: estimate.solution.len(),
         });
     }

@@ -4,65 +4,26 @@
 //! stamps, duplicate rows, motor currents, 1 % torque noise), validated on a second
 //! recording it was not identified on.
 
+mod common;
+
+use common::{add_torque_noise, joint_truth, motion, overall_error, ur5, F0, FC, FV, IA};
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
 use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, PipelineError, Prediction};
 use dyngen_identify::report::MergedLinks;
-use dyngen_identify::simulate::{add_joint_terms, record_trajectory, FourierExcitation, Gaussian, Logger, Recording};
+use dyngen_identify::simulate::{add_joint_terms, record_trajectory, Gaussian, Logger, Recording};
 use dyngen_identify::validate::Validation;
 use dyngen_identify::{Accumulator, Channels, Method, Options, Status};
 use dyngen_model::joint_params::Coulomb;
-use dyngen_model::sample::SplitMix64;
 use dyngen_reference::Reference;
 
-const IA: [f64; 6] = [0.40, 0.40, 0.20, 0.08, 0.08, 0.08];
-const FV: [f64; 6] = [3.0, 3.0, 2.0, 0.6, 0.6, 0.6];
-const FC: [f64; 6] = [6.0, 6.0, 4.0, 1.5, 1.5, 1.5];
-const F0: [f64; 6] = [0.2, -0.3, 0.1, 0.05, -0.05, 0.02];
 const GAINS: [f64; 6] = [14.0, 13.0, 12.0, 9.0, 8.5, 8.0];
-
-fn robot() -> Reference {
-    Reference::new(&dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap())
-}
-
-fn joint_truth() -> Vec<f64> {
-    (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect()
-}
-
-/// A multi-sine of 5 harmonics of 0.1 Hz per joint, seeded: velocity amplitudes up
-/// to 0.3 rad/s per harmonic (so accelerations reach ~1 rad/s², which the rotor
-/// inertias need), about a pose where gravity on the shoulder and elbow varies.
-fn motion(seed: u64) -> FourierExcitation {
-    let mut rng = SplitMix64::new(seed);
-    let harmonics = 5;
-    let mut coef = || -> Vec<Vec<f64>> {
-        (0..6)
-            .map(|_| (1..=harmonics).map(|_| rng.uniform(-0.3, 0.3)).collect())
-            .collect()
-    };
-    let (a, b) = (coef(), coef());
-    FourierExcitation::new(0.1, vec![0.0, -1.0, 1.0, 0.0, 0.0, 0.0], &a, &b)
-}
 
 fn recording(robot: &Reference, seed: u64, times: &[f64]) -> Recording {
     let mut rec = record_trajectory(robot, &robot.model().standard_params(), &motion(seed), times);
     add_joint_terms(&mut rec, &joint_truth(), Coulomb::Sign);
     rec
-}
-
-/// 1 % of each joint's RMS torque as Gaussian noise on the torques (or currents).
-fn add_torque_noise(rec: &mut Recording, noise: &mut Gaussian) -> Vec<f64> {
-    let rms: Vec<f64> = (0..6)
-        .map(|j| (rec.samples.iter().map(|s| s.tau[j] * s.tau[j]).sum::<f64>() / rec.len() as f64).sqrt())
-        .collect();
-    let sigma: Vec<f64> = rms.iter().map(|r| 0.01 * r).collect();
-    for s in &mut rec.samples {
-        for j in 0..6 {
-            s.tau[j] += noise.normal(sigma[j]);
-        }
-    }
-    sigma
 }
 
 /// A file `Logger::write` wrote, read back with velocities and accelerations;
@@ -86,7 +47,7 @@ fn read_log(text: &str, gains: Option<&str>) -> dyngen_identify::data::Trajector
 
 #[test]
 fn noise_free_identification_recovers_friction_and_rotor_inertia() {
-    let robot = robot();
+    let robot = ur5();
     let times: Vec<f64> = (0..2000).map(|k| 0.01 * k as f64).collect();
     let rec = recording(&robot, 1, &times);
     let est = mim::torque(
@@ -140,7 +101,7 @@ fn noise_free_identification_recovers_friction_and_rotor_inertia() {
 /// noisy currents and accelerations from filtered positions.
 #[test]
 fn identification_through_a_real_looking_log_meets_its_targets() {
-    let robot = robot();
+    let robot = ur5();
     let logger = Logger {
         gains: Some(GAINS.to_vec()),
         current_quantum: 1e-4,
@@ -224,7 +185,7 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
 fn drive_gains_from_a_known_payload() {
     use dyngen_identify::gains::identify_gains;
     use dyngen_identify::payload::Payload;
-    let robot = robot();
+    let robot = ur5();
     let nominal = robot.model().standard_params();
     // 5 kg, centre of mass 10 cm off the flange's axis and 5 cm beyond it, a
     // cylinder of radius 5 cm and length 10 cm about its centre, moved to the body
@@ -311,24 +272,12 @@ fn with_friction(estimator: Estimator) -> IdentifyOptions {
     }
 }
 
-fn overall_error(robot: &Reference, id: &pipeline::Identification, traj: &Trajectory) -> f64 {
-    let predicted = id.predict(robot, traj).unwrap();
-    let names: Vec<String> = robot.model().joints.iter().map(|j| j.name.clone()).collect();
-    Validation::new(
-        &names,
-        (0..traj.len()).map(|k| traj.tau(k)),
-        predicted.iter().map(|p| &p[..]),
-    )
-    .unwrap()
-    .overall
-}
-
 /// Joint 4 without viscous friction: with 1 % torque noise OLS makes its Fv
 /// negative; the consistent estimator keeps every Ia, Fv, Fc ≥ 0 (Fv4 held at the
 /// bound) and predicts another recording as well as OLS.
 #[test]
 fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
-    let robot = robot();
+    let robot = ur5();
     let mut joints = joint_truth();
     joints[4 * 3 + 1] = 0.0;
     let traj = noisy_trajectory(&robot, &joints, 1, 3);
@@ -407,7 +356,7 @@ fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
 /// refused by name.
 #[test]
 fn rows_below_a_speed_are_left_out_and_counted() {
-    let robot = robot();
+    let robot = ur5();
     let traj = noisy_trajectory(&robot, &joint_truth(), 1, 3);
     let speed = 0.05;
     let options = IdentifyOptions {

@@ -2,38 +2,14 @@
 //! last link, with rotor inertia and friction in its drives and 1 % torque noise; the
 //! load's mass, centre of mass and inertia from `τ − τ_known = Y_6 · π_L`.
 
+mod common;
+
+use common::{joint_truth, motion, ur5};
 use dyngen_identify::payload::{self, KnownRobot, Payload};
-use dyngen_identify::simulate::{add_joint_terms, record_trajectory, FourierExcitation, Gaussian};
+use dyngen_identify::simulate::{add_joint_terms, record_trajectory, Gaussian};
 use dyngen_identify::{IdentifyError, Options};
 use dyngen_model::joint_params::Coulomb;
-use dyngen_model::sample::SplitMix64;
 use dyngen_reference::Reference;
-
-fn robot() -> Reference {
-    Reference::new(&dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap())
-}
-
-/// `[Ia, Fv, Fc, F0]` per joint, of the order of a UR5's drives.
-fn joint_params() -> Vec<f64> {
-    let ia = [0.40, 0.40, 0.20, 0.08, 0.08, 0.08];
-    let fv = [3.0, 3.0, 2.0, 0.6, 0.6, 0.6];
-    let fc = [6.0, 6.0, 4.0, 1.5, 1.5, 1.5];
-    let f0 = [0.2, -0.3, 0.1, 0.05, -0.05, 0.02];
-    (0..6).flat_map(|j| [ia[j], fv[j], fc[j], f0[j]]).collect()
-}
-
-/// A seeded multi-sine of 5 harmonics of 0.1 Hz per joint about a pose where
-/// gravity loads the shoulder and elbow.
-fn motion(seed: u64) -> FourierExcitation {
-    let mut rng = SplitMix64::new(seed);
-    let mut coef = || -> Vec<Vec<f64>> {
-        (0..6)
-            .map(|_| (1..=5).map(|_| rng.uniform(-0.3, 0.3)).collect())
-            .collect()
-    };
-    let (a, b) = (coef(), coef());
-    FourierExcitation::new(0.1, vec![0.0, -1.0, 1.0, 0.0, 0.0, 0.0], &a, &b)
-}
 
 /// 2.5 kg, centre of mass 3 cm off the flange axis and 6 cm beyond it, a box
 /// 8 × 6 × 10 cm about its centre.
@@ -56,7 +32,7 @@ fn loaded_recording(robot: &Reference, payload: &Payload) -> dyngen_identify::da
     }
     let times: Vec<f64> = (0..12_000).map(|k| k as f64 * 0.01).collect();
     let mut rec = record_trajectory(robot, &params, &motion(4), &times);
-    add_joint_terms(&mut rec, &joint_params(), Coulomb::Sign);
+    add_joint_terms(&mut rec, &joint_truth(), Coulomb::Sign);
     let mut noise = Gaussian::new(17);
     for j in 0..6 {
         let rms = (rec.samples.iter().map(|s| s.tau[j] * s.tau[j]).sum::<f64>() / rec.len() as f64).sqrt();
@@ -69,11 +45,11 @@ fn loaded_recording(robot: &Reference, payload: &Payload) -> dyngen_identify::da
 
 #[test]
 fn a_payload_on_the_last_link_is_recovered() {
-    let robot = robot();
+    let robot = ur5();
     let (m, c, inertia) = load();
     let truth = Payload::from_mass_properties(6, m, c, inertia);
     let data = loaded_recording(&robot, &truth);
-    let (nominal, jp) = (robot.model().standard_params(), joint_params());
+    let (nominal, jp) = (robot.model().standard_params(), joint_truth());
     let known = KnownRobot {
         dynamics: &robot,
         params: &nominal,
@@ -115,7 +91,7 @@ fn a_payload_on_the_last_link_is_recovered() {
 
 #[test]
 fn bad_arguments_are_named() {
-    let robot = robot();
+    let robot = ur5();
     let truth = Payload::from_mass_properties(6, 1.0, [0.0; 3], [[1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0], [0.0, 0.0, 1e-3]]);
     let data = loaded_recording(&robot, &truth);
     let nominal = robot.model().standard_params();

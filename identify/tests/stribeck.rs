@@ -4,67 +4,33 @@
 //! back and the model predicts a second recording better than sign friction; on
 //! joints without a Stribeck effect it is no worse; its JSON predicts the same.
 
+mod common;
+
+use common::{add_torque_noise, joint_truth, motion, overall_error, ur5, FC};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::pipeline::{self, Identification, IdentifyOptions, JointTerms, PipelineError};
 use dyngen_identify::report::ParameterReport;
-use dyngen_identify::simulate::{
-    add_joint_terms, add_stribeck_terms, record_trajectory, FourierExcitation, Gaussian, Recording,
-};
+use dyngen_identify::simulate::{add_joint_terms, add_stribeck_terms, record_trajectory, Gaussian};
 use dyngen_identify::stribeck::{Stribeck, StribeckError};
-use dyngen_identify::validate::Validation;
 use dyngen_model::joint_params::Coulomb;
-use dyngen_model::sample::SplitMix64;
 use dyngen_reference::Reference;
 
-const IA: [f64; 6] = [0.40, 0.40, 0.20, 0.08, 0.08, 0.08];
-const FV: [f64; 6] = [3.0, 3.0, 2.0, 0.6, 0.6, 0.6];
-const FC: [f64; 6] = [6.0, 6.0, 4.0, 1.5, 1.5, 1.5];
-const F0: [f64; 6] = [0.2, -0.3, 0.1, 0.05, -0.05, 0.02];
 const FS: [f64; 6] = [9.0, 9.0, 6.0, 2.2, 2.2, 2.2];
 const VS: [f64; 6] = [0.05, 0.05, 0.08, 0.04, 0.04, 0.04];
-
-fn robot() -> Reference {
-    Reference::new(&dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap())
-}
-
-/// A multi-sine of 5 harmonics of 0.1 Hz per joint, seeded, about a pose where
-/// gravity on the shoulder and elbow varies: every joint reverses a few times.
-fn motion(seed: u64) -> FourierExcitation {
-    let mut rng = SplitMix64::new(seed);
-    let mut coef = || -> Vec<Vec<f64>> {
-        (0..6)
-            .map(|_| (1..=5).map(|_| rng.uniform(-0.3, 0.3)).collect())
-            .collect()
-    };
-    let (a, b) = (coef(), coef());
-    FourierExcitation::new(0.1, vec![0.0, -1.0, 1.0, 0.0, 0.0, 0.0], &a, &b)
-}
 
 /// 60 s at 100 Hz of the motion of `seed`, with rotor inertia and linear friction,
 /// Stribeck terms when `stribeck`, and 1 % of each joint's RMS torque as noise.
 fn recording(robot: &Reference, seed: u64, stribeck: bool) -> Trajectory {
     let times: Vec<f64> = (0..6000).map(|k| 0.01 * k as f64).collect();
     let mut rec = record_trajectory(robot, &robot.model().standard_params(), &motion(seed), &times);
-    let joints: Vec<f64> = (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect();
+    let joints = joint_truth();
     add_joint_terms(&mut rec, &joints, Coulomb::Sign);
     if stribeck {
         let s: Vec<Stribeck> = (0..6).map(|j| Stribeck { fs: FS[j], vs: VS[j] }).collect();
         add_stribeck_terms(&mut rec, &joints, &s, Coulomb::Sign).unwrap();
     }
-    add_torque_noise(&mut rec, seed + 100);
+    add_torque_noise(&mut rec, &mut Gaussian::new(seed + 100));
     rec.to_trajectory().unwrap()
-}
-
-fn add_torque_noise(rec: &mut Recording, seed: u64) {
-    let mut noise = Gaussian::new(seed);
-    let sigma: Vec<f64> = (0..6)
-        .map(|j| 0.01 * (rec.samples.iter().map(|s| s.tau[j].powi(2)).sum::<f64>() / rec.len() as f64).sqrt())
-        .collect();
-    for s in &mut rec.samples {
-        for j in 0..6 {
-            s.tau[j] += noise.normal(sigma[j]);
-        }
-    }
 }
 
 fn identify(robot: &Reference, traj: &Trajectory, joints: JointTerms) -> Identification {
@@ -75,22 +41,9 @@ fn identify(robot: &Reference, traj: &Trajectory, joints: JointTerms) -> Identif
     pipeline::identify(robot, traj, &options).unwrap()
 }
 
-/// The overall relative prediction error of `id` on `traj`.
-fn validate(robot: &Reference, id: &Identification, traj: &Trajectory) -> f64 {
-    let predicted = id.predict(robot, traj).unwrap();
-    let names: Vec<String> = robot.model().joints.iter().map(|j| j.name.clone()).collect();
-    Validation::new(
-        &names,
-        (0..traj.len()).map(|k| traj.tau(k)),
-        predicted.iter().map(|p| &p[..]),
-    )
-    .unwrap()
-    .overall
-}
-
 #[test]
 fn stribeck_friction_is_recovered_and_predicts_better_than_sign() {
-    let robot = robot();
+    let robot = ur5();
     let (train, test) = (recording(&robot, 1, true), recording(&robot, 2, true));
     let sign = identify(&robot, &train, JointTerms::Friction(Coulomb::Sign));
     let stribeck = identify(&robot, &train, JointTerms::Stribeck(Coulomb::Sign));
@@ -127,7 +80,10 @@ fn stribeck_friction_is_recovered_and_predicts_better_than_sign() {
             j + 1
         );
     }
-    let (e_sign, e_stribeck) = (validate(&robot, &sign, &test), validate(&robot, &stribeck, &test));
+    let (e_sign, e_stribeck) = (
+        overall_error(&robot, &sign, &test),
+        overall_error(&robot, &stribeck, &test),
+    );
     println!(
         "validation: sign {:.3} %, stribeck {:.3} %",
         100.0 * e_sign,
@@ -151,7 +107,7 @@ fn stribeck_friction_is_recovered_and_predicts_better_than_sign() {
 
 #[test]
 fn without_a_stribeck_effect_it_is_no_worse_than_sign() {
-    let robot = robot();
+    let robot = ur5();
     let (train, test) = (recording(&robot, 3, false), recording(&robot, 4, false));
     let sign = identify(&robot, &train, JointTerms::Friction(Coulomb::Sign));
     let stribeck = identify(&robot, &train, JointTerms::Stribeck(Coulomb::Sign));
@@ -165,7 +121,10 @@ fn without_a_stribeck_effect_it_is_no_worse_than_sign() {
             .sum()
     };
     assert!(residual(&stribeck) <= residual(&sign) * (1.0 + 1e-12));
-    let (e_sign, e_stribeck) = (validate(&robot, &sign, &test), validate(&robot, &stribeck, &test));
+    let (e_sign, e_stribeck) = (
+        overall_error(&robot, &sign, &test),
+        overall_error(&robot, &stribeck, &test),
+    );
     println!(
         "validation: sign {:.4} %, stribeck {:.4} %",
         100.0 * e_sign,
@@ -176,7 +135,7 @@ fn without_a_stribeck_effect_it_is_no_worse_than_sign() {
 
 #[test]
 fn bad_stribeck_parameters_are_refused_with_the_joint_named() {
-    let robot = robot();
+    let robot = ur5();
     let traj = recording(&robot, 5, true);
     // The simulator refuses a Stribeck velocity that is not positive.
     let times: Vec<f64> = (0..10).map(|k| 0.01 * k as f64).collect();
@@ -229,15 +188,15 @@ fn bad_stribeck_parameters_are_refused_with_the_joint_named() {
 /// result is carried to every sample, and the parameters still come back.
 #[test]
 fn a_long_recording_is_fitted_on_a_part_then_on_every_sample() {
-    let robot = robot();
+    let robot = ur5();
     let len = dyngen_identify::stribeck::ROUND_SAMPLES + 6_000;
     let times: Vec<f64> = (0..len).map(|k| 0.005 * k as f64).collect();
     let mut rec = record_trajectory(&robot, &robot.model().standard_params(), &motion(7), &times);
-    let joints: Vec<f64> = (0..6).flat_map(|j| [IA[j], FV[j], FC[j], F0[j]]).collect();
+    let joints = joint_truth();
     let truth: Vec<Stribeck> = (0..6).map(|j| Stribeck { fs: FS[j], vs: VS[j] }).collect();
     add_joint_terms(&mut rec, &joints, Coulomb::Sign);
     add_stribeck_terms(&mut rec, &joints, &truth, Coulomb::Sign).unwrap();
-    add_torque_noise(&mut rec, 8);
+    add_torque_noise(&mut rec, &mut Gaussian::new(8));
     let traj = rec.to_trajectory().unwrap();
     let id = identify(&robot, &traj, JointTerms::Stribeck(Coulomb::Sign));
     let fit = id.stribeck.as_ref().unwrap();

@@ -25,6 +25,30 @@ pub fn rel_err(x: &[f64], y: &[f64], floor: f64) -> f64 {
     diff / scale
 }
 
+/// Evaluates the symbolic graph's `outputs` with `q`, `v`, `a` (or `tau`, for
+/// `aba`) and `params` as its arguments: the generator's algorithms without
+/// compiling them.
+pub fn eval_graph(
+    g: &dyngen_codegen::sym::Graph,
+    outputs: &[dyngen_codegen::sym::NodeId],
+    q: &[f64],
+    v: &[f64],
+    a_or_tau: &[f64],
+    params: &[f64],
+) -> Vec<f64> {
+    use dyngen_codegen::algo::{ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
+    g.eval(outputs, |arg, index| {
+        let i = index as usize;
+        match arg {
+            ARG_Q => q[i],
+            ARG_V => v[i],
+            ARG_A => a_or_tau[i],
+            ARG_PARAMS => params[i],
+            _ => panic!("unknown argument {arg}"),
+        }
+    })
+}
+
 /// A pose as 12 numbers: rotation row-major, then translation.
 pub fn pose_vec(p: &dyngen::Pose<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(12);

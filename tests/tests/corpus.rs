@@ -5,11 +5,11 @@
 //! from the expression graph, so nothing this large is compiled here), and the
 //! reference implementation.
 
-use dyngen_codegen::algo::{self, Inputs, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
+use dyngen_codegen::algo::{self, Inputs};
 use dyngen_codegen::sym::{Graph, NodeId};
 use dyngen_model::{load_urdf, Model};
 use dyngen_reference::Reference;
-use dyngen_tests::{load_fixture, pose_vec, rel_err, workspace_root, wrench_vec, Fixture};
+use dyngen_tests::{eval_graph as eval, load_fixture, pose_vec, rel_err, workspace_root, wrench_vec, Fixture};
 
 /// Agreement required with Pinocchio (normwise, relative).
 const TOL: f64 = 1e-10;
@@ -24,19 +24,6 @@ fn load(name: &str) -> (Model, Fixture) {
 
 fn rows(m: &[Vec<f64>]) -> Vec<f64> {
     m.iter().flatten().copied().collect()
-}
-
-fn eval(g: &Graph, outputs: &[NodeId], q: &[f64], v: &[f64], a_or_tau: &[f64], params: &[f64]) -> Vec<f64> {
-    g.eval(outputs, |arg, index| {
-        let i = index as usize;
-        match arg {
-            ARG_Q => q[i],
-            ARG_V => v[i],
-            ARG_A => a_or_tau[i],
-            ARG_PARAMS => params[i],
-            _ => panic!("unknown argument {arg}"),
-        }
-    })
 }
 
 /// The model as loaded has Pinocchio's joints, numbering, parents and parameters.

@@ -11,14 +11,14 @@
 //! and every algorithm against the reference on a few random states with perturbed
 //! parameters.
 
-use dyngen_codegen::algo::{self, Force, Inputs, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
+use dyngen_codegen::algo::{self, Force, Inputs, ARG_Q};
 use dyngen_codegen::sym::{Expr, Graph, NodeId};
 use dyngen_model::math::{self, Mat3, Vec3};
 use dyngen_model::{
     DeclaredJointType, Description, Inertial, JointDesc, JointKind, Limits, LinkDesc, Model, Placement, DEFAULT_GRAVITY,
 };
 use dyngen_reference::{perturbed_params, sample_states, Reference, SplitMix64, State};
-use dyngen_tests::{pose_vec, rel_err, wrench_vec};
+use dyngen_tests::{eval_graph as eval, pose_vec, rel_err, wrench_vec};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Agreement required between the graph and the reference (normwise, relative).
@@ -354,21 +354,6 @@ impl Symbolic {
             body_resultants: force_ids(&algo::body_resultants(g, model)),
         }
     }
-}
-
-/// Evaluates `outputs` with `q`, `v`, `a` (or `tau`, for `aba`) and `params` as the
-/// graph's arguments.
-fn eval(g: &Graph, outputs: &[NodeId], q: &[f64], v: &[f64], a_or_tau: &[f64], params: &[f64]) -> Vec<f64> {
-    g.eval(outputs, |arg, index| {
-        let i = index as usize;
-        match arg {
-            ARG_Q => q[i],
-            ARG_V => v[i],
-            ARG_A => a_or_tau[i],
-            ARG_PARAMS => params[i],
-            _ => panic!("unknown argument {arg}"),
-        }
-    })
 }
 
 /// A regressor evaluated with its structural zeros as 0, and the positions of those

@@ -22,37 +22,10 @@ by joint name, whatever the declaration order (the humanoid's chest declares its
 children l_arm, r_arm, neck; by name they are l_arm, neck, r_arm).
 """
 import argparse
-import math
 import os
 import sys
 
-import numpy as np
-
-from urdf_writer import ROOT, joint_xml, link_xml
-
-
-def rpy_matrix(r, p, y):
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
-
-
-def sig6(x):
-    return float(f"{x:.6g}")
-
-
-def box_inertia(name, m, dims, rpy):
-    a, b, c = dims
-    box = np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
-    R = rpy_matrix(*rpy)
-    inertia = R @ box @ R.T
-    inertia = np.vectorize(sig6)(0.5 * (inertia + inertia.T))
-    ev = np.linalg.eigvalsh(inertia)
-    if not (ev[0] > 0 and ev[2] < ev[0] + ev[1] - 1e-6 * ev.sum()):
-        sys.exit(f"{name}: rounded inertia not physical: {ev}")
-    return inertia
+from urdf_writer import ROOT, box_inertia, joint_xml, link_xml
 
 
 class Robot:

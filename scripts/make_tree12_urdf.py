@@ -20,12 +20,7 @@ turned by a fixed rpy relative to the link frame, giving full tensors that are
 physical by construction; the tensors are rounded to 6 significant digits and
 re-checked (positive definite, triangle inequalities with margin).
 """
-import math
-import sys
-
-import numpy as np
-
-from urdf_writer import joint_xml, link_xml, main
+from urdf_writer import box_inertia, joint_xml, link_xml, main
 
 # Links: name -> (mass kg, com xyz in link frame, box dims (x, y, z) m, box rpy in link frame)
 LINKS = {
@@ -82,28 +77,9 @@ LINK_ORDER = ["base_link", "torso_link", "neck_link", "head_link", "camera_link"
               "r_hand_link", "l_shoulder_link", "l_upper_arm_link", "l_forearm_link", "l_hand_link"]
 
 
-def rpy_matrix(r, p, y):
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
-
-
-def sig6(x):
-    return float(f"{x:.6g}")
-
-
 def inertia(name):
-    m, _, (a, b, c), rpy = LINKS[name]
-    box = np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
-    R = rpy_matrix(*rpy)
-    I = R @ box @ R.T
-    I = np.vectorize(sig6)(0.5 * (I + I.T))
-    ev = np.linalg.eigvalsh(I)
-    if not (ev[0] > 0 and ev[2] < ev[0] + ev[1] - 1e-6 * ev.sum()):
-        sys.exit(f"{name}: rounded inertia not physical: {ev}")
-    return I
+    m, _, dims, rpy = LINKS[name]
+    return box_inertia(name, m, dims, rpy)
 
 
 def tree_joint_xml(j):

@@ -39,6 +39,34 @@ def fmt(v):
     return " ".join(repr(clean(x)) for x in v)
 
 
+def rpy_matrix(r, p, y):
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def sig6(x):
+    return float(f"{x:.6g}")
+
+
+def box_inertia(name, m, dims, rpy):
+    """The inertia (3 x 3, about the centre of mass) of a homogeneous box of mass `m` and
+    dimensions `dims`, its axes turned by `rpy` in the link frame: full and physical by
+    construction, rounded to 6 significant digits and re-checked (exits naming `name`
+    if rounding broke it)."""
+    a, b, c = dims
+    box = np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
+    R = rpy_matrix(*rpy)
+    inertia = R @ box @ R.T
+    inertia = np.vectorize(sig6)(0.5 * (inertia + inertia.T))
+    ev = np.linalg.eigvalsh(inertia)
+    if not (ev[0] > 0 and ev[2] < ev[0] + ev[1] - 1e-6 * ev.sum()):
+        sys.exit(f"{name}: rounded inertia not physical: {ev}")
+    return inertia
+
+
 def inertial_xml(mass, com, I, indent="    "):
     """The `<inertial>` element of a link: centre of mass `com`, inertia `I` (3 x 3)
     about it in link axes."""

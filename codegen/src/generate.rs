@@ -225,14 +225,14 @@ impl In {
 
 /// A `dyngen` type returned per body, built from a fixed number of outputs.
 #[derive(Clone, Copy)]
-enum Record {
+pub(crate) enum Record {
     Pose,
     Wrench,
     BodyRegressor,
 }
 
 impl Record {
-    fn ty(self) -> TokenStream {
+    pub(crate) fn ty(self) -> TokenStream {
         match self {
             Record::Pose => quote!(::dyngen::Pose<S>),
             Record::Wrench => quote!(::dyngen::Wrench<S>),
@@ -248,7 +248,7 @@ impl Record {
         }
     }
 
-    fn build(self, c: &[TokenStream]) -> TokenStream {
+    pub(crate) fn build(self, c: &[TokenStream]) -> TokenStream {
         match self {
             Record::Pose => {
                 let (r, t) = (&c[..9], &c[9..]);
@@ -721,7 +721,12 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     functions.extend(joints.reports);
     items.extend(joints.items);
     methods.extend(joints.methods);
-    let tokens = robot_type(model, &format_ident!("{}", name), bases, &functions, &items, &methods);
+    let ty = format_ident!("{}", name);
+    let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
+    functions.extend(frames.reports);
+    items.extend(frames.items);
+    let mut tokens = robot_type(model, &ty, bases, &functions, &items, &methods);
+    tokens.extend(frames.enum_item);
     GeneratedCode {
         tokens,
         functions,
@@ -731,7 +736,7 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
 
 /// `#[doc]` attributes, one per line of `text`, so that prettyplease prints `///`
 /// lines (a multi-line string would come out as a `/** … */` block).
-fn doc_attrs(text: &str) -> TokenStream {
+pub(crate) fn doc_attrs(text: &str) -> TokenStream {
     let lines = text
         .lines()
         .map(|l| if l.is_empty() { String::new() } else { format!(" {l}") });
@@ -797,6 +802,18 @@ fn model_expr(model: &Model) -> TokenStream {
             merged: &[#(#merged),*],
         })
     });
+    let frames = model.frames.iter().map(|f| {
+        let name = &f.name;
+        let body = emit::usize_lit(f.body);
+        let rotation = mat3(&f.placement.rotation);
+        let translation = f64_array(&f.placement.translation);
+        quote!(::dyngen::FrameModel {
+            name: #name,
+            body: #body,
+            rotation: #rotation,
+            translation: #translation,
+        })
+    });
     let (name, base) = (&model.name, &model.base);
     let gravity = f64_array(&model.gravity);
     quote!(::dyngen::RobotModel {
@@ -805,6 +822,7 @@ fn model_expr(model: &Model) -> TokenStream {
         base: #base,
         joints: &[#(#joints),*],
         bodies: &[#(#bodies),*],
+        frames: &[#(#frames),*],
     })
 }
 

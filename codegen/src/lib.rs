@@ -17,6 +17,7 @@ pub mod base;
 mod build;
 pub mod dsl;
 pub mod emit;
+mod frames;
 mod generate;
 mod joints;
 pub mod sym;

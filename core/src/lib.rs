@@ -21,21 +21,27 @@ extern crate std;
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos, sqrt and tanh");
 
+mod derivatives;
+mod frames;
 mod joints;
 mod robot;
 mod robot_model;
 mod scalar;
 
 pub use dyngen_macros::robot;
+pub use derivatives::{AbaDerivatives, Linearization, RneaDerivatives};
+pub use frames::{FrameJacobian, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
 pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
-pub use robot_model::{BodyModel, JointLimits, JointModel, JointType, RobotModel};
+pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
 pub use scalar::Scalar;
 
 /// Support for generated code; not a public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::frames::__express_jacobian as express_jacobian;
+
     /// A slice as a fixed-size array, with a message naming the argument when the
     /// length is wrong.
     #[inline(always)]

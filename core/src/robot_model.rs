@@ -55,6 +55,19 @@ pub struct BodyModel {
     pub merged: &'static [&'static str],
 }
 
+/// A named frame rigidly attached to a body: a link of the description (the base
+/// link, a moving body's own link, a link merged through a fixed joint such as a
+/// tool flange) or a frame a `robot!` description declares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameModel {
+    pub name: &'static str,
+    /// The body it is attached to: 0 is the fixed base.
+    pub body: usize,
+    /// The frame in the body's frame: `x_body = rotation · x_frame + translation`.
+    pub rotation: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+}
+
 /// A fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
 /// `bodies[j - 1]` (body `j`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,4 +79,7 @@ pub struct RobotModel {
     pub base: &'static str,
     pub joints: &'static [JointModel],
     pub bodies: &'static [BodyModel],
+    /// Every named frame, the base link first; a generated robot's frame index
+    /// (`R::frame_index`, its frame enum) indexes this list.
+    pub frames: &'static [FrameModel],
 }

@@ -4,7 +4,7 @@
 //! declaration order, or by joint name as Pinocchio and urdfdom number them).
 
 use crate::error::{Element, ErrorKind, ModelError};
-use crate::ir::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+use crate::ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
 use std::collections::HashMap;
 
@@ -350,6 +350,11 @@ impl Description {
             base: self.links[root].name.clone(),
             joints: Vec::new(),
             bodies: Vec::new(),
+            frames: vec![Frame {
+                name: self.links[root].name.clone(),
+                body: 0,
+                placement: Placement::IDENTITY,
+            }],
             warnings: Vec::new(),
         };
         let mut warnings = Vec::new();
@@ -388,6 +393,11 @@ impl Description {
                 }
                 _ => (owner, origin),
             };
+            model.frames.push(Frame {
+                name: self.links[link].name.clone(),
+                body,
+                placement,
+            });
             // Lump this link's inertial into its owning body (the base's is ignored).
             if body > 0 {
                 if let Some(inertial) = &self.links[link].inertial {

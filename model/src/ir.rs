@@ -228,6 +228,18 @@ pub struct Body {
     pub merged: Vec<String>,
 }
 
+/// A named frame rigidly attached to a body: every link of the description (the
+/// base link, each moving body's own link, the links merged through fixed joints)
+/// and the frames a `robot!` description declares.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub name: String,
+    /// The body it is attached to: 0 is the fixed base.
+    pub body: usize,
+    /// The frame in the body's frame: `x_body = rotation · x_frame + translation`.
+    pub placement: Placement,
+}
+
 /// A checked fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
 /// `bodies[j - 1]` (body `j`), and `joints[j - 1].parent < j`.
 #[derive(Clone, Debug, PartialEq)]
@@ -239,6 +251,10 @@ pub struct Model {
     pub base: String,
     pub joints: Vec<Joint>,
     pub bodies: Vec<Body>,
+    /// Every named frame: the base link first, then the links in the order the
+    /// depth-first numbering reaches them (each body's own link before the links
+    /// merged into it). Names are unique.
+    pub frames: Vec<Frame>,
     /// What the front end accepted but the user should know: inertias that break
     /// physical consistency within [`INERTIA_TOLERANCE`](crate::desc::INERTIA_TOLERANCE)
     /// (CAD rounding), kept as written. Empty for a strict build.
@@ -277,6 +293,11 @@ impl Model {
     /// The nominal standard parameters of every body, 10 per body, body 1 first.
     pub fn standard_params(&self) -> Vec<f64> {
         self.bodies.iter().flat_map(|b| b.inertial.standard_params()).collect()
+    }
+
+    /// The frame named `name`, by its index in [`Model::frames`].
+    pub fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|f| f.name == name)
     }
 
     /// Whether joint `a` (1-based) lies on the path from body `i` to the base.

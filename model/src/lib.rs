@@ -41,7 +41,7 @@ pub use desc::{
     JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY, INERTIA_TOLERANCE,
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
-pub use ir::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, load_urdf_with, parse_urdf, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

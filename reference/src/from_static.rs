@@ -3,7 +3,7 @@
 //! so the reference, identification and NIM see exactly the generator's numbering.
 
 use dyngen::{JointType, Robot, RobotModel};
-use dyngen_model::{Body, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+use dyngen_model::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
 
 /// The runtime model of a generated robot's `MODEL`.
 pub fn model_from_static(m: &RobotModel) -> Model {
@@ -51,6 +51,18 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     inertia: b.inertia,
                 },
                 merged: b.merged.iter().map(|s| s.to_string()).collect(),
+            })
+            .collect(),
+        frames: m
+            .frames
+            .iter()
+            .map(|f| Frame {
+                name: f.name.to_string(),
+                body: f.body,
+                placement: Placement {
+                    rotation: f.rotation,
+                    translation: f.translation,
+                },
             })
             .collect(),
     }

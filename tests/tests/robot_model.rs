@@ -58,6 +58,14 @@ fn check<R: Robot>(want: &Model) {
         assert_eq!(g.inertia, w.inertial.inertia, "{who}: {b} inertia");
         assert_eq!(g.merged, w.merged, "{who}: {b} merged links");
     }
+    assert_eq!(got.frames.len(), want.frames.len(), "{who}: frames");
+    for (g, w) in got.frames.iter().zip(&want.frames) {
+        let f = &w.name;
+        assert_eq!(g.name, w.name, "{who}: frame name");
+        assert_eq!(g.body, w.body, "{who}: {f} body");
+        assert_eq!(g.rotation, w.placement.rotation, "{who}: {f} rotation");
+        assert_eq!(g.translation, w.placement.translation, "{who}: {f} translation");
+    }
     // What the other constants say agrees with the model.
     assert_eq!(
         R::parents(),

@@ -1,0 +1,601 @@
+//! Frames in generated code: every link of the description (and every frame a `robot!`
+//! description declares) is a named frame with a placement, a Jacobian, a velocity
+//! and a classical acceleration, and the robot gets its centre of mass and the
+//! centre of mass's Jacobian. Each frame's functions walk only the bodies between the
+//! base and the frame, so only the Jacobian columns of the joints on that path are
+//! computed; the others are exact zeros.
+//!
+//! Everything is built in world axes at the frame origin (Pinocchio's
+//! `LOCAL_WORLD_ALIGNED`): joint `k`'s column is `[z_k × (p − o_k); z_k]` for a
+//! revolute joint (`z_k` its axis, `o_k` its origin, `p` the frame origin) and
+//! `[z_k; 0]` for a prismatic one. `dyngen::FrameJacobian` and `dyngen::FrameMotion`
+//! turn that into `LOCAL` or `WORLD` at run time, a few products per column.
+
+use crate::algo::{BodyParams, JointTransform, M3, V3, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
+use crate::emit::{self, Arg, FnReport, FnSpec, Output};
+use crate::generate::{doc_attrs, Record, Sizes};
+use crate::sym::{Expr, Graph, NodeId};
+use dyngen_model::Model;
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+/// A body's placement and motion in world axes: rotation `r`, origin `t`, angular
+/// velocity `w`, velocity `v` and classical acceleration `acc` of the origin, angular
+/// acceleration `wd`. Gravity plays no part here.
+#[derive(Clone, Copy)]
+struct WorldBody<'g> {
+    r: M3<'g>,
+    t: V3<'g>,
+    w: V3<'g>,
+    v: V3<'g>,
+    wd: V3<'g>,
+    acc: V3<'g>,
+}
+
+/// Joint `k`'s axis `z` and origin `o` in the world (the origin is body `k`'s).
+#[derive(Clone, Copy)]
+struct WorldJoint<'g> {
+    z: V3<'g>,
+    o: V3<'g>,
+    revolute: bool,
+}
+
+/// What a walk from the base computes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Walk {
+    /// Placements only.
+    Placement,
+    /// Placements, velocities and accelerations (reading `v` and `a`).
+    Motion,
+}
+
+/// The bodies from the base to `body`, base side first (body 0 excluded).
+fn path(model: &Model, body: usize) -> Vec<usize> {
+    let mut p = Vec::new();
+    let mut k = body;
+    while k != 0 {
+        p.push(k);
+        k = model.parent(k);
+    }
+    p.reverse();
+    p
+}
+
+/// Walks `bodies` (each one's parent walked before it, or the base) and returns, for
+/// every body index `0..=n`, its world placement and motion where it was walked, and
+/// the joints of the walked bodies.
+fn walk<'g>(
+    g: &'g Graph,
+    model: &Model,
+    bodies: &[usize],
+    what: Walk,
+) -> (Vec<Option<WorldBody<'g>>>, Vec<Option<WorldJoint<'g>>>) {
+    let n = model.dof();
+    let zero = V3::zero(g);
+    let mut world: Vec<Option<WorldBody<'g>>> = vec![None; n + 1];
+    world[0] = Some(WorldBody {
+        r: M3::constant(g, dyngen_model::math::IDENTITY),
+        t: zero,
+        w: zero,
+        v: zero,
+        wd: zero,
+        acc: zero,
+    });
+    let mut joints = vec![None; n + 1];
+    for &k in bodies {
+        let p = world[model.parent(k)].expect("parents are walked before their children");
+        let x = JointTransform::new(g, model, k);
+        let joint = &model.joints[k - 1];
+        let r0 = p.r.mul(&x.origin);
+        let z = r0.mul_vec(V3::constant(g, joint.axis));
+        let d = p.r.mul_vec(x.translation);
+        let t = p.t + d;
+        let revolute = joint.kind.is_revolute();
+        joints[k] = Some(WorldJoint { z, o: t, revolute });
+        let mut b = WorldBody {
+            r: r0.mul(&x.motion),
+            t,
+            w: zero,
+            v: zero,
+            wd: zero,
+            acc: zero,
+        };
+        if what == Walk::Motion {
+            let qd = g.input(ARG_V, (k - 1) as u32);
+            let qdd = g.input(ARG_A, (k - 1) as u32);
+            let zqd = z.scale(qd);
+            // The parent's velocity and acceleration carried to the joint origin.
+            let v = p.v + p.w.cross(d);
+            let acc = p.acc + p.wd.cross(d) + p.w.cross(p.w.cross(d));
+            if revolute {
+                b.w = p.w + zqd;
+                b.wd = p.wd + z.scale(qdd) + p.w.cross(zqd);
+                b.v = v;
+                b.acc = acc;
+            } else {
+                b.w = p.w;
+                b.wd = p.wd;
+                b.v = v + zqd;
+                b.acc = acc + z.scale(qdd) + p.w.cross(zqd).scale(g.constant(2.0));
+            }
+        }
+        world[k] = Some(b);
+    }
+    (world, joints)
+}
+
+/// The frame's world rotation and origin, and its offset `e = R_b p_f` from its
+/// body's origin.
+fn frame_pose<'g>(g: &'g Graph, model: &Model, f: usize, body: &WorldBody<'g>) -> (M3<'g>, V3<'g>, V3<'g>) {
+    let pl = &model.frames[f].placement;
+    let e = body.r.mul_vec(V3::constant(g, pl.translation));
+    (body.r.mul(&M3::constant(g, pl.rotation)), body.t + e, e)
+}
+
+fn pose_ids(r: &M3<'_>, t: &V3<'_>) -> Vec<NodeId> {
+    r.0.iter().flatten().chain(t.0.iter()).map(|x| x.id()).collect()
+}
+
+fn v3_ids<'a>(v: &'a V3<'_>) -> impl Iterator<Item = NodeId> + 'a {
+    v.0.iter().map(|x| x.id())
+}
+
+/// Frame `f`'s placement (12 outputs: rotation row-major, translation).
+fn build_placement(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+    let b = model.frames[f].body;
+    let (world, _) = walk(g, model, &path(model, b), Walk::Placement);
+    let (r, t, _) = frame_pose(g, model, f, &world[b].expect("walked"));
+    pose_ids(&r, &t)
+}
+
+/// Every frame's placement, one walk over all bodies.
+fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
+    let all: Vec<usize> = (1..=model.dof()).collect();
+    let (world, _) = walk(g, model, &all, Walk::Placement);
+    (0..model.frames.len())
+        .flat_map(|f| {
+            let (r, t, _) = frame_pose(g, model, f, &world[model.frames[f].body].expect("walked"));
+            pose_ids(&r, &t)
+        })
+        .collect()
+}
+
+/// Frame `f`'s placement (12) and `LOCAL_WORLD_ALIGNED` Jacobian (6 × n, row-major).
+fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+    let n = model.dof();
+    let b = model.frames[f].body;
+    let on_path = path(model, b);
+    let (world, joints) = walk(g, model, &on_path, Walk::Placement);
+    let (r, p, _) = frame_pose(g, model, f, &world[b].expect("walked"));
+    let mut jac = vec![vec![g.zero(); n]; 6];
+    for &k in &on_path {
+        let j = joints[k].expect("walked");
+        let (lin, ang) = if j.revolute {
+            (j.z.cross(p - j.o), j.z)
+        } else {
+            (j.z, V3::zero(g))
+        };
+        for (row, e) in lin.0.iter().chain(ang.0.iter()).enumerate() {
+            jac[row][k - 1] = *e;
+        }
+    }
+    let mut out = pose_ids(&r, &p);
+    out.extend(jac.iter().flatten().map(|x| x.id()));
+    out
+}
+
+/// Frame `f`'s placement (12), velocity (6) and classical acceleration (6) of its
+/// origin, `LOCAL_WORLD_ALIGNED`.
+fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+    let bi = model.frames[f].body;
+    let (world, _) = walk(g, model, &path(model, bi), Walk::Motion);
+    let b = world[bi].expect("walked");
+    let (r, p, e) = frame_pose(g, model, f, &b);
+    let v = b.v + b.w.cross(e);
+    let acc = b.acc + b.wd.cross(e) + b.w.cross(b.w.cross(e));
+    let mut out = pose_ids(&r, &p);
+    out.extend(v3_ids(&v).chain(v3_ids(&b.w)).chain(v3_ids(&acc)).chain(v3_ids(&b.wd)));
+    out
+}
+
+/// Per body `i`: `m_i` and `m_i c_i` (the first moment about the world origin, world
+/// axes), from the symbolic parameters.
+fn moments<'g>(g: &'g Graph, model: &Model, world: &[Option<WorldBody<'g>>]) -> Vec<(Expr<'g>, V3<'g>)> {
+    (1..=model.dof())
+        .map(|i| {
+            let b = world[i].expect("walked");
+            let p = BodyParams::input(g, i);
+            (p.m, b.t.scale(p.m) + b.r.mul_vec(p.h))
+        })
+        .collect()
+}
+
+/// The centre of mass (3 outputs).
+fn build_com(g: &Graph, model: &Model) -> Vec<NodeId> {
+    let all: Vec<usize> = (1..=model.dof()).collect();
+    let (world, _) = walk(g, model, &all, Walk::Placement);
+    let (m, h) = moments(g, model, &world)
+        .into_iter()
+        .fold((g.zero(), V3::zero(g)), |(m, h), (mi, hi)| (m + mi, h + hi));
+    v3_ids(&h.scale(g.one() / m)).collect()
+}
+
+/// The centre of mass's Jacobian (3 × n, row-major): column `k` is
+/// `z_k × (h_k − m_k o_k) / m` for a revolute joint and `z_k m_k / m` for a prismatic
+/// one, `m_k` and `h_k` the mass and first moment of the bodies joint `k` carries.
+fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
+    let n = model.dof();
+    let all: Vec<usize> = (1..=n).collect();
+    let (world, joints) = walk(g, model, &all, Walk::Placement);
+    let mut sub = moments(g, model, &world);
+    for i in (1..=n).rev() {
+        let p = model.parent(i);
+        if p > 0 {
+            let (mi, hi) = sub[i - 1];
+            let (mp, hp) = sub[p - 1];
+            sub[p - 1] = (mp + mi, hp + hi);
+        }
+    }
+    let total = (1..=n)
+        .filter(|&i| model.parent(i) == 0)
+        .fold(g.zero(), |m, i| m + sub[i - 1].0);
+    let inv = g.one() / total;
+    let mut jac = vec![vec![g.zero(); n]; 3];
+    for k in 1..=n {
+        let j = joints[k].expect("walked");
+        let (mk, hk) = sub[k - 1];
+        let col = if j.revolute {
+            j.z.cross(hk - j.o.scale(mk)).scale(inv)
+        } else {
+            j.z.scale(mk * inv)
+        };
+        for r in 0..3 {
+            jac[r][k - 1] = col.0[r];
+        }
+    }
+    jac.iter().flatten().map(|x| x.id()).collect()
+}
+
+/// A Rust identifier for frame names: `wrist_3_link` → `Wrist3Link`, unique among
+/// the frames (a numeric suffix where two names would meet).
+fn variant_names(model: &Model) -> Vec<syn::Ident> {
+    let mut taken = std::collections::HashSet::new();
+    model
+        .frames
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let mut s: String = f
+                .name
+                .split(|c: char| !c.is_ascii_alphanumeric())
+                .filter(|w| !w.is_empty())
+                .map(|w| {
+                    let mut c = w.chars();
+                    let first = c.next().map(|x| x.to_ascii_uppercase());
+                    first.into_iter().chain(c).collect::<String>()
+                })
+                .collect();
+            if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) || syn::parse_str::<syn::Ident>(&s).is_err()
+            {
+                s = format!("Frame{s}");
+            }
+            if !taken.insert(s.clone()) {
+                s = format!("{s}{k}");
+                taken.insert(s.clone());
+            }
+            format_ident!("{}", s)
+        })
+        .collect()
+}
+
+/// The frame enum's name for the robot type `ty`.
+pub(crate) fn frame_type(ty: &syn::Ident) -> syn::Ident {
+    format_ident!("{}Frame", ty)
+}
+
+/// What frames add to the generated code.
+pub(crate) struct FrameFns {
+    /// The frame enum, outside the robot type's `impl`.
+    pub enum_item: TokenStream,
+    /// Inherent functions and constants of the robot type, by name.
+    pub items: Vec<(String, TokenStream)>,
+    pub reports: Vec<FnReport>,
+}
+
+fn arg(id: u8, name: &'static str, len: usize) -> Arg {
+    Arg { id, name, len }
+}
+
+/// The frame enum and every frame function of the robot type `ty`.
+pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statements: usize) -> FrameFns {
+    let n = sizes.n;
+    let nf = model.frames.len();
+    let [n_l, nf_l] = [n, nf].map(emit::usize_lit);
+    let fty = frame_type(ty);
+    let variants = variant_names(model);
+    let mut items = Vec::new();
+    let mut reports = Vec::new();
+    // Emits `spec`, reporting its operation count under `report_as`.
+    let mut emit_one = |spec: FnSpec<'_>, g: &Graph, report_as: String| {
+        let (tokens, mut report) = emit::emit_fn(g, &spec, max_statements);
+        report.name = report_as;
+        reports.push(report);
+        tokens
+    };
+    let q = || arg(ARG_Q, "q", n);
+    let pose_ret = Record::Pose.ty();
+    let assemble_pose = |outs: &[TokenStream]| Record::Pose.build(outs);
+
+    // Per frame: placement, Jacobian, motion; private, dispatched by the enum.
+    let mut placement_fns = Vec::new();
+    let mut jacobian_fns = Vec::new();
+    let mut motion_fns = Vec::new();
+    let mut per_frame = Vec::new();
+    for (f, frame) in model.frames.iter().enumerate() {
+        let label = &frame.name;
+        let (pn, jn, mn) = (
+            format!("__frame_placement_{f}"),
+            format!("__frame_jacobian_{f}"),
+            format!("__frame_motion_{f}"),
+        );
+        let g = Graph::new();
+        let outputs = build_placement(&g, model, f);
+        let spec = FnSpec {
+            name: &pn,
+            public: false,
+            doc: format!("The placement of frame `{label}`."),
+            args: vec![q()],
+            ret: pose_ret.clone(),
+            output: Output::Return(Box::new(assemble_pose)),
+            outputs,
+        };
+        let mut t = emit_one(spec, &g, format!("frame_placement[{label}]"));
+
+        let g = Graph::new();
+        let outputs = build_jacobian(&g, model, f);
+        let place = move |k: usize| {
+            if k < 9 {
+                let (r, c) = (emit::usize_lit(k / 3), emit::usize_lit(k % 3));
+                quote!(out.placement.rotation[(#r, #c)])
+            } else if k < 12 {
+                let i = emit::usize_lit(k - 9);
+                quote!(out.placement.translation[#i])
+            } else {
+                let (r, c) = (emit::usize_lit((k - 12) / n), emit::usize_lit((k - 12) % n));
+                quote!(out.jacobian[#r][#c])
+            }
+        };
+        let spec = FnSpec {
+            name: &jn,
+            public: false,
+            doc: format!("The placement and `LOCAL_WORLD_ALIGNED` Jacobian of frame `{label}`."),
+            args: vec![q()],
+            ret: quote!(::dyngen::FrameJacobian<S, #n_l>),
+            output: Output::InPlace {
+                place: Box::new(place),
+                clear: quote!(*out = ::core::default::Default::default();),
+            },
+            outputs,
+        };
+        t.extend(emit_one(spec, &g, format!("frame_jacobian[{label}]")));
+
+        let g = Graph::new();
+        let outputs = build_motion(&g, model, f);
+        let assemble = |o: &[TokenStream]| {
+            let pose = Record::Pose.build(&o[..12]);
+            let m = |s: &[TokenStream]| {
+                let (l, a) = (&s[..3], &s[3..]);
+                quote!(::dyngen::Motion {
+                    linear: ::dyngen::nalgebra::Vector3::new(#(#l),*),
+                    angular: ::dyngen::nalgebra::Vector3::new(#(#a),*),
+                })
+            };
+            let (v, a) = (m(&o[12..18]), m(&o[18..24]));
+            quote!(::dyngen::FrameMotion { placement: #pose, velocity: #v, acceleration: #a })
+        };
+        let spec = FnSpec {
+            name: &mn,
+            public: false,
+            doc: format!(
+                "The placement, velocity and classical acceleration of frame `{label}`,\n`LOCAL_WORLD_ALIGNED`."
+            ),
+            args: vec![q(), arg(ARG_V, "v", n), arg(ARG_A, "a", n)],
+            ret: quote!(::dyngen::FrameMotion<S>),
+            output: Output::Return(Box::new(assemble)),
+            outputs,
+        };
+        t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
+        per_frame.push(t);
+        let v = &variants[f];
+        let (pn, jn, mn) = (format_ident!("{}", pn), format_ident!("{}", jn), format_ident!("{}", mn));
+        placement_fns.push(quote!(#fty::#v => Self::#pn(q)));
+        jacobian_fns.push(quote!(#fty::#v => Self::#jn(q, out)));
+        motion_fns.push(quote!(#fty::#v => Self::#mn(q, v, a)));
+    }
+
+    // All placements at once, and the centre of mass.
+    let g = Graph::new();
+    let outputs = build_placements(&g, model);
+    let spec = FnSpec {
+        name: "frame_placements",
+        public: true,
+        doc: format!(
+            "Every frame's placement in the world at `q` ({n} joint positions), in the order of\n`{fty}::ALL` (`Self::MODEL.frames`): `x_world = rotation · x_frame + translation`."
+        ),
+        args: vec![q()],
+        ret: quote!([::dyngen::Pose<S>; #nf_l]),
+        output: Output::Return(Box::new(|outs: &[TokenStream]| {
+            let items = outs.chunks(12).map(|c| Record::Pose.build(c));
+            quote!([#(#items),*])
+        })),
+        outputs,
+    };
+    let placements = emit_one(spec, &g, "frame_placements".to_string());
+
+    let params = || arg(ARG_PARAMS, "params", 10 * n);
+    let g = Graph::new();
+    let outputs = build_com(&g, model);
+    let spec = FnSpec {
+        name: "center_of_mass",
+        public: true,
+        doc: format!(
+            "The centre of mass of all moving bodies in the world, m (Pinocchio's `centerOfMass`\nwithout the base). `q`: {n} joint positions; {}.",
+            sizes.params()
+        ),
+        args: vec![q(), params()],
+        ret: quote!([S; 3]),
+        output: Output::Return(Box::new(|outs: &[TokenStream]| quote!([#(#outs),*]))),
+        outputs,
+    };
+    let com = emit_one(spec, &g, "center_of_mass".to_string());
+
+    let g = Graph::new();
+    let outputs = build_com_jacobian(&g, model);
+    let spec = FnSpec {
+        name: "com_jacobian",
+        public: true,
+        doc: format!(
+            "The Jacobian of the centre of mass (3 × {n}): `ċ = J_c(q) v`, world axes (Pinocchio's\n`jacobianCenterOfMass`). {}.",
+            sizes.params()
+        ),
+        args: vec![q(), params()],
+        ret: quote!([[S; #n_l]; 3]),
+        output: Output::InPlace {
+            place: Box::new(move |k: usize| {
+                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                quote!(out[#r][#c])
+            }),
+            clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
+        },
+        outputs,
+    };
+    let com_jacobian = emit_one(spec, &g, "com_jacobian".to_string());
+
+    let zero_a = quote!(&[<S as ::dyngen::Scalar>::ZERO; #n_l]);
+    let dispatch_doc = doc_attrs(&format!(
+        "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. Walks only the bodies between the\nbase and the frame."
+    ));
+    let jacobian_doc = doc_attrs(&format!(
+        "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`."
+    ));
+    let motion_doc = doc_attrs(
+        "Frame `frame`'s placement, velocity and classical acceleration at `(q, v, a)`,\n`LOCAL_WORLD_ALIGNED`; `FrameMotion::velocity_in` and\n`FrameMotion::classical_acceleration_in` express them in another reference frame.",
+    );
+    let velocity_doc = doc_attrs(
+        "Frame `frame`'s velocity at `(q, v)` in `reference` (Pinocchio's `getFrameVelocity`):\n`J(q) v`.",
+    );
+    let acc_doc = doc_attrs(
+        "Frame `frame`'s classical acceleration at `(q, v, a)` in `reference` (Pinocchio's\n`getFrameClassicalAcceleration`). With `a = 0` it is the drift `J̇(q, v)·v` of\n`ẍ = J q̈ + J̇ q̇`, the term operational-space and task-space controllers subtract.",
+    );
+    let nframes_doc = doc_attrs(&format!(
+        "Number of frames: every link of the description and every declared frame (`{fty}`)."
+    ));
+    items.push((
+        "frames".to_string(),
+        quote! {
+            #nframes_doc
+            pub const NFRAMES: usize = #nf_l;
+            #dispatch_doc
+            #[inline]
+            pub fn frame_placement<S: ::dyngen::Scalar>(q: &[S; #n_l], frame: #fty) -> ::dyngen::Pose<S> {
+                match frame { #(#placement_fns,)* }
+            }
+            #jacobian_doc
+            #[inline]
+            pub fn frame_jacobian<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame, out: &mut ::dyngen::FrameJacobian<S, #n_l>,
+            ) {
+                match frame { #(#jacobian_fns,)* }
+                ::dyngen::__private::express_jacobian(out, reference);
+            }
+            #motion_doc
+            #[inline]
+            pub fn frame_motion<S: ::dyngen::Scalar>(q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty) -> ::dyngen::FrameMotion<S> {
+                match frame { #(#motion_fns,)* }
+            }
+            #velocity_doc
+            #[inline]
+            pub fn frame_velocity<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+            ) -> ::dyngen::Motion<S> {
+                Self::frame_motion(q, v, #zero_a, frame).velocity_in(reference)
+            }
+            #acc_doc
+            #[inline]
+            pub fn frame_classical_acceleration<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+            ) -> ::dyngen::Motion<S> {
+                Self::frame_motion(q, v, a, frame).classical_acceleration_in(reference)
+            }
+            #placements
+            #com
+            #com_jacobian
+            #(#per_frame)*
+        },
+    ));
+
+    let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
+    let bodies = model.frames.iter().map(|f| emit::usize_lit(f.body));
+    let indices = (0..nf).map(emit::usize_lit);
+    let variant_docs = model.frames.iter().map(|f| {
+        let what = match f.body {
+            0 => "on the base".to_string(),
+            b if model.bodies[b - 1].name == f.name => format!("body {b}'s own frame"),
+            b => format!("on body {b} (`{}`)", model.bodies[b - 1].name),
+        };
+        format!(" Frame `{}`, {what}.", f.name)
+    });
+    let enum_doc = doc_attrs(&format!(
+        "The frames of [`{ty}`]: every link of the description (links on fixed joints\nincluded) and every frame the description declares, in the order of\n`{ty}::MODEL.frames`."
+    ));
+    let index_arms = variants.iter().zip(indices.clone()).map(|(v, i)| quote!(#fty::#v => #i));
+    let from_index_arms = variants.iter().zip(indices).map(|(v, i)| quote!(#i => Some(#fty::#v)));
+    let enum_item = quote! {
+        #enum_doc
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[allow(non_camel_case_types)]
+        pub enum #fty {
+            #(#[doc = #variant_docs] #variants,)*
+        }
+
+        #[allow(clippy::all)]
+        impl #fty {
+            /// Every frame, in index order.
+            pub const ALL: [#fty; #nf_l] = [#(#fty::#variants),*];
+            /// Frame names (the description's link names), in index order.
+            pub const NAMES: [&'static str; #nf_l] = [#(#names),*];
+            /// The body each frame is attached to (0 = base), in index order.
+            pub const BODIES: [usize; #nf_l] = [#(#bodies),*];
+
+            /// The frame's index in `ALL` and in the robot's `MODEL.frames`.
+            pub const fn index(self) -> usize {
+                match self { #(#index_arms,)* }
+            }
+
+            /// The frame at `index`, if there is one.
+            pub const fn from_index(index: usize) -> ::core::option::Option<#fty> {
+                match index { #(#from_index_arms,)* _ => None }
+            }
+
+            /// The frame named `name` (a link name of the description), if there is one.
+            pub fn from_name(name: &str) -> ::core::option::Option<#fty> {
+                Self::NAMES.iter().position(|n| *n == name).and_then(Self::from_index)
+            }
+
+            /// The frame's name.
+            pub const fn name(self) -> &'static str {
+                Self::NAMES[self.index()]
+            }
+
+            /// The body the frame is attached to (0 = base).
+            pub const fn body(self) -> usize {
+                Self::BODIES[self.index()]
+            }
+        }
+    };
+    FrameFns {
+        enum_item,
+        items,
+        reports,
+    }
+}

@@ -1,0 +1,237 @@
+//! Frames and their kinematics: the value types of the generated frame functions and
+//! the change of reference frame, in Pinocchio's conventions. Generated code computes
+//! everything `LOCAL_WORLD_ALIGNED` (at the frame origin, world axes); the other two
+//! reference frames follow from the frame's placement in a few products.
+
+use crate::{Pose, Scalar};
+use nalgebra::Vector3;
+
+/// In which frame a velocity, an acceleration or a Jacobian is expressed, as
+/// Pinocchio's `ReferenceFrame`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ReferenceFrame {
+    /// The frame's own axes, at its origin (Pinocchio's `LOCAL`).
+    Local,
+    /// World axes, at the frame's origin (Pinocchio's `LOCAL_WORLD_ALIGNED`): the
+    /// linear part is the velocity of the frame origin as a world vector. What
+    /// operational-space controllers usually want.
+    #[default]
+    LocalWorldAligned,
+    /// World axes, at the world origin (Pinocchio's `WORLD`): the spatial velocity of
+    /// the body seen at the world origin.
+    World,
+}
+
+/// A spatial motion vector (a twist, or an acceleration) with named parts: linear
+/// first, then angular, as Pinocchio orders them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion<S: Scalar> {
+    pub linear: Vector3<S>,
+    pub angular: Vector3<S>,
+}
+
+impl<S: Scalar> Default for Motion<S> {
+    fn default() -> Self {
+        Motion {
+            linear: Vector3::from_element(S::ZERO),
+            angular: Vector3::from_element(S::ZERO),
+        }
+    }
+}
+
+impl<S: Scalar> Motion<S> {
+    /// `[linear; angular]`.
+    pub fn to_array(&self) -> [S; 6] {
+        let (l, a) = (&self.linear, &self.angular);
+        [l[0], l[1], l[2], a[0], a[1], a[2]]
+    }
+}
+
+/// A frame's placement and its Jacobian `J` (6 × N, rows `[linear; angular]`,
+/// column `k` the motion of the frame for a unit velocity of joint `k`), the output of
+/// the generated `frame_jacobian`. Columns of joints that do not move the frame are
+/// exact zeros.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameJacobian<S: Scalar, const N: usize> {
+    /// The frame in the world: `x_world = rotation · x_frame + translation`.
+    pub placement: Pose<S>,
+    pub jacobian: [[S; N]; 6],
+}
+
+impl<S: Scalar, const N: usize> Default for FrameJacobian<S, N> {
+    fn default() -> Self {
+        FrameJacobian {
+            placement: Pose::default(),
+            jacobian: [[S::ZERO; N]; 6],
+        }
+    }
+}
+
+impl<S: Scalar, const N: usize> FrameJacobian<S, N> {
+    /// The frame's velocity `J · v` for joint velocities `v`, in the reference frame
+    /// the Jacobian is expressed in.
+    pub fn velocity(&self, v: &[S; N]) -> Motion<S> {
+        let row = |r: usize| {
+            let mut s = S::ZERO;
+            for k in 0..N {
+                s += self.jacobian[r][k] * v[k];
+            }
+            s
+        };
+        Motion {
+            linear: Vector3::new(row(0), row(1), row(2)),
+            angular: Vector3::new(row(3), row(4), row(5)),
+        }
+    }
+
+    /// Re-expresses a `LOCAL_WORLD_ALIGNED` Jacobian (as the generated code writes it)
+    /// in `reference`.
+    pub(crate) fn express_from_lwa(&mut self, reference: ReferenceFrame) {
+        for k in 0..N {
+            let column = Motion {
+                linear: Vector3::new(self.jacobian[0][k], self.jacobian[1][k], self.jacobian[2][k]),
+                angular: Vector3::new(self.jacobian[3][k], self.jacobian[4][k], self.jacobian[5][k]),
+            };
+            let c = velocity_from_lwa(&self.placement, &column, reference).to_array();
+            for r in 0..6 {
+                self.jacobian[r][k] = c[r];
+            }
+        }
+    }
+}
+
+/// A frame's placement, velocity and classical acceleration, `LOCAL_WORLD_ALIGNED`,
+/// as the generated `frame_motion` computes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameMotion<S: Scalar> {
+    pub placement: Pose<S>,
+    /// Linear: the velocity of the frame origin; angular: the body's angular velocity.
+    pub velocity: Motion<S>,
+    /// Linear: the classical acceleration of the frame origin (the second time
+    /// derivative of its position); angular: the body's angular acceleration.
+    pub acceleration: Motion<S>,
+}
+
+impl<S: Scalar> Default for FrameMotion<S> {
+    fn default() -> Self {
+        FrameMotion {
+            placement: Pose::default(),
+            velocity: Motion::default(),
+            acceleration: Motion::default(),
+        }
+    }
+}
+
+impl<S: Scalar> FrameMotion<S> {
+    /// The velocity in `reference` (Pinocchio's `getFrameVelocity`).
+    pub fn velocity_in(&self, reference: ReferenceFrame) -> Motion<S> {
+        velocity_from_lwa(&self.placement, &self.velocity, reference)
+    }
+
+    /// The classical acceleration in `reference` (Pinocchio's
+    /// `getFrameClassicalAcceleration`): the spatial acceleration in that frame plus
+    /// `ω × v` on the linear part. In `LOCAL` and `LOCAL_WORLD_ALIGNED` its linear part
+    /// is the acceleration of the frame origin; with `a = 0` it is the drift `J̇(q, v)·v`.
+    pub fn classical_acceleration_in(&self, reference: ReferenceFrame) -> Motion<S> {
+        let (acc, w) = (&self.acceleration, &self.velocity.angular);
+        match reference {
+            ReferenceFrame::LocalWorldAligned => *acc,
+            ReferenceFrame::Local => rotate_back(&self.placement, acc),
+            ReferenceFrame::World => {
+                // At the world origin O: a_O = a_p − ω̇ × p − ω × (ω × p).
+                let p = &self.placement.translation;
+                Motion {
+                    linear: acc.linear - acc.angular.cross(p) - w.cross(&w.cross(p)),
+                    angular: acc.angular,
+                }
+            }
+        }
+    }
+}
+
+/// `Rᵀ m`: a world-aligned motion in the frame's own axes.
+fn rotate_back<S: Scalar>(placement: &Pose<S>, m: &Motion<S>) -> Motion<S> {
+    let r = &placement.rotation;
+    let back = |x: &Vector3<S>| {
+        Vector3::new(
+            r[(0, 0)] * x[0] + r[(1, 0)] * x[1] + r[(2, 0)] * x[2],
+            r[(0, 1)] * x[0] + r[(1, 1)] * x[1] + r[(2, 1)] * x[2],
+            r[(0, 2)] * x[0] + r[(1, 2)] * x[1] + r[(2, 2)] * x[2],
+        )
+    };
+    Motion {
+        linear: back(&m.linear),
+        angular: back(&m.angular),
+    }
+}
+
+/// A twist (or a Jacobian column) given at the frame origin in world axes, in
+/// `reference`: `LOCAL` rotates it into the frame's axes, `WORLD` moves its point to
+/// the world origin (`v_O = v_p + p × ω`).
+fn velocity_from_lwa<S: Scalar>(placement: &Pose<S>, m: &Motion<S>, reference: ReferenceFrame) -> Motion<S> {
+    match reference {
+        ReferenceFrame::LocalWorldAligned => *m,
+        ReferenceFrame::Local => rotate_back(placement, m),
+        ReferenceFrame::World => Motion {
+            linear: m.linear + placement.translation.cross(&m.angular),
+            angular: m.angular,
+        },
+    }
+}
+
+/// Support for generated code: the conversion the generated `frame_jacobian` applies.
+#[doc(hidden)]
+pub fn __express_jacobian<S: Scalar, const N: usize>(j: &mut FrameJacobian<S, N>, reference: ReferenceFrame) {
+    if reference != ReferenceFrame::LocalWorldAligned {
+        j.express_from_lwa(reference);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Matrix3;
+
+    fn pose() -> Pose<f64> {
+        // A rotation of 0.3 rad about z, at (1, 2, 3).
+        let (s, c) = 0.3f64.sin_cos();
+        Pose {
+            rotation: Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+            translation: Vector3::new(1.0, 2.0, 3.0),
+        }
+    }
+
+    #[test]
+    fn local_is_the_rotated_world_aligned_motion() {
+        let p = pose();
+        let m = Motion {
+            linear: Vector3::new(0.5, -1.0, 2.0),
+            angular: Vector3::new(0.1, 0.2, -0.3),
+        };
+        let local = velocity_from_lwa(&p, &m, ReferenceFrame::Local);
+        let back = p.rotation * local.linear;
+        assert!((back - m.linear).norm() < 1e-15);
+        assert!((p.rotation * local.angular - m.angular).norm() < 1e-15);
+    }
+
+    #[test]
+    fn world_velocity_is_the_body_point_at_the_origin() {
+        let p = pose();
+        let m = Motion {
+            linear: Vector3::new(0.5, -1.0, 2.0),
+            angular: Vector3::new(0.1, 0.2, -0.3),
+        };
+        let w = velocity_from_lwa(&p, &m, ReferenceFrame::World);
+        // The velocity of the body point at the world origin: v_p + ω × (0 − p).
+        let want = m.linear + m.angular.cross(&(-p.translation));
+        assert!((w.linear - want).norm() < 1e-15);
+    }
+
+    #[test]
+    fn jacobian_velocity_is_j_times_v() {
+        let mut j = FrameJacobian::<f64, 2>::default();
+        j.jacobian = [[1.0, 2.0], [0.0, 1.0], [3.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 0.0]];
+        let v = j.velocity(&[2.0, -1.0]);
+        assert_eq!(v.to_array(), [0.0, -1.0, 6.0, 0.0, -1.0, 2.0]);
+    }
+}

@@ -41,13 +41,17 @@
 //! Per pair of joints on one path this is three force transforms and a few dot
 //! products; the rest is linear in the number of bodies.
 //!
+//! In [`aba_derivatives`] the same closed form is taken at `a = q̈`, with the spatial
+//! accelerations and bias forces built as `aba` builds them (so they are `aba`'s
+//! nodes) and `∂q̈/∂(q, v) = −M⁻¹ ∂τ/∂(q, v)`.
+//!
 //! # `M⁻¹`
 //!
 //! Featherstone's `LᵀDL` factorisation (RBDA §6.5): with regular labelling a tree's
 //! `M` factors without fill-in, `L` has the sparsity of the tree and so has `L⁻¹`;
 //! `M⁻¹ = L⁻¹ D⁻¹ L⁻ᵀ`, one division per joint, upper triangle built and mirrored.
 
-use crate::algo::{self, BodyParams, Force, Inputs, JointTransform, Kinematics, Motion, ARG_Q, ARG_TAU, ARG_V, M3};
+use crate::algo::{self, BodyParams, Force, Inputs, JointTransform, Kinematics, Motion, ARG_Q, ARG_TAU, ARG_V, M3, V3};
 use crate::sym::{Expr, Graph, NodeId};
 use dyngen_model::Model;
 
@@ -119,9 +123,16 @@ pub fn aba_derivatives_with<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaDer
         }
     };
     let qd: Vec<Expr<'g>> = (0..n).map(|i| g.input(ARG_V, i as u32)).collect();
-    let k = algo::kinematics_with(g, model, |j| qd[j - 1], |j| ddq[j - 1]);
-    let r = algo::rnea_with_acceleration(g, model, &ddq);
-    let (dq, dv) = rnea_partials(g, model, &qd, &k, &r.wrenches);
+    // Next to `aba`, its accelerations and bias forces give the state (fewer new
+    // operations than an rnea at a = q̈); otherwise the classical rnea is cheaper.
+    let (dq, dv) = match how {
+        Ddq::Aba => spatial_partials(g, model, &qd, &ddq),
+        Ddq::InverseInertia => {
+            let k = algo::kinematics_with(g, model, |j| qd[j - 1], |j| ddq[j - 1]);
+            let r = algo::rnea_with_acceleration(g, model, &ddq);
+            rnea_partials(g, model, &qd, &k, &r.wrenches)
+        }
+    };
     g.mark("derivatives: −M⁻¹ ∂τ/∂q, −M⁻¹ ∂τ/∂v");
     let times_minv = |d: &[Vec<Expr<'g>>]| -> Vec<Vec<Expr<'g>>> {
         (0..n)
@@ -232,20 +243,79 @@ pub fn rnea_partials<'g>(
     let n = model.dof();
     assert_eq!(qd.len(), n, "one joint velocity per joint");
     let x = &k.x;
-    let s: Vec<Motion<'g>> = (1..=n).map(|j| algo::subspace(g, model, j)).collect();
     g.mark("derivatives: spatial velocities and accelerations");
-    // Spatial velocity (v = linear velocity of the frame origin) and spatial
-    // acceleration, gravity included: the classical origin acceleration minus ω × u.
-    let mut v = vec![Motion::zero(g); n + 1];
+    let v = velocities(g, model, x, qd);
+    // The spatial acceleration, gravity included: the classical acceleration of the
+    // frame origin minus ω × u.
     let mut a = vec![Motion::zero(g); n + 1];
     for i in 1..=n {
-        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + s[i - 1].scale(qd[i - 1]);
         let m = &k.motion[i];
         a[i] = Motion {
             v: m.acc - m.w.cross(v[i].v),
             w: m.wd,
         };
     }
+    partials(g, model, x, &v, &a, wrenches)
+}
+
+/// [`rnea_partials`] at joint accelerations given as expressions, with the spatial
+/// accelerations and body wrenches built as `aba` builds its accelerations and bias
+/// forces, so that next to `aba` in one graph they are `aba`'s nodes.
+fn spatial_partials<'g>(
+    g: &'g Graph,
+    model: &Model,
+    qd: &[Expr<'g>],
+    qdd: &[Expr<'g>],
+) -> (Vec<Vec<Expr<'g>>>, Vec<Vec<Expr<'g>>>) {
+    let n = model.dof();
+    let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    g.mark("derivatives: spatial velocities, accelerations and wrenches");
+    let v = velocities(g, model, &x, qd);
+    let mut a = vec![Motion {
+        v: V3::constant(g, model.gravity.map(|c| -c)),
+        w: V3::zero(g),
+    }];
+    let mut f: Vec<Force<'g>> = Vec::with_capacity(n);
+    for i in 1..=n {
+        let s = algo::subspace(g, model, i);
+        let bias = v[i].cross_motion(s.scale(qd[i - 1]));
+        let ai = x[i - 1].motion_to_child(a[model.parent(i)]) + bias + s.scale(qdd[i - 1]);
+        let body = BodyParams::input(g, i);
+        f.push(inertia_times(&body, ai) + v[i].cross_force(inertia_times(&body, v[i])));
+        a.push(ai);
+    }
+    for i in (1..=n).rev() {
+        let p = model.parent(i);
+        if p > 0 {
+            f[p - 1] = f[p - 1] + x[i - 1].force_to_parent(f[i - 1]);
+        }
+    }
+    partials(g, model, &x, &v, &a, &f)
+}
+
+/// Spatial velocities (linear part: the velocity of the frame origin) in body axes,
+/// index 0 the base, built as `aba` builds them.
+fn velocities<'g>(g: &'g Graph, model: &Model, x: &[JointTransform<'g>], qd: &[Expr<'g>]) -> Vec<Motion<'g>> {
+    let n = model.dof();
+    let mut v = vec![Motion::zero(g); n + 1];
+    for i in 1..=n {
+        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + algo::subspace(g, model, i).scale(qd[i - 1]);
+    }
+    v
+}
+
+/// The closed form from spatial velocities `v` and accelerations `a` (gravity
+/// included; index 0 the base) and the joint wrenches.
+fn partials<'g>(
+    g: &'g Graph,
+    model: &Model,
+    x: &[JointTransform<'g>],
+    v: &[Motion<'g>],
+    a: &[Motion<'g>],
+    wrenches: &[Force<'g>],
+) -> (Vec<Vec<Expr<'g>>>, Vec<Vec<Expr<'g>>>) {
+    let n = model.dof();
+    let s: Vec<Motion<'g>> = (1..=n).map(|j| algo::subspace(g, model, j)).collect();
     g.mark("derivatives: composite inertias, inertia rates and momenta");
     let own: Vec<BodyParams<'g>> = (1..=n).map(|j| BodyParams::input(g, j)).collect();
     let ic = composites(model, x, own.clone());

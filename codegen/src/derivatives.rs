@@ -203,19 +203,19 @@ fn composites<'g>(model: &Model, x: &[JointTransform<'g>], mut c: Vec<BodyParams
 
 /// The rate of change of a body's spatial inertia when it moves at `v = (u, ω)`,
 /// `v×* I − I v×`, which is again of the form of a rigid-body inertia: mass rate 0,
-/// `ḣ = m u + ω × h`, `İ = S(ω) I − I S(ω) − S(u) S(h) − S(h) S(u)` (symmetric; built
-/// as `A + Aᵀ − (h uᵀ + u hᵀ) + 2 (u·h) E` with `A = S(ω) I`, upper triangle mirrored).
+/// `ḣ = m u + ω × h`, `İ = S(ω) I − I S(ω) − S(u) S(h) − S(h) S(u)` (symmetric).
+/// With `A = S(ω) I`: off the diagonal `İ_ij = A_ij + A_ji − h_i u_j − u_i h_j`, on it
+/// `İ_ii = 2 (A_ii + Σ_{k≠i} u_k h_k)`; upper triangle built and mirrored.
 fn inertia_rate<'g>(g: &'g Graph, b: &BodyParams<'g>, v: Motion<'g>) -> BodyParams<'g> {
     let (w, u, h) = (v.w, v.v, b.h);
     let a = M3::skew(w).mul(&b.inertia).0;
-    let uh = u.dot(h);
+    let uh = [0, 1, 2].map(|k| u.0[k] * h.0[k]);
     let mut r = [[g.zero(); 3]; 3];
     for i in 0..3 {
-        for j in i..3 {
-            let mut e = a[i][j] + a[j][i] - (h.0[i] * u.0[j] + u.0[i] * h.0[j]);
-            if i == j {
-                e = e + uh + uh;
-            }
+        let e = a[i][i] + (uh[(i + 1) % 3] + uh[(i + 2) % 3]);
+        r[i][i] = e + e;
+        for j in i + 1..3 {
+            let e = a[i][j] + a[j][i] - (h.0[i] * u.0[j] + u.0[i] * h.0[j]);
             r[i][j] = e;
             r[j][i] = e;
         }
@@ -701,7 +701,7 @@ mod tests {
     /// The operation counts, against `rnea` and against forward mode.
     #[test]
     fn op_counts() {
-        for rel in ["robots/ur5/ur5.urdf", "robots/panda/panda.urdf"] {
+        for rel in ROBOTS {
             let model = load(rel);
             let count = |build: &dyn Fn(&Graph) -> Vec<NodeId>| {
                 let g = Graph::new();

@@ -422,6 +422,31 @@ pub struct Kinematics<'g> {
 
 /// The forward Newton–Euler pass.
 pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics<'g> {
+    let qd = |j: usize| {
+        if inputs == Inputs::Static {
+            g.zero()
+        } else {
+            g.input(ARG_V, (j - 1) as u32)
+        }
+    };
+    let qdd = |j: usize| {
+        if inputs == Inputs::Full {
+            g.input(ARG_A, (j - 1) as u32)
+        } else {
+            g.zero()
+        }
+    };
+    kinematics_with(g, model, qd, qdd)
+}
+
+/// The forward Newton–Euler pass with joint `j`'s velocity `qd(j)` and acceleration
+/// `qdd(j)` given as expressions (each asked for once per joint, velocity first).
+pub fn kinematics_with<'g>(
+    g: &'g Graph,
+    model: &Model,
+    qd: impl Fn(usize) -> Expr<'g>,
+    qdd: impl Fn(usize) -> Expr<'g>,
+) -> Kinematics<'g> {
     let n = model.dof();
     let mut x: Vec<JointTransform<'g>> = Vec::with_capacity(n);
     let mut motion = vec![BodyMotion {
@@ -436,16 +461,8 @@ pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics
         let p = joint.parent;
         let xj = &x[j - 1];
         let axis = V3::constant(g, joint.axis);
-        let qd = if inputs == Inputs::Static {
-            g.zero()
-        } else {
-            g.input(ARG_V, (j - 1) as u32)
-        };
-        let qdd = if inputs == Inputs::Full {
-            g.input(ARG_A, (j - 1) as u32)
-        } else {
-            g.zero()
-        };
+        let qd = qd(j);
+        let qdd = qdd(j);
         let t = xj.translation;
         let mp = motion[p];
         // Acceleration of the joint-frame origin, still in parent axes.
@@ -486,8 +503,21 @@ pub struct Rnea<'g> {
 /// (gravity as a base acceleration `−g`), per-body Newton–Euler with the symbolic
 /// standard parameters, backward pass accumulating what each joint transmits.
 pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
-    let n = model.dof();
     let k = kinematics(g, model, inputs);
+    rnea_from(g, model, k)
+}
+
+/// [`rnea`] with the joint accelerations given as expressions (`a[j − 1]` for joint
+/// `j`), e.g. the outputs of [`aba`]; `q`, `v` and the parameters are inputs.
+pub fn rnea_with_acceleration<'g>(g: &'g Graph, model: &Model, a: &[Expr<'g>]) -> Rnea<'g> {
+    assert_eq!(a.len(), model.dof(), "one acceleration per joint");
+    let k = kinematics_with(g, model, |j| g.input(ARG_V, (j - 1) as u32), |j| a[j - 1]);
+    rnea_from(g, model, k)
+}
+
+/// The Newton–Euler wrenches and the backward pass over given kinematics.
+fn rnea_from<'g>(g: &'g Graph, model: &Model, k: Kinematics<'g>) -> Rnea<'g> {
+    let n = model.dof();
     let mut f: Vec<Force<'g>> = (1..=n)
         .map(|j| {
             mark_body(g, model, j, "Newton–Euler wrench");
@@ -631,7 +661,7 @@ pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
 
 /// A body's parameters seen from its parent frame: `h' = R h + m p`,
 /// `I' = R I Rᵀ − m S(p)S(p) − S(p)S(R h) − S(R h)S(p)`.
-fn composite_to_parent<'g>(x: &JointTransform<'g>, b: &BodyParams<'g>) -> BodyParams<'g> {
+pub fn composite_to_parent<'g>(x: &JointTransform<'g>, b: &BodyParams<'g>) -> BodyParams<'g> {
     let p = x.translation;
     let rh = x.to_parent(b.h);
     let rot = b.inertia.rotate_sym(&x.motion).rotate_sym(&x.origin);

@@ -15,6 +15,7 @@
 pub mod algo;
 pub mod base;
 mod build;
+pub mod derivatives;
 pub mod dsl;
 pub mod emit;
 mod frames;

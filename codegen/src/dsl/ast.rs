@@ -16,6 +16,7 @@ pub struct Robot {
     pub joints: Attr<JointList>,
     pub body_joint_vectors: Attr<VectorTable>,
     pub bodies: Attr<BodyTable>,
+    pub frames: Attr<FrameTable>,
 }
 
 /// One top-level `keyword: value`.
@@ -187,4 +188,25 @@ impl Shape {
             Shape::Principal { moments, .. } => moments.value(),
         }
     }
+}
+
+/// `frames: { name: (i, [x, y, z], rest: [r, p, y]), ... }`.
+pub struct FrameTable {
+    pub entries: Vec<FrameEntry>,
+}
+
+/// One named frame fixed to body `i`: its origin at `position` from the body's centre
+/// of mass (for the base, from the base origin) in the body's axes, its axes rotated
+/// by `rest` (roll-pitch-yaw) from the body's.
+pub struct FrameEntry {
+    pub name: syn::Ident,
+    /// `None` when the value did not parse (its error is recorded); the name is kept
+    /// for the duplicate check.
+    pub frame: Option<Frame>,
+}
+
+pub struct Frame {
+    pub body: Index,
+    pub position: Vector,
+    pub rest: Option<Vector>,
 }

@@ -3,7 +3,7 @@
 //! already recorded), and rules that need the size `n` run only once the incidence
 //! matrix has a consistent shape, so one mistake does not cascade.
 
-use super::ast::{Body, BodyTable, Joint, JointList, Matrix, Robot, Shape, VectorTable};
+use super::ast::{Body, BodyTable, FrameTable, Joint, JointList, Matrix, Robot, Shape, VectorTable};
 use super::ctxt::{Ctxt, Loc};
 use super::symbol;
 use dyngen_model::graph::{self, IncidenceError, IncidenceTree};
@@ -54,6 +54,12 @@ pub fn check(cx: &Ctxt, robot: &Robot) -> Option<IncidenceTree> {
             check_triangle_inequality(cx, body);
         }
     }
+
+    if let Some(table) = &robot.frames.value {
+        check_frame_names(cx, table, n);
+        check_frame_bodies(cx, table, n);
+        check_frame_numbers(cx, table);
+    }
     valid.map(|(_, tree)| tree)
 }
 
@@ -65,7 +71,7 @@ fn check_required_keywords(cx: &Ctxt, robot: &Robot) {
         (symbol::BODY_JOINT_VECTORS, robot.body_joint_vectors.is_given()),
         (symbol::BODIES, robot.bodies.is_given()),
     ];
-    let inline_started = robot.gravity.is_given() || inline.iter().any(|(_, given)| *given);
+    let inline_started = robot.gravity.is_given() || robot.frames.is_given() || inline.iter().any(|(_, given)| *given);
     let mut missing: Vec<String> = Vec::new();
     if !robot.name.is_given() {
         missing.push(format!("`{}`", symbol::NAME));
@@ -86,10 +92,11 @@ fn check_required_keywords(cx: &Ctxt, robot: &Robot) {
             .chain(symbol::INLINE_REQUIRED.iter().copied())
             .map(|s| format!("{s}: .."))
             .collect();
+        let optional: Vec<String> = symbol::INLINE_OPTIONAL.iter().map(|s| format!("`{s}`")).collect();
         let inline_form = format!(
-            "an inline robot is `{}` (`{}` optional)",
+            "an inline robot is `{}` ({} optional)",
             keys.join(", "),
-            symbol::GRAVITY
+            optional.join(" and ")
         );
         if inline_started {
             inline_form
@@ -128,6 +135,7 @@ fn check_urdf_excludes_inline(cx: &Ctxt, robot: &Robot) {
         &robot.joints.key,
         &robot.body_joint_vectors.key,
         &robot.bodies.key,
+        &robot.frames.key,
     ];
     for key in keys.into_iter().flatten() {
         cx.error_spanned_by(
@@ -548,6 +556,75 @@ fn check_triangle_inequality(cx: &Ctxt, body: &Body) {
                 rounded(j[a] + j[b])
             ),
         );
+    }
+}
+
+/// A frame names a link of its own: two frames of one name, or a frame named like a
+/// body's link (`body0` to `bodyn`), would make one name mean two links.
+fn check_frame_names(cx: &Ctxt, table: &FrameTable, n: Option<usize>) {
+    let mut seen = HashSet::new();
+    for e in &table.entries {
+        let name = e.name.to_string();
+        if !seen.insert(name.clone()) {
+            cx.error_spanned_by(
+                &e.name,
+                format!("duplicate frame `{name}`; each frame name appears once"),
+            );
+            continue;
+        }
+        let Some(n) = n else { continue };
+        let body = name
+            .strip_prefix("body")
+            .and_then(|k| k.parse::<usize>().ok().filter(|i| i.to_string() == k));
+        if let Some(i) = body.filter(|&i| i <= n) {
+            cx.error_spanned_by(
+                &e.name,
+                format!(
+                    "frame name `{name}` is the link of body {i}; the bodies' links are `body0` to `body{n}`, so a \
+                     frame needs another name, such as `tool`"
+                ),
+            );
+        }
+    }
+}
+
+/// A frame is fixed to one of the bodies 0..n.
+fn check_frame_bodies(cx: &Ctxt, table: &FrameTable, n: Option<usize>) {
+    let Some(n) = n else { return };
+    for f in table.entries.iter().filter_map(|e| e.frame.as_ref()) {
+        if !(0..=n as i64).contains(&f.body.value) {
+            cx.error_spanned_by(
+                f.body.loc,
+                format!(
+                    "body {} does not exist; a frame is fixed to one of the bodies 0 (the base) to {n}",
+                    f.body.value
+                ),
+            );
+        }
+    }
+}
+
+/// Every number of a description lies within the model's ±1e9 (SI); checked here so
+/// the error points at the number.
+fn check_frame_numbers(cx: &Ctxt, table: &FrameTable) {
+    let max = dyngen_model::desc::MAX_MAGNITUDE;
+    for f in table.entries.iter().filter_map(|e| e.frame.as_ref()) {
+        let rest = f
+            .rest
+            .iter()
+            .flat_map(|r| r.parts.iter().map(|p| (p, "rest angle", "rad")));
+        let position = f.position.parts.iter().map(|p| (p, "position", "m"));
+        for (x, what, unit) in position.chain(rest) {
+            if x.value.abs() > max {
+                cx.error_spanned_by(
+                    x.loc,
+                    format!(
+                        "frame {what} {} is out of range; give it in {unit}, within ±{max:e}",
+                        x.value
+                    ),
+                );
+            }
+        }
     }
 }
 

@@ -86,6 +86,39 @@ pub fn lower(robot: &Robot, tree: &IncidenceTree) -> Option<Description> {
         });
     }
 
+    // Each frame is a massless link on a fixed joint, as a URDF gives a tool point.
+    // Body i's link frame is at its inner joint's point, where the centre of mass is
+    // at -c_ia, so a frame at p from the centre of mass is at p - c_ia; the base's
+    // link frame is the base frame, so there p itself.
+    for entry in robot.frames.value.iter().flat_map(|t| &t.entries) {
+        let frame = entry.frame.as_ref()?;
+        let i = usize::try_from(frame.body.value).ok()?;
+        let p = frame.position.value();
+        let translation = match *inner_joint.get(i)? {
+            None => p,
+            Some(a) => math::sub(&p, &vector(i, a)?),
+        };
+        let rest = frame.rest.as_ref().map_or([0.0; 3], |r| r.value());
+        let name = entry.name.to_string();
+        descs.push(JointDesc {
+            name: format!("{name}_fixed"),
+            kind: DeclaredJointType::Fixed,
+            parent: format!("body{i}"),
+            child: name.clone(),
+            origin: Placement::from_xyz_rpy(translation, rest),
+            // Unused on a fixed joint; URDF's default, as the URDF front end reads it.
+            axis: [1.0, 0.0, 0.0],
+            limits: None,
+            dynamics: Default::default(),
+            line: None,
+        });
+        links.push(LinkDesc {
+            name,
+            inertial: None,
+            line: None,
+        });
+    }
+
     Some(Description {
         name,
         gravity,

@@ -25,6 +25,11 @@
 //!         1: cylinder(mass: 10.0, radius: 0.05, length: 1.0, axis: x),
 //!         2: principal(mass: 5.0, moments: [0.005, 0.4, 0.4]),
 //!     },
+//!     frames: {                               // optional; name: (body, [x, y, z])
+//!         tool: (2, [0.5, 0.0, 0.0]),         //   from the centre of mass, in body axes
+//!         camera: (1, [0.0, 0.05, 0.0], rest: [0.0, 0.0, 1.5707963267948966]),
+//!         base_mark: (0, [0.1, 0.0, 0.0]),    //   body 0: from the base origin
+//!     },
 //! }
 //! ```
 //!
@@ -37,6 +42,7 @@
 //!            | 'joints' ':' '[' joint,* ']'
 //!            | 'body_joint_vectors' ':' '{' ('(' INTEGER ',' INTEGER ')' ':' vec3),* '}'
 //!            | 'bodies' ':' '{' (INTEGER ':' body),* '}'
+//!            | 'frames' ':' '{' (IDENT ':' frame),* '}'
 //! joint     := ('revolute' | 'continuous' | 'prismatic') '(' axis (',' option)* ','? ')'
 //! option    := 'rest' ':' vec3                    [roll, pitch, yaw], rad
 //!            | 'limits' ':' '[' num ',' num ']'   [lower, upper]; not on continuous joints
@@ -44,6 +50,7 @@
 //! body      := 'cylinder' '(' 'mass' ':' num ',' 'radius' ':' num ',' 'length' ':' num
 //!                             ',' 'axis' ':' ('x' | 'y' | 'z') ')'     (arguments in any order)
 //!            | 'principal' '(' 'mass' ':' num ',' 'moments' ':' vec3 ')'
+//! frame     := '(' INTEGER ',' vec3 (',' 'rest' ':' vec3)? ','? ')'    body, position, [roll, pitch, yaw]
 //! vec3      := '[' num ',' num ',' num ']'
 //! num       := '-'? (INTEGER | FLOAT)             e.g. -1, 0.5, -9.81, 1e-3; finite
 //! ```
@@ -69,7 +76,12 @@
 //! `a`'s point) and inertia `diag(J1, J2, J3)`. `principal(mass: m, moments: [J1, J2,
 //! J3])` gives them directly; `cylinder(mass, radius, length, axis)` is a homogeneous
 //! cylinder along that body axis: `J_axis = m r²/2`, the other two `m (3r² + l²)/12`.
-//! Limits carry velocity and effort 0.0, meaning "not specified". The model then
+//! Limits carry velocity and effort 0.0, meaning "not specified". A frame
+//! `name: (i, p, rest: r)` is a link `name` without inertial on a fixed joint
+//! `name_fixed` from link `body<i>`: origin translation `p − c_ia` (`a` the joint
+//! whose outboard body is `i`; for the base, `p`), rotation from `r`. The model
+//! merges it into body `i` (listed in that body's `merged`; on the base, into the
+//! fixed base). The model then
 //! renumbers bodies to regular labelling if the user's numbering is not (names keep
 //! the user's numbers).
 //!
@@ -84,7 +96,9 @@
 //! joint; `c_ia` missing where `S_ia ≠ 0`, given where `S_ia = 0`, duplicated or out
 //! of range; bodies missing, duplicated, out of range or body 0; unknown body kinds
 //! or arguments, missing arguments; mass, radius, length or moments not positive;
-//! moments breaking the triangle inequality.
+//! moments breaking the triangle inequality; frames malformed, with an unknown option,
+//! a duplicate name, a name that is not a plain identifier or is a body's link
+//! (`body0..bodyn`), a body out of range, or a position or angle beyond ±1e9.
 
 mod ast;
 mod check;
@@ -218,6 +232,139 @@ mod tests {
             &[b2.inertia[0][0], b2.inertia[1][1], b2.inertia[2][2]],
             &[0.005, 0.4, 0.4]
         ));
+    }
+
+    /// Planar2 with a frame on each kind of body: a moving body, one with a rest
+    /// rotation, and the base.
+    fn planar2_with_frames() -> TokenStream {
+        let mut tokens = planar2();
+        tokens.extend(quote! {
+            frames: {
+                tool: (2, [0.2, 0.0, 0.0]),
+                camera: (1, [0.0, 0.05, 0.0], rest: [0.0, 0.0, 1.5707963267948966]),
+                base_mark: (0, [0.1, 0.0, 0.0],),
+            },
+        });
+        tokens
+    }
+
+    #[test]
+    fn frames_lower_to_massless_links_on_fixed_joints() {
+        let d = description(planar2_with_frames());
+        let links: Vec<(&str, bool)> = d
+            .links
+            .iter()
+            .map(|l| (l.name.as_str(), l.inertial.is_some()))
+            .collect();
+        assert_eq!(
+            links,
+            [
+                ("body0", false),
+                ("body1", true),
+                ("body2", true),
+                ("tool", false),
+                ("camera", false),
+                ("base_mark", false)
+            ]
+        );
+        let joints: Vec<(&str, &str, &str, bool)> = d
+            .joints
+            .iter()
+            .map(|j| {
+                let fixed = j.kind == dyngen_model::DeclaredJointType::Fixed;
+                (j.name.as_str(), j.parent.as_str(), j.child.as_str(), fixed)
+            })
+            .collect();
+        assert_eq!(
+            joints,
+            [
+                ("joint1", "body0", "body1", false),
+                ("joint2", "body1", "body2", false),
+                ("tool_fixed", "body2", "tool", true),
+                ("camera_fixed", "body1", "camera", true),
+                ("base_mark_fixed", "body0", "base_mark", true),
+            ]
+        );
+        // Body 2's link frame is at joint 2's point, c_22 = [-0.5, 0, 0] from the
+        // centre of mass: the tool is at p - c_22.
+        let tool = &d.joints[2].origin;
+        assert!(close(&tool.translation, &[0.7, 0.0, 0.0]));
+        assert_eq!(tool.rotation, dyngen_model::math::IDENTITY);
+        // Body 1's at joint 1's point, c_11 = [-0.5, 0, 0]; the camera turned by a
+        // quarter turn about z.
+        let camera = &d.joints[3].origin;
+        assert!(close(&camera.translation, &[0.5, 0.05, 0.0]));
+        let r = camera.rotation;
+        assert!(close(
+            &[r[0][0], r[0][1], r[1][0], r[1][1], r[2][2]],
+            &[0.0, -1.0, 1.0, 0.0, 1.0]
+        ));
+        let want = dyngen_model::Placement::from_xyz_rpy([0.5, 0.05, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]);
+        assert_eq!(camera.rotation, want.rotation);
+        // The base's link frame is the base frame: the position as written.
+        let mark = &d.joints[4].origin;
+        assert!(close(&mark.translation, &[0.1, 0.0, 0.0]));
+        assert_eq!(mark.rotation, dyngen_model::math::IDENTITY);
+    }
+
+    #[test]
+    fn frames_build_and_merge_into_their_bodies() {
+        let with = description(planar2_with_frames()).build().unwrap();
+        let without = description(planar2()).build().unwrap();
+        assert_eq!(with.dof(), 2);
+        assert_eq!(with.joints, without.joints);
+        let merged: Vec<(&str, Vec<&str>)> = with
+            .bodies
+            .iter()
+            .map(|b| (b.name.as_str(), b.merged.iter().map(String::as_str).collect()))
+            .collect();
+        assert_eq!(merged, [("body1", vec!["camera"]), ("body2", vec!["tool"])]);
+        // Massless frames leave the bodies' inertials as they were.
+        for (a, b) in with.bodies.iter().zip(&without.bodies) {
+            assert_eq!(a.inertial, b.inertial);
+        }
+        assert!(with.warnings.is_empty());
+    }
+
+    #[test]
+    fn frame_rules() {
+        let mut tokens = planar2();
+        tokens.extend(quote! {
+            frames: {
+                tool: (3, [0.2, 0.0, 0.0]),
+                tool: (2, [0.0, 0.0, 0.0]),
+                body2: (2, [0.0, 0.0, 0.0]),
+                body3: (2, [0.0, 0.0, 0.0]),
+                body02: (2, [0.0, 0.0, 0.0]),
+                far: (-1, [2e9, 0.0, 0.0], rest: [0.0, -1e10, 0.0]),
+            },
+        });
+        let e = messages(tokens);
+        let want = [
+            "duplicate frame `tool`",
+            "frame name `body2` is the link of body 2; the bodies' links are `body0` to `body2`",
+            "body 3 does not exist; a frame is fixed to one of the bodies 0 (the base) to 2",
+            "body -1 does not exist",
+            "frame position 2000000000 is out of range; give it in m, within ±1e9",
+            "frame rest angle -10000000000 is out of range; give it in rad, within ±1e9",
+        ];
+        assert_eq!(e.len(), want.len(), "{e:#?}");
+        for (got, want) in e.iter().zip(want) {
+            assert!(got.contains(want), "{got:?} should contain {want:?}");
+        }
+    }
+
+    #[test]
+    fn frames_belong_to_the_inline_form() {
+        let e = messages(quote!(name: R, urdf: "r.urdf", frames: {}));
+        assert_eq!(e.len(), 1, "{e:#?}");
+        assert!(e[0].starts_with("`frames` cannot be combined with `urdf`"), "{e:?}");
+        let e = messages(quote!(name: R, frames: {}));
+        assert!(
+            e[0].starts_with("missing `incidence`, `joints`, `body_joint_vectors` and `bodies`"),
+            "{e:?}"
+        );
+        assert!(e[0].ends_with("(`gravity` and `frames` optional)"), "{e:?}");
     }
 
     #[test]

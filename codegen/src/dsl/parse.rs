@@ -5,8 +5,8 @@
 //! would point at the whole macro call there).
 
 use super::ast::{
-    Attr, Axis, Body, BodyEntry, BodyTable, Entry, Index, Joint, JointList, Limits, Matrix, Num, Robot, Row, Shape,
-    Vector, VectorEntry, VectorTable,
+    Attr, Axis, Body, BodyEntry, BodyTable, Entry, Frame, FrameEntry, FrameTable, Index, Joint, JointList, Limits,
+    Matrix, Num, Robot, Row, Shape, Vector, VectorEntry, VectorTable,
 };
 use super::ctxt::{Ctxt, Loc};
 use super::symbol::{self, Symbol};
@@ -26,6 +26,7 @@ pub fn robot(cx: &Ctxt, input: TokenStream) -> Robot {
         joints: Attr::none(symbol::JOINTS),
         body_joint_vectors: Attr::none(symbol::BODY_JOINT_VECTORS),
         bodies: Attr::none(symbol::BODIES),
+        frames: Attr::none(symbol::FRAMES),
     };
     for piece in nonempty_pieces(cx, input, "`keyword: value`") {
         let Some(field) = report(cx, key_value(piece.tokens, "keyword", symbol::TOP_LEVEL)) else {
@@ -54,8 +55,9 @@ pub fn robot(cx: &Ctxt, input: TokenStream) -> Robot {
             symbol::BODY_JOINT_VECTORS => robot
                 .body_joint_vectors
                 .set(cx, key, || body_joint_vectors(cx, value, loc)),
-            // symbol::BODIES, the last of TOP_LEVEL.
-            _ => robot.bodies.set(cx, key, || bodies(cx, value, loc)),
+            symbol::BODIES => robot.bodies.set(cx, key, || bodies(cx, value, loc)),
+            // symbol::FRAMES, the last of TOP_LEVEL.
+            _ => robot.frames.set(cx, key, || frames(cx, value, loc)),
         }
     }
     robot
@@ -762,6 +764,122 @@ fn cylinder_axis(input: ParseStream, end: Loc) -> syn::Result<(usize, Loc)> {
     }
 }
 
+fn frames(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<FrameTable> {
+    let (entries, _) = braced_entries(
+        cx,
+        tokens,
+        end,
+        "the frames as `{ tool: (2, [0.2, 0.0, 0.0]), ... }`",
+        "a frame `name: (body, [x, y, z])`",
+        frame_entry,
+    )?;
+    Some(FrameTable { entries })
+}
+
+/// `name: (i, [x, y, z])` or `name: (i, [x, y, z], rest: [r, p, y])`.
+fn frame_entry(cx: &Ctxt, tokens: TokenStream) -> Option<FrameEntry> {
+    let loc = Loc::of(&tokens, Span::call_site());
+    let parsed = parse_all(tokens, |input| {
+        let name = frame_name(input, loc)?;
+        if !input.peek(Token![:]) {
+            let found = rest_loc(input, Loc::at(name.span()));
+            return Err(error(
+                found,
+                format!("expected `:` after the frame name `{name}`, as in `{name}: (body, [x, y, z])`"),
+            ));
+        }
+        input.parse::<Token![:]>()?;
+        let value: TokenStream = input.parse()?;
+        Ok((name, value))
+    });
+    let (name, value) = report(cx, parsed)?;
+    let frame = frame_value(cx, &name, value, loc);
+    Some(FrameEntry { name, frame })
+}
+
+/// A frame's name: a plain identifier (it names a link, and may name generated items).
+fn frame_name(input: ParseStream, end: Loc) -> syn::Result<syn::Ident> {
+    const WHAT: &str = "the frame's name, an identifier such as `tool` or `camera_mount`";
+    if input.is_empty() {
+        return Err(error(end, format!("expected {WHAT}")));
+    }
+    let tt: TokenTree = input.fork().parse()?;
+    match input.parse::<syn::Ident>() {
+        Ok(ident) if !ident.to_string().starts_with("r#") => Ok(ident),
+        _ => match &tt {
+            // A keyword or a raw identifier.
+            TokenTree::Ident(word) => Err(syn::Error::new_spanned(
+                &tt,
+                format!(
+                    "`{word}` cannot name a frame: a frame's name is a plain identifier (not a Rust keyword, \
+                     not raw), such as `tool` or `camera_mount`"
+                ),
+            )),
+            _ => Err(syn::Error::new_spanned(&tt, format!("expected {WHAT}"))),
+        },
+    }
+}
+
+/// `(i, [x, y, z], rest: [r, p, y])` after `name:`.
+fn frame_value(cx: &Ctxt, name: &syn::Ident, value: TokenStream, end: Loc) -> Option<Frame> {
+    let form = format!(
+        "a frame is `{name}: (body, [x, y, z])` or `{name}: (body, [x, y, z], {}: [roll, pitch, yaw])`: the \
+         body's number (0 for the base), the frame's position from the body's centre of mass (from the base \
+         origin for body 0) in the body's axes, and its rotation from those axes",
+        symbol::REST
+    );
+    let args = report(
+        cx,
+        single_group(
+            value,
+            Delimiter::Parenthesis,
+            &format!("`(body, [x, y, z])` after `{name}:`; {form}"),
+            end,
+        ),
+    )?;
+    let args_loc = Loc::at(args.span());
+    let mut pieces = nonempty_pieces(cx, args.stream(), "an argument").into_iter();
+    let Some(first) = pieces.next() else {
+        cx.error_spanned_by(args_loc, format!("expected `(body, [x, y, z])`; {form}"));
+        return None;
+    };
+    let ploc = Loc::of(&first.tokens, args.span());
+    let body = report(
+        cx,
+        parse_all(first.tokens, |i| {
+            index(i, "the number of the body the frame is fixed to", ploc)
+        }),
+    );
+    let Some(second) = pieces.next() else {
+        cx.error_spanned_by(
+            args_loc,
+            format!("expected the frame's position `[x, y, z]` after the body number; {form}"),
+        );
+        return None;
+    };
+    let ploc = Loc::of(&second.tokens, args.span());
+    let position = report(
+        cx,
+        parse_all(second.tokens, |i| vector(i, "the frame's position", ploc)),
+    );
+    // Options only after a well-formed position: a position written without its
+    // brackets would otherwise be reported once per number.
+    let position = position?;
+    let mut rest = None;
+    for (_, _, value, vloc) in named_args(cx, pieces.collect(), symbol::FRAME_OPTIONS, "frame") {
+        // `rest`, the only option.
+        rest = report(
+            cx,
+            parse_all(value, |i| vector(i, "the rest rotation `[roll, pitch, yaw]`", vloc)),
+        );
+    }
+    Some(Frame {
+        body: body?,
+        position,
+        rest,
+    })
+}
+
 /// "mass: .., radius: .."
 fn arg_list(args: &[Symbol]) -> String {
     let parts: Vec<String> = args.iter().map(|a| format!("{a}: ..")).collect();
@@ -846,6 +964,61 @@ mod tests {
         let e = errors(quote!(bodies: { 1: blob() }));
         assert_eq!(e.len(), 1, "{e:#?}");
         assert!(e[0].contains("unknown body kind `blob`"));
+    }
+
+    #[test]
+    fn frames_parse() {
+        let cx = Ctxt::new();
+        let r = robot(
+            &cx,
+            quote!(frames: { tool: (2, [0.2, 0, -1e-3]), camera: (1, [0, 0.05, 0], rest: [0, 0, 1.5],) }),
+        );
+        cx.check().unwrap();
+        let frames = &r.frames.value.unwrap().entries;
+        let tool = frames[0].frame.as_ref().unwrap();
+        assert_eq!(frames[0].name, "tool");
+        assert_eq!((tool.body.value, tool.position.value()), (2, [0.2, 0.0, -1e-3]));
+        assert!(tool.rest.is_none());
+        let camera = frames[1].frame.as_ref().unwrap();
+        assert_eq!(frames[1].name, "camera");
+        assert_eq!(camera.body.value, 1);
+        assert_eq!(camera.rest.unwrap().value(), [0.0, 0.0, 1.5]);
+    }
+
+    #[test]
+    fn frame_syntax_errors_are_all_collected() {
+        let e = errors(quote! {
+            frames: {
+                "tool": (2, [0, 0, 0]),
+                type: (2, [0, 0, 0]),
+                r#tool: (2, [0, 0, 0]),
+                tool (2, [0, 0, 0]),
+                a: [2, 0, 0, 0],
+                b: (2),
+                c: (2, 0.1, 0.0, 0.0),
+                d: (2.5, [0, 0]),
+                e: (2, [0, 0, 0], rset: [0, 0, 0], rest: [0, 0]),
+                f: (),
+            },
+        });
+        let want = [
+            "expected the frame's name, an identifier such as `tool`",
+            "`type` cannot name a frame",
+            "`r#tool` cannot name a frame",
+            "expected `:` after the frame name `tool`",
+            "expected `(body, [x, y, z])` after `a:`; a frame is `a: (body, [x, y, z])` or",
+            "expected the frame's position `[x, y, z]` after the body number",
+            "expected the frame's position as `[x, y, z]`",
+            "expected the number of the body the frame is fixed to, an integer",
+            "the frame's position needs exactly 3 numbers",
+            "unknown argument `rset` of a frame (did you mean `rest`?); valid arguments are `rest`",
+            "the rest rotation `[roll, pitch, yaw]` needs exactly 3 numbers",
+            "expected `(body, [x, y, z])`; a frame is `f: (body, [x, y, z])` or",
+        ];
+        assert_eq!(e.len(), want.len(), "{e:#?}");
+        for (got, want) in e.iter().zip(want) {
+            assert!(got.contains(want), "{got:?} should contain {want:?}");
+        }
     }
 
     #[test]

@@ -15,11 +15,23 @@ pub const INCIDENCE: Symbol = Symbol("incidence");
 pub const JOINTS: Symbol = Symbol("joints");
 pub const BODY_JOINT_VECTORS: Symbol = Symbol("body_joint_vectors");
 pub const BODIES: Symbol = Symbol("bodies");
+pub const FRAMES: Symbol = Symbol("frames");
 
 /// All top-level keywords, in the order the docs present them.
-pub const TOP_LEVEL: &[Symbol] = &[NAME, URDF, GRAVITY, INCIDENCE, JOINTS, BODY_JOINT_VECTORS, BODIES];
+pub const TOP_LEVEL: &[Symbol] = &[
+    NAME,
+    URDF,
+    GRAVITY,
+    INCIDENCE,
+    JOINTS,
+    BODY_JOINT_VECTORS,
+    BODIES,
+    FRAMES,
+];
 /// What the inline form needs besides `name`.
 pub const INLINE_REQUIRED: &[Symbol] = &[INCIDENCE, JOINTS, BODY_JOINT_VECTORS, BODIES];
+/// What the inline form may add.
+pub const INLINE_OPTIONAL: &[Symbol] = &[GRAVITY, FRAMES];
 
 // Joint types.
 pub const REVOLUTE: Symbol = Symbol("revolute");
@@ -33,6 +45,8 @@ pub const FIXED: Symbol = Symbol("fixed");
 pub const REST: Symbol = Symbol("rest");
 pub const LIMITS: Symbol = Symbol("limits");
 pub const JOINT_OPTIONS: &[Symbol] = &[REST, LIMITS];
+/// Named extras of a frame.
+pub const FRAME_OPTIONS: &[Symbol] = &[REST];
 
 // Axis names (joint axes may also be negated: `-x`).
 pub const X: Symbol = Symbol("x");
@@ -124,6 +138,7 @@ mod tests {
     fn suggests_close_keywords_only() {
         assert_eq!(did_you_mean(TOP_LEVEL, "bodys"), " (did you mean `bodies`?)");
         assert_eq!(did_you_mean(TOP_LEVEL, "joint"), " (did you mean `joints`?)");
+        assert_eq!(did_you_mean(TOP_LEVEL, "frame"), " (did you mean `frames`?)");
         assert_eq!(did_you_mean(TOP_LEVEL, "colour"), "");
         assert_eq!(did_you_mean(AXES, "w"), "");
     }

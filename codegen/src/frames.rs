@@ -11,7 +11,7 @@
 //! `[z_k; 0]` for a prismatic one. `dyngen::FrameJacobian` and `dyngen::FrameMotion`
 //! turn that into `LOCAL` or `WORLD` at run time, a few products per column.
 
-use crate::algo::{BodyParams, JointTransform, M3, V3, ARG_A, ARG_PARAMS, ARG_Q, ARG_V};
+use crate::algo::{BodyParams, JointTransform, ARG_A, ARG_PARAMS, ARG_Q, ARG_V, M3, V3};
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
 use crate::generate::{doc_attrs, Record, Sizes};
 use crate::sym::{Expr, Graph, NodeId};
@@ -299,6 +299,8 @@ pub(crate) struct FrameFns {
     pub enum_item: TokenStream,
     /// Inherent functions and constants of the robot type, by name.
     pub items: Vec<(String, TokenStream)>,
+    /// `Robot` methods.
+    pub methods: TokenStream,
     pub reports: Vec<FnReport>,
 }
 
@@ -407,7 +409,11 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
         per_frame.push(t);
         let v = &variants[f];
-        let (pn, jn, mn) = (format_ident!("{}", pn), format_ident!("{}", jn), format_ident!("{}", mn));
+        let (pn, jn, mn) = (
+            format_ident!("{}", pn),
+            format_ident!("{}", jn),
+            format_ident!("{}", mn),
+        );
         placement_fns.push(quote!(#fty::#v => Self::#pn(q)));
         jacobian_fns.push(quote!(#fty::#v => Self::#jn(q, out)));
         motion_fns.push(quote!(#fty::#v => Self::#mn(q, v, a)));
@@ -481,9 +487,8 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let motion_doc = doc_attrs(
         "Frame `frame`'s placement, velocity and classical acceleration at `(q, v, a)`,\n`LOCAL_WORLD_ALIGNED`; `FrameMotion::velocity_in` and\n`FrameMotion::classical_acceleration_in` express them in another reference frame.",
     );
-    let velocity_doc = doc_attrs(
-        "Frame `frame`'s velocity at `(q, v)` in `reference` (Pinocchio's `getFrameVelocity`):\n`J(q) v`.",
-    );
+    let velocity_doc =
+        doc_attrs("Frame `frame`'s velocity at `(q, v)` in `reference` (Pinocchio's `getFrameVelocity`):\n`J(q) v`.");
     let acc_doc = doc_attrs(
         "Frame `frame`'s classical acceleration at `(q, v, a)` in `reference` (Pinocchio's\n`getFrameClassicalAcceleration`). With `a = 0` it is the drift `J̇(q, v)·v` of\n`ẍ = J q̈ + J̇ q̇`, the term operational-space and task-space controllers subtract.",
     );
@@ -548,7 +553,10 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let enum_doc = doc_attrs(&format!(
         "The frames of [`{ty}`]: every link of the description (links on fixed joints\nincluded) and every frame the description declares, in the order of\n`{ty}::MODEL.frames`."
     ));
-    let index_arms = variants.iter().zip(indices.clone()).map(|(v, i)| quote!(#fty::#v => #i));
+    let index_arms = variants
+        .iter()
+        .zip(indices.clone())
+        .map(|(v, i)| quote!(#fty::#v => #i));
     let from_index_arms = variants.iter().zip(indices).map(|(v, i)| quote!(#i => Some(#fty::#v)));
     let enum_item = quote! {
         #enum_doc
@@ -593,9 +601,38 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             }
         }
     };
+    let methods = quote! {
+        fn frame_placement<S: ::dyngen::Scalar>(q: &[S], frame: usize) -> ::core::option::Option<::dyngen::Pose<S>> {
+            use ::dyngen::__private::as_array;
+            Some(Self::frame_placement(as_array(q, "q"), #fty::from_index(frame)?))
+        }
+        fn frame_jacobian<S: ::dyngen::Scalar>(
+            q: &[S], frame: usize, reference: ::dyngen::ReferenceFrame, jacobian: &mut [S],
+        ) -> ::core::option::Option<::dyngen::Pose<S>> {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            let frame = #fty::from_index(frame)?;
+            let mut j = ::dyngen::FrameJacobian::<S, #n_l>::default();
+            Self::frame_jacobian(as_array(q, "q"), frame, reference, &mut j);
+            *as_rows_mut::<S, #n_l, 6>(jacobian, "jacobian") = j.jacobian;
+            Some(j.placement)
+        }
+        fn frame_motion<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], frame: usize) -> ::core::option::Option<::dyngen::FrameMotion<S>> {
+            use ::dyngen::__private::as_array;
+            Some(Self::frame_motion(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), #fty::from_index(frame)?))
+        }
+        fn center_of_mass<S: ::dyngen::Scalar>(q: &[S], params: &[S]) -> [S; 3] {
+            use ::dyngen::__private::as_array;
+            Self::center_of_mass(as_array(q, "q"), as_array(params, "params"))
+        }
+        fn com_jacobian<S: ::dyngen::Scalar>(q: &[S], params: &[S], jacobian: &mut [S]) {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            Self::com_jacobian(as_array(q, "q"), as_array(params, "params"), as_rows_mut::<S, #n_l, 3>(jacobian, "jacobian"));
+        }
+    };
     FrameFns {
         enum_item,
         items,
+        methods,
         reports,
     }
 }

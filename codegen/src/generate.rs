@@ -721,16 +721,180 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     functions.extend(joints.reports);
     items.extend(joints.items);
     methods.extend(joints.methods);
+    let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
+    functions.extend(derivative_reports);
+    items.extend(derivative_items);
+    methods.push(derivative_methods(sizes.n));
     let ty = format_ident!("{}", name);
     let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
     functions.extend(frames.reports);
     items.extend(frames.items);
+    methods.push(frames.methods);
     let mut tokens = robot_type(model, &ty, bases, &functions, &items, &methods);
     tokens.extend(frames.enum_item);
     GeneratedCode {
         tokens,
         functions,
         items,
+    }
+}
+
+/// The derivatives of the dynamics (`crate::derivatives`) as inherent functions
+/// writing `dyngen::RneaDerivatives` / `dyngen::AbaDerivatives`, and `M⁻¹` alone.
+fn derivative_items(
+    model: &Model,
+    sizes: &Sizes,
+    max_statements: usize,
+) -> (Vec<(String, TokenStream)>, Vec<FnReport>) {
+    use crate::derivatives::{self, Ddq};
+    let n = sizes.n;
+    let n_l = emit::usize_lit(n);
+    let arg = |id, name, len| Arg { id, name, len };
+    let (q, v, a, params) = (
+        arg(ARG_Q, "q", n),
+        arg(ARG_V, "v", n),
+        arg(ARG_A, "a", n),
+        arg(ARG_PARAMS, "params", 10 * n),
+    );
+    // Output `k` of a list of n × n matrices (and leading vectors) stored in the
+    // fields `fields` of `out`.
+    let place = move |fields: &'static [(&'static str, bool)]| {
+        move |k: usize| {
+            let mut k = k;
+            for (name, is_matrix) in fields {
+                let f = format_ident!("{}", name);
+                let len = if *is_matrix { n * n } else { n };
+                if k < len {
+                    return if *is_matrix {
+                        let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                        quote!(out.#f[#r][#c])
+                    } else {
+                        let i = emit::usize_lit(k);
+                        quote!(out.#f[#i])
+                    };
+                }
+                k -= len;
+            }
+            unreachable!("output {k} beyond the fields")
+        }
+    };
+    let ids = |m: &[Vec<Expr<'_>>]| m.iter().flatten().map(|x| x.id()).collect::<Vec<_>>();
+    let clear = quote!(*out = ::core::default::Default::default(););
+    let mut items = Vec::new();
+    let mut reports = Vec::new();
+
+    let g = Graph::new();
+    let d = derivatives::rnea_derivatives(&g, model);
+    let mut outputs = ids(&d.dtau_dq);
+    outputs.extend(ids(&d.dtau_dv));
+    outputs.extend(ids(&d.m));
+    let spec = FnSpec {
+        name: "rnea_derivatives",
+        public: true,
+        doc: format!(
+            "The derivatives of inverse dynamics `tau = rnea(q, v, a)` (Pinocchio's\n`computeRNEADerivatives`): `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M(q)`, {n} × {n} each, row `i`\nthe derivatives of `tau_i`, written to `out`. Built in closed form (composite\ninertias, momenta and rates of inertia carried up the tree); entries of joints on\ndifferent branches are exact zeros. {}; {}.",
+            sizes.state(),
+            sizes.params()
+        ),
+        args: vec![q, v, a, params],
+        ret: quote!(::dyngen::RneaDerivatives<S, #n_l>),
+        output: Output::InPlace {
+            place: Box::new(place(&[("dtau_dq", true), ("dtau_dv", true), ("dtau_da", true)])),
+            clear: clear.clone(),
+        },
+        outputs,
+    };
+    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
+    items.push(("rnea_derivatives".to_string(), t));
+    reports.push(r);
+
+    let g = Graph::new();
+    let d = derivatives::aba_derivatives_with(&g, model, Ddq::InverseInertia);
+    let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
+    outputs.extend(ids(&d.ddq_dq));
+    outputs.extend(ids(&d.ddq_dv));
+    outputs.extend(ids(&d.minv));
+    let (q, v, tau, params) = (
+        arg(ARG_Q, "q", n),
+        arg(ARG_V, "v", n),
+        arg(ARG_TAU, "tau", n),
+        arg(ARG_PARAMS, "params", 10 * n),
+    );
+    let spec = FnSpec {
+        name: "aba_derivatives",
+        public: true,
+        doc: format!(
+            "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per joint).\n`AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+            sizes.params()
+        ),
+        args: vec![q, v, tau, params],
+        ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
+        output: Output::InPlace {
+            place: Box::new(place(&[("ddq", false), ("ddq_dq", true), ("ddq_dv", true), ("minv", true)])),
+            clear: clear.clone(),
+        },
+        outputs,
+    };
+    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
+    items.push(("aba_derivatives".to_string(), t));
+    reports.push(r);
+
+    let g = Graph::new();
+    let m = algo::crba(&g, model);
+    let minv = derivatives::inverse_inertia(&g, model, &m);
+    let spec = FnSpec {
+        name: "inverse_inertia",
+        public: true,
+        doc: format!(
+            "`M(q)⁻¹` ({n} × {n}, symmetric; Pinocchio's `computeMinverse`) from the tree's `LᵀDL`\nfactorisation of [`Self::crba`]'s matrix, written to `out`. {}.",
+            sizes.params()
+        ),
+        args: vec![arg(ARG_Q, "q", n), arg(ARG_PARAMS, "params", 10 * n)],
+        ret: quote!([[S; #n_l]; #n_l]),
+        output: Output::InPlace {
+            place: Box::new(move |k: usize| {
+                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                quote!(out[#r][#c])
+            }),
+            clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
+        },
+        outputs: ids(&minv),
+    };
+    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
+    items.push(("inverse_inertia".to_string(), t));
+    reports.push(r);
+    (items, reports)
+}
+
+/// The `Robot` methods of [`derivative_items`].
+fn derivative_methods(n: usize) -> TokenStream {
+    let n_l = emit::usize_lit(n);
+    quote! {
+        fn rnea_derivatives<S: ::dyngen::Scalar>(
+            q: &[S], v: &[S], a: &[S], params: &[S], dtau_dq: &mut [S], dtau_dv: &mut [S], dtau_da: &mut [S],
+        ) {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            let mut d = ::dyngen::RneaDerivatives::<S, #n_l>::default();
+            Self::rnea_derivatives(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), as_array(params, "params"), &mut d);
+            *as_rows_mut::<S, #n_l, #n_l>(dtau_dq, "dtau_dq") = d.dtau_dq;
+            *as_rows_mut::<S, #n_l, #n_l>(dtau_dv, "dtau_dv") = d.dtau_dv;
+            *as_rows_mut::<S, #n_l, #n_l>(dtau_da, "dtau_da") = d.dtau_da;
+        }
+        fn aba_derivatives<S: ::dyngen::Scalar>(
+            q: &[S], v: &[S], tau: &[S], params: &[S], ddq: &mut [S], ddq_dq: &mut [S], ddq_dv: &mut [S], minv: &mut [S],
+        ) {
+            use ::dyngen::__private::{as_array, as_array_mut, as_rows_mut};
+            let mut d = ::dyngen::AbaDerivatives::<S, #n_l>::default();
+            Self::aba_derivatives(as_array(q, "q"), as_array(v, "v"), as_array(tau, "tau"), as_array(params, "params"), &mut d);
+            *as_array_mut::<S, #n_l>(ddq, "ddq") = d.ddq;
+            *as_rows_mut::<S, #n_l, #n_l>(ddq_dq, "ddq_dq") = d.ddq_dq;
+            *as_rows_mut::<S, #n_l, #n_l>(ddq_dv, "ddq_dv") = d.ddq_dv;
+            *as_rows_mut::<S, #n_l, #n_l>(minv, "minv") = d.minv;
+        }
+        fn inverse_inertia<S: ::dyngen::Scalar>(q: &[S], params: &[S], minv: &mut [S]) {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            Self::inverse_inertia(as_array(q, "q"), as_array(params, "params"), as_rows_mut::<S, #n_l, #n_l>(minv, "minv"));
+        }
     }
 }
 

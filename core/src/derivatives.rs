@@ -155,7 +155,10 @@ mod tests {
         };
         let base = step(q[0], v[0], tau[0]);
         let h = 1e-3;
-        for (col, x) in [step(q[0] + h, v[0], tau[0]), step(q[0], v[0] + h, tau[0])].iter().enumerate() {
+        for (col, x) in [step(q[0] + h, v[0], tau[0]), step(q[0], v[0] + h, tau[0])]
+            .iter()
+            .enumerate()
+        {
             for row in 0..2 {
                 let fd = (x[row] - base[row]) / h;
                 assert!((fd - l.a(row, col).unwrap()).abs() < 1e-9, "A[{row}][{col}]");
@@ -163,7 +166,10 @@ mod tests {
         }
         let x = step(q[0], v[0], tau[0] + h);
         for row in 0..2 {
-            assert!(((x[row] - base[row]) / h - l.b(row, 0).unwrap()).abs() < 1e-9, "B[{row}]");
+            assert!(
+                ((x[row] - base[row]) / h - l.b(row, 0).unwrap()).abs() < 1e-9,
+                "B[{row}]"
+            );
         }
         assert_eq!(l.a(2, 0), None);
         assert_eq!(l.b(0, 1), None);

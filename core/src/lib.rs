@@ -28,8 +28,8 @@ mod robot;
 mod robot_model;
 mod scalar;
 
-pub use dyngen_macros::robot;
 pub use derivatives::{AbaDerivatives, Linearization, RneaDerivatives};
+pub use dyngen_macros::robot;
 pub use frames::{FrameJacobian, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;

@@ -1,7 +1,7 @@
 //! The [`Robot`] trait every generated robot type implements, and the small spatial
 //! types of its API.
 
-use crate::{Coulomb, RobotModel, Scalar};
+use crate::{Coulomb, FrameMotion, ReferenceFrame, RobotModel, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// A body's pose in the base frame: `x_base = rotation · x_body + translation`.
@@ -209,6 +209,52 @@ pub trait Robot {
     fn base_regressor_joints<S: Scalar>(q: &[S], v: &[S], a: &[S], coulomb: Coulomb<S>, y: &mut [S]);
     /// `β_j = K_j [params; joint_params]`. `beta`: `NBASE_JOINTS`.
     fn base_params_joints<S: Scalar>(params: &[S], joint_params: &[S], beta: &mut [S]);
+
+    /// Frame `frame`'s placement in the world (`frame` indexes `MODEL.frames`; the
+    /// generated frame enum gives the same through `index()`); `None` when there is no
+    /// such frame.
+    fn frame_placement<S: Scalar>(q: &[S], frame: usize) -> Option<Pose<S>>;
+    /// Frame `frame`'s Jacobian (6 × `NV`, rows `[linear; angular]`) in `reference`,
+    /// row-major into `jacobian`; returns the frame's placement, `None` (and `jacobian`
+    /// untouched) when there is no such frame.
+    fn frame_jacobian<S: Scalar>(
+        q: &[S],
+        frame: usize,
+        reference: ReferenceFrame,
+        jacobian: &mut [S],
+    ) -> Option<Pose<S>>;
+    /// Frame `frame`'s placement, velocity and classical acceleration,
+    /// `LOCAL_WORLD_ALIGNED`; `None` when there is no such frame.
+    fn frame_motion<S: Scalar>(q: &[S], v: &[S], a: &[S], frame: usize) -> Option<FrameMotion<S>>;
+    /// The centre of mass of the moving bodies in the world. `params`: `NPARAMS`.
+    fn center_of_mass<S: Scalar>(q: &[S], params: &[S]) -> [S; 3];
+    /// The centre of mass's Jacobian (3 × `NV`, world axes), row-major into `jacobian`.
+    fn com_jacobian<S: Scalar>(q: &[S], params: &[S], jacobian: &mut [S]);
+    /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`Robot::rnea`], each `NV × NV` row-major.
+    fn rnea_derivatives<S: Scalar>(
+        q: &[S],
+        v: &[S],
+        a: &[S],
+        params: &[S],
+        dtau_dq: &mut [S],
+        dtau_dv: &mut [S],
+        dtau_da: &mut [S],
+    );
+    /// `q̈ = aba(q, v, tau)` and `∂q̈/∂q`, `∂q̈/∂v`, `M⁻¹ = ∂q̈/∂τ`, each `NV × NV`
+    /// row-major.
+    #[allow(clippy::too_many_arguments)]
+    fn aba_derivatives<S: Scalar>(
+        q: &[S],
+        v: &[S],
+        tau: &[S],
+        params: &[S],
+        ddq: &mut [S],
+        ddq_dq: &mut [S],
+        ddq_dv: &mut [S],
+        minv: &mut [S],
+    );
+    /// `M(q)⁻¹`, row-major into `minv` (`NV × NV`).
+    fn inverse_inertia<S: Scalar>(q: &[S], params: &[S], minv: &mut [S]);
 }
 
 /// Operation counts of one generated function, as the generator measured them.

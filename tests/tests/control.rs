@@ -1,0 +1,322 @@
+//! The control kernels of every shipped robot against Pinocchio 4.1 (fixtures in
+//! `tests/fixtures/control/`, made by `scripts/make_control_fixtures.py`): frame
+//! placements, Jacobians, velocities and classical accelerations in the three
+//! reference frames, the `J̇v` drift, the centre of mass and its Jacobian, the
+//! derivatives of inverse and forward dynamics and `M⁻¹`. Then the same functions
+//! against central finite differences of the generated code itself.
+
+use dyngen::{Pose, ReferenceFrame, Robot};
+use dyngen_tests::tree12::Tree12;
+use dyngen_tests::{pose_vec, rel_err, workspace_root};
+use robot_gripper_arm::GripperArm;
+use robot_panda::Panda;
+use robot_paper6::Paper6;
+use robot_planar2::Planar2;
+use robot_puma560::Puma560;
+use robot_ur5::Ur5;
+use serde_json::Value;
+
+const TOL: f64 = 1e-10;
+const REFS: [(ReferenceFrame, &str); 3] = [
+    (ReferenceFrame::World, "world"),
+    (ReferenceFrame::Local, "local"),
+    (ReferenceFrame::LocalWorldAligned, "lwa"),
+];
+
+fn load(name: &str) -> Value {
+    let path = workspace_root().join(format!("tests/fixtures/control/{name}.json"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).expect("fixture JSON")
+}
+
+/// Numbers of a JSON value, nested lists flattened row-major.
+fn nums(v: &Value) -> Vec<f64> {
+    match v {
+        Value::Number(x) => vec![x.as_f64().expect("f64")],
+        Value::Array(xs) => xs.iter().flat_map(nums).collect(),
+        _ => panic!("not a number or list: {v}"),
+    }
+}
+
+fn fixture_pose(v: &Value) -> Vec<f64> {
+    let mut p = nums(&v["rotation"]);
+    p.extend(nums(&v["translation"]));
+    p
+}
+
+/// Worst relative error of each quantity over the fixture, by name.
+#[derive(Default, Debug)]
+struct Worst(Vec<(&'static str, f64)>);
+
+impl Worst {
+    fn add(&mut self, what: &'static str, who: &str, sample: usize, got: &[f64], want: &[f64], floor: f64) {
+        let e = rel_err(got, want, floor);
+        assert!(
+            e < TOL,
+            "{who}: {what}, sample {sample}: relative error {e:e}\n got {got:?}\nwant {want:?}"
+        );
+        match self.0.iter_mut().find(|(w, _)| *w == what) {
+            Some((_, x)) => *x = x.max(e),
+            None => self.0.push((what, e)),
+        }
+    }
+}
+
+fn check<R: Robot>(fixture: &str) -> Worst {
+    let fx = load(fixture);
+    let who = R::NAME;
+    let n = R::NV;
+    let names: Vec<String> = fx["joint_names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(names, R::joint_names(), "{who}: joint order");
+    // The same frames as Pinocchio's link frames, each on the same body.
+    let frames = fx["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), R::MODEL.frames.len(), "{who}: frame count");
+    let index: Vec<usize> = frames
+        .iter()
+        .map(|f| {
+            let name = f["name"].as_str().unwrap();
+            let k = R::MODEL
+                .frames
+                .iter()
+                .position(|m| m.name == name)
+                .unwrap_or_else(|| panic!("{who}: no frame {name}"));
+            assert_eq!(
+                R::MODEL.frames[k].body as u64,
+                f["parent_joint"].as_u64().unwrap(),
+                "{who}: {name}'s body"
+            );
+            k
+        })
+        .collect();
+
+    let params = R::nominal_params();
+    let mut worst = Worst::default();
+    for (s, sample) in fx["samples"].as_array().unwrap().iter().enumerate() {
+        let (q, v, a, tau) = (
+            nums(&sample["q"]),
+            nums(&sample["v"]),
+            nums(&sample["a"]),
+            nums(&sample["tau"]),
+        );
+        let zero = vec![0.0; n];
+        for (f, want) in index.iter().zip(sample["frames"].as_array().unwrap()) {
+            let placement = R::frame_placement(&q, *f).unwrap();
+            worst.add(
+                "placement",
+                who,
+                s,
+                &pose_vec(&placement),
+                &fixture_pose(&want["oMf"]),
+                1.0,
+            );
+            for (reference, key) in REFS {
+                let mut jac = vec![0.0; 6 * n];
+                let p = R::frame_jacobian(&q, *f, reference, &mut jac).unwrap();
+                assert_eq!(
+                    pose_vec(&p),
+                    pose_vec(&placement),
+                    "{who}: placement beside the Jacobian"
+                );
+                worst.add("jacobian", who, s, &jac, &nums(&want[format!("J_{key}").as_str()]), 1.0);
+                let m = R::frame_motion(&q, &v, &a, *f).unwrap();
+                worst.add(
+                    "velocity",
+                    who,
+                    s,
+                    &m.velocity_in(reference).to_array(),
+                    &nums(&want[format!("v_{key}").as_str()]),
+                    1.0,
+                );
+                let acc = m.classical_acceleration_in(reference).to_array();
+                worst.add(
+                    "classical acceleration",
+                    who,
+                    s,
+                    &acc,
+                    &nums(&want[format!("acc_{key}").as_str()]),
+                    1.0,
+                );
+                let drift = R::frame_motion(&q, &v, &zero, *f)
+                    .unwrap()
+                    .classical_acceleration_in(reference)
+                    .to_array();
+                worst.add(
+                    "drift J̇v",
+                    who,
+                    s,
+                    &drift,
+                    &nums(&want[format!("drift_{key}").as_str()]),
+                    1.0,
+                );
+            }
+        }
+        worst.add(
+            "centre of mass",
+            who,
+            s,
+            &R::center_of_mass(&q, params),
+            &nums(&sample["com"]),
+            1.0,
+        );
+        let mut jc = vec![0.0; 3 * n];
+        R::com_jacobian(&q, params, &mut jc);
+        worst.add("centre of mass Jacobian", who, s, &jc, &nums(&sample["Jcom"]), 1.0);
+
+        let (mut dq, mut dv, mut m) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+        R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut m);
+        worst.add("dtau/dq", who, s, &dq, &nums(&sample["dtau_dq"]), 1.0);
+        worst.add("dtau/dv", who, s, &dv, &nums(&sample["dtau_dv"]), 1.0);
+        worst.add("dtau/da = M", who, s, &m, &nums(&sample["M"]), 1.0);
+
+        let (mut ddq, mut minv) = (vec![0.0; n], vec![0.0; n * n]);
+        R::aba_derivatives(&q, &v, &tau, params, &mut ddq, &mut dq, &mut dv, &mut minv);
+        worst.add("aba", who, s, &ddq, &nums(&sample["ddq"]), 1.0);
+        worst.add("ddq/dq", who, s, &dq, &nums(&sample["ddq_dq"]), 1.0);
+        worst.add("ddq/dv", who, s, &dv, &nums(&sample["ddq_dv"]), 1.0);
+        worst.add("Minv", who, s, &minv, &nums(&sample["Minv"]), 1.0);
+        let mut alone = vec![0.0; n * n];
+        R::inverse_inertia(&q, params, &mut alone);
+        worst.add("inverse_inertia", who, s, &alone, &nums(&sample["Minv"]), 1.0);
+    }
+    // A frame index beyond the frames is refused, not a panic.
+    let nf = R::MODEL.frames.len();
+    assert!(R::frame_placement(&vec![0.0; n], nf).is_none());
+    assert!(R::frame_jacobian(&vec![0.0; n], nf, ReferenceFrame::Local, &mut vec![0.0; 6 * n]).is_none());
+    worst
+}
+
+#[test]
+fn control_kernels_match_pinocchio() {
+    let all = [
+        ("ur5", check::<Ur5>("ur5")),
+        ("gripper_arm", check::<GripperArm>("gripper_arm")),
+        ("planar2", check::<Planar2>("planar2")),
+        ("paper6", check::<Paper6>("paper6")),
+        ("puma560", check::<Puma560>("puma560")),
+        ("panda", check::<Panda>("panda")),
+        ("tree12", check::<Tree12>("tree12")),
+    ];
+    for (name, w) in &all {
+        let line: Vec<String> = w.0.iter().map(|(k, e)| format!("{k} {e:.1e}")).collect();
+        println!("{name}: {}", line.join(", "));
+    }
+}
+
+/// Central differences of a function of `x` (each coordinate in turn), column by
+/// column: `out[r][c] = ∂f_r/∂x_c`.
+fn central<F: Fn(&[f64]) -> Vec<f64>>(x: &[f64], h: f64, f: F) -> Vec<Vec<f64>> {
+    let rows = f(x).len();
+    let mut d = vec![vec![0.0; x.len()]; rows];
+    for c in 0..x.len() {
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        xp[c] += h;
+        xm[c] -= h;
+        let (fp, fm) = (f(&xp), f(&xm));
+        for r in 0..rows {
+            d[r][c] = (fp[r] - fm[r]) / (2.0 * h);
+        }
+    }
+    d
+}
+
+fn fd_err(got: &[f64], fd: &[Vec<f64>]) -> f64 {
+    let want: Vec<f64> = fd.iter().flatten().copied().collect();
+    rel_err(got, &want, 1.0)
+}
+
+/// The generated Jacobians, drift and derivatives against central differences of the
+/// generated placements, velocities, rnea and aba, at random states (fixed seed).
+fn finite_differences<R: Robot>() -> [f64; 6] {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+    let n = R::NV;
+    let params = R::nominal_params();
+    let mut worst = [0.0f64; 6];
+    for _ in 0..5 {
+        let q: Vec<f64> = (0..n).map(|_| rng.gen_range(-1.5..1.5)).collect();
+        let v: Vec<f64> = (0..n).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let a: Vec<f64> = (0..n).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let tau: Vec<f64> = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();
+        let h = 1e-6;
+        for f in 0..R::MODEL.frames.len() {
+            // Translation part of the Jacobian: d(position)/dq.
+            let mut jac = vec![0.0; 6 * n];
+            R::frame_jacobian(&q, f, ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
+            let fd = central(&q, h, |x| {
+                let p: Pose<f64> = R::frame_placement(x, f).unwrap();
+                p.translation.iter().copied().collect()
+            });
+            worst[0] = worst[0].max(fd_err(&jac[..3 * n], &fd));
+            // The classical acceleration is d/dt of the velocity J(q) v along
+            // q(t) = q + t v + t² a / 2.
+            let vel_at = |t: f64| {
+                let qt: Vec<f64> = (0..n).map(|i| q[i] + t * v[i] + 0.5 * t * t * a[i]).collect();
+                let vt: Vec<f64> = (0..n).map(|i| v[i] + t * a[i]).collect();
+                R::frame_motion(&qt, &vt, &a, f).unwrap().velocity.to_array()
+            };
+            let fd: Vec<f64> = (0..6).map(|r| (vel_at(h)[r] - vel_at(-h)[r]) / (2.0 * h)).collect();
+            let acc = R::frame_motion(&q, &v, &a, f).unwrap().acceleration.to_array();
+            worst[1] = worst[1].max(rel_err(&acc, &fd, 1.0));
+        }
+        let mut jc = vec![0.0; 3 * n];
+        R::com_jacobian(&q, params, &mut jc);
+        worst[2] = worst[2].max(fd_err(&jc, &central(&q, h, |x| R::center_of_mass(x, params).to_vec())));
+
+        let (mut dq, mut dv, mut m) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+        R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut m);
+        let rnea = |q: &[f64], v: &[f64]| {
+            let mut t = vec![0.0; n];
+            R::rnea(q, v, &a, params, &mut t);
+            t
+        };
+        worst[3] = worst[3].max(fd_err(&dq, &central(&q, h, |x| rnea(x, &v))));
+        worst[3] = worst[3].max(fd_err(&dv, &central(&v, h, |x| rnea(&q, x))));
+
+        let (mut ddq, mut minv) = (vec![0.0; n], vec![0.0; n * n]);
+        R::aba_derivatives(&q, &v, &tau, params, &mut ddq, &mut dq, &mut dv, &mut minv);
+        let aba = |q: &[f64], v: &[f64], tau: &[f64]| {
+            let mut t = vec![0.0; n];
+            R::aba(q, v, tau, params, &mut t);
+            t
+        };
+        // Relative to the size of q̈, which reaches 1e4 on light wrists.
+        let scale = ddq.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        let fq = central(&q, h, |x| aba(x, &v, &tau));
+        let fv = central(&v, h, |x| aba(&q, x, &tau));
+        let ft = central(&tau, h, |x| aba(&q, &v, x));
+        for (got, fd) in [(&dq, &fq), (&dv, &fv), (&minv, &ft)] {
+            let want: Vec<f64> = fd.iter().flatten().copied().collect();
+            let e = got.iter().zip(&want).map(|(g, w)| (g - w).abs()).fold(0.0, f64::max);
+            worst[4] = worst[4].max(e / scale.max(want.iter().fold(1.0f64, |m, x| m.max(x.abs()))));
+        }
+        worst[5] = worst[5].max(rel_err(&ddq, &aba(&q, &v, &tau), 1.0));
+    }
+    worst
+}
+
+#[test]
+fn control_kernels_match_finite_differences() {
+    let all = [
+        ("ur5", finite_differences::<Ur5>()),
+        ("gripper_arm", finite_differences::<GripperArm>()),
+        ("planar2", finite_differences::<Planar2>()),
+        ("paper6", finite_differences::<Paper6>()),
+        ("puma560", finite_differences::<Puma560>()),
+        ("panda", finite_differences::<Panda>()),
+        ("tree12", finite_differences::<Tree12>()),
+    ];
+    for (name, w) in &all {
+        println!(
+            "{name}: jacobian {:.1e}, classical acceleration {:.1e}, com jacobian {:.1e}, rnea derivatives {:.1e}, aba derivatives {:.1e}, ddq vs aba {:.1e}",
+            w[0], w[1], w[2], w[3], w[4], w[5]
+        );
+        assert!(w[0] < 1e-7 && w[1] < 1e-6 && w[2] < 1e-7, "{name}: {w:?}");
+        assert!(w[3] < 1e-6 && w[4] < 1e-6, "{name}: {w:?}");
+        assert!(w[5] < 1e-12, "{name}: {w:?}");
+    }
+}

@@ -108,6 +108,47 @@ pub fn aba_derivatives<'g>(g: &'g Graph, model: &Model) -> AbaDerivatives<'g> {
 /// `q̈` itself depends on is not differentiated again.
 pub fn aba_derivatives_with<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaDerivatives<'g> {
     let n = model.dof();
+    let AbaParts {
+        ddq,
+        dtau_dq: dq,
+        dtau_dv: dv,
+        minv,
+    } = aba_derivative_parts(g, model, how);
+    g.mark("derivatives: −M⁻¹ ∂τ/∂q, −M⁻¹ ∂τ/∂v");
+    let times_minv = |d: &[Vec<Expr<'g>>]| -> Vec<Vec<Expr<'g>>> {
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|c| {
+                        let col: Vec<Expr<'g>> = d.iter().map(|row| row[c]).collect();
+                        -dot(&minv[i], &col)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    AbaDerivatives {
+        ddq_dq: times_minv(&dq),
+        ddq_dv: times_minv(&dv),
+        ddq,
+        minv,
+    }
+}
+
+/// What [`aba_derivatives_with`] multiplies: `q̈`, `∂τ/∂q` and `∂τ/∂v` at `a = q̈`, and
+/// `M⁻¹`. Generated code takes these and does the two `n × n` products in a loop:
+/// written out, they would add `2 n²(2n − 1)` straight-line operations to a function
+/// that is already larger than the instruction cache.
+pub struct AbaParts<'g> {
+    pub ddq: Vec<Expr<'g>>,
+    pub dtau_dq: Vec<Vec<Expr<'g>>>,
+    pub dtau_dv: Vec<Vec<Expr<'g>>>,
+    pub minv: Vec<Vec<Expr<'g>>>,
+}
+
+/// The parts of [`aba_derivatives_with`], before the products with `−M⁻¹`.
+pub fn aba_derivative_parts<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaParts<'g> {
+    let n = model.dof();
     let (ddq, minv) = match how {
         Ddq::Aba => {
             let ddq = algo::aba(g, model, algo::Armature::None);
@@ -133,23 +174,10 @@ pub fn aba_derivatives_with<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaDer
             rnea_partials(g, model, &qd, &k, &r.wrenches)
         }
     };
-    g.mark("derivatives: −M⁻¹ ∂τ/∂q, −M⁻¹ ∂τ/∂v");
-    let times_minv = |d: &[Vec<Expr<'g>>]| -> Vec<Vec<Expr<'g>>> {
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|c| {
-                        let col: Vec<Expr<'g>> = d.iter().map(|row| row[c]).collect();
-                        -dot(&minv[i], &col)
-                    })
-                    .collect()
-            })
-            .collect()
-    };
-    AbaDerivatives {
-        ddq_dq: times_minv(&dq),
-        ddq_dv: times_minv(&dv),
+    AbaParts {
         ddq,
+        dtau_dq: dq,
+        dtau_dv: dv,
         minv,
     }
 }

@@ -748,7 +748,7 @@ fn derivative_items(
 ) -> (Vec<(String, TokenStream)>, Vec<FnReport>) {
     use crate::derivatives::{self, Ddq};
     let n = sizes.n;
-    let n_l = emit::usize_lit(n);
+    let (n_l, np_l) = (emit::usize_lit(n), emit::usize_lit(10 * n));
     let arg = |id, name, len| Arg { id, name, len };
     let (q, v, a, params) = (
         arg(ARG_Q, "q", n),
@@ -809,10 +809,10 @@ fn derivative_items(
     reports.push(r);
 
     let g = Graph::new();
-    let d = derivatives::aba_derivatives_with(&g, model, Ddq::InverseInertia);
+    let d = derivatives::aba_derivative_parts(&g, model, Ddq::InverseInertia);
     let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
-    outputs.extend(ids(&d.ddq_dq));
-    outputs.extend(ids(&d.ddq_dv));
+    outputs.extend(ids(&d.dtau_dq));
+    outputs.extend(ids(&d.dtau_dv));
     outputs.extend(ids(&d.minv));
     let (q, v, tau, params) = (
         arg(ARG_Q, "q", n),
@@ -820,13 +820,14 @@ fn derivative_items(
         arg(ARG_TAU, "tau", n),
         arg(ARG_PARAMS, "params", 10 * n),
     );
+    let aba_doc = doc_attrs(&format!(
+        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per joint); the two products with it run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+        sizes.params()
+    ));
     let spec = FnSpec {
-        name: "aba_derivatives",
-        public: true,
-        doc: format!(
-            "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per joint).\n`AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
-            sizes.params()
-        ),
+        name: "__aba_derivative_parts",
+        public: false,
+        doc: "The generated part of [`Self::aba_derivatives`]: `ddq`, `M⁻¹`, and `∂τ/∂q`, `∂τ/∂v`\nat `a = ddq` in the places of `∂q̈/∂q`, `∂q̈/∂v`.".to_string(),
         args: vec![q, v, tau, params],
         ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
         output: Output::InPlace {
@@ -835,8 +836,23 @@ fn derivative_items(
         },
         outputs,
     };
-    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
-    items.push(("aba_derivatives".to_string(), t));
+    let (parts, mut r) = emit::emit_fn(&g, &spec, max_statements);
+    r.name = "aba_derivatives".to_string();
+    items.push((
+        "aba_derivatives".to_string(),
+        quote! {
+            #aba_doc
+            #[inline]
+            pub fn aba_derivatives<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
+                out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
+            ) {
+                Self::__aba_derivative_parts(q, v, tau, params, out);
+                ::dyngen::__private::times_minus_minv(out);
+            }
+            #parts
+        },
+    ));
     reports.push(r);
 
     let g = Graph::new();

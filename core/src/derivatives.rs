@@ -87,6 +87,29 @@ impl<S: Scalar, const N: usize> Linearization<S, N> {
     }
 }
 
+/// Support for generated code: `ddq_dq ← −M⁻¹ ddq_dq`, `ddq_dv ← −M⁻¹ ddq_dv`, where
+/// the generated part left `∂τ/∂q` and `∂τ/∂v` (loops: small code, vectorised).
+#[doc(hidden)]
+#[inline]
+pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>) {
+    let (dq, dv) = (d.ddq_dq, d.ddq_dv);
+    for i in 0..N {
+        let row = &d.minv[i];
+        let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
+        for k in 0..N {
+            let m = row[k];
+            for c in 0..N {
+                sq[c] += m * dq[k][c];
+                sv[c] += m * dv[k][c];
+            }
+        }
+        for c in 0..N {
+            d.ddq_dq[i][c] = -sq[c];
+            d.ddq_dv[i][c] = -sv[c];
+        }
+    }
+}
+
 impl<S: Scalar, const N: usize> AbaDerivatives<S, N> {
     /// The semi-implicit (symplectic) Euler step `v⁺ = v + dt·q̈(q, v, τ)`,
     /// `q⁺ = q + dt·v⁺` from the state `(q, v)` these derivatives were taken at,

@@ -40,6 +40,7 @@ pub use scalar::Scalar;
 /// Support for generated code; not a public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::derivatives::__times_minus_minv as times_minus_minv;
     pub use crate::frames::__express_jacobian as express_jacobian;
 
     /// A slice as a fixed-size array, with a message naming the argument when the

@@ -739,6 +739,9 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     }
 }
 
+/// The statement budget of a part of the derivative functions (see [`derivative_items`]).
+const DERIVATIVE_MAX_STATEMENTS: usize = 800;
+
 /// The derivatives of the dynamics (`crate::derivatives`) as inherent functions
 /// writing `dyngen::RneaDerivatives` / `dyngen::AbaDerivatives`, and `M⁻¹` alone.
 fn derivative_items(
@@ -747,6 +750,11 @@ fn derivative_items(
     max_statements: usize,
 ) -> (Vec<(String, TokenStream)>, Vec<FnReport>) {
     use crate::derivatives::{self, Ddq};
+    // Parts of at most 800 statements: measured on the Panda (release, 2 cores),
+    // aba_derivatives ran 967 ns in parts of 1,200 and 811 ns in parts of 800 (400:
+    // 772 ns, but the UR5's and rnea_derivatives got slower); rnea_derivatives was
+    // unchanged within 2 %. rustc schedules large straight-line functions poorly.
+    let max_statements = max_statements.min(DERIVATIVE_MAX_STATEMENTS);
     let n = sizes.n;
     let (n_l, np_l) = (emit::usize_lit(n), emit::usize_lit(10 * n));
     let arg = |id, name, len| Arg { id, name, len };

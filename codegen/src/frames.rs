@@ -141,7 +141,7 @@ fn v3_ids<'a>(v: &'a V3<'_>) -> impl Iterator<Item = NodeId> + 'a {
 }
 
 /// Frame `f`'s placement (12 outputs: rotation row-major, translation).
-fn build_placement(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+pub fn build_placement(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let b = model.frames[f].body;
     let (world, _) = walk(g, model, &path(model, b), Walk::Placement);
     let (r, t, _) = frame_pose(g, model, f, &world[b].expect("walked"));
@@ -149,7 +149,7 @@ fn build_placement(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
 }
 
 /// Every frame's placement, one walk over all bodies.
-fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
+pub fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
     let all: Vec<usize> = (1..=model.dof()).collect();
     let (world, _) = walk(g, model, &all, Walk::Placement);
     (0..model.frames.len())
@@ -161,7 +161,7 @@ fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
 }
 
 /// Frame `f`'s placement (12) and `LOCAL_WORLD_ALIGNED` Jacobian (6 × n, row-major).
-fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let n = model.dof();
     let b = model.frames[f].body;
     let on_path = path(model, b);
@@ -186,7 +186,7 @@ fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
 
 /// Frame `f`'s placement (12), velocity (6) and classical acceleration (6) of its
 /// origin, `LOCAL_WORLD_ALIGNED`.
-fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+pub fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let bi = model.frames[f].body;
     let (world, _) = walk(g, model, &path(model, bi), Walk::Motion);
     let b = world[bi].expect("walked");
@@ -211,7 +211,7 @@ fn moments<'g>(g: &'g Graph, model: &Model, world: &[Option<WorldBody<'g>>]) -> 
 }
 
 /// The centre of mass (3 outputs).
-fn build_com(g: &Graph, model: &Model) -> Vec<NodeId> {
+pub fn build_com(g: &Graph, model: &Model) -> Vec<NodeId> {
     let all: Vec<usize> = (1..=model.dof()).collect();
     let (world, _) = walk(g, model, &all, Walk::Placement);
     let (m, h) = moments(g, model, &world)
@@ -223,7 +223,7 @@ fn build_com(g: &Graph, model: &Model) -> Vec<NodeId> {
 /// The centre of mass's Jacobian (3 × n, row-major): column `k` is
 /// `z_k × (h_k − m_k o_k) / m` for a revolute joint and `z_k m_k / m` for a prismatic
 /// one, `m_k` and `h_k` the mass and first moment of the bodies joint `k` carries.
-fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
+pub fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
     let n = model.dof();
     let all: Vec<usize> = (1..=n).collect();
     let (world, joints) = walk(g, model, &all, Walk::Placement);

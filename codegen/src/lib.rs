@@ -18,7 +18,7 @@ mod build;
 pub mod derivatives;
 pub mod dsl;
 pub mod emit;
-mod frames;
+pub mod frames;
 mod generate;
 mod joints;
 pub mod sym;

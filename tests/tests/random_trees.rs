@@ -727,3 +727,137 @@ fn a_difference_and_its_mirror_share_one_node() {
         "x − y is {mirror:?}, not −(y − x) = −{first:?}"
     );
 }
+
+/// Central differences of `f` at `x`, one column per coordinate (row-major result,
+/// `rows × x.len()`).
+fn central(x: &[f64], h: f64, f: impl Fn(&[f64]) -> Vec<f64>) -> Vec<f64> {
+    let cols: Vec<Vec<f64>> = (0..x.len())
+        .map(|c| {
+            let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+            xp[c] += h;
+            xm[c] -= h;
+            f(&xp).iter().zip(f(&xm)).map(|(p, m)| (p - m) / (2.0 * h)).collect()
+        })
+        .collect();
+    let rows = cols.first().map_or(0, Vec::len);
+    (0..rows).flat_map(|r| cols.iter().map(move |c| c[r])).collect()
+}
+
+/// The control kernels through the graph on every random tree: each frame's
+/// Jacobian against differences of its placement (the angular part from `Ṙ Rᵀ`), its
+/// velocity against `J v`, its classical acceleration against differences of the
+/// velocity along `q + t v + t² a / 2`; the centre of mass against the reference's
+/// poses and its Jacobian against differences; the derivatives of rnea and aba
+/// against differences of the reference's rnea and aba.
+#[test]
+fn control_kernels_agree_with_differences_on_random_trees() {
+    use dyngen_codegen::derivatives;
+    use dyngen_codegen::frames;
+    let mut failures = Vec::new();
+    let mut frames_checked = 0;
+    for (tree, _) in all_trees() {
+        let model = tree.build();
+        let n = model.dof();
+        let reference = Reference::new(&model);
+        let mut fail = |what: &str, k: usize, got: &[f64], want: &[f64], tol: f64| {
+            let e = rel_err(got, want, 1.0);
+            if !(e < tol) {
+                failures.push(format!(
+                    "seed {:#x} sample {k}: {what}: relative error {e:e}",
+                    tree.seed
+                ));
+            }
+        };
+        let zeros = vec![0.0; n];
+        let h = 1e-6;
+        for (k, s) in sample_states(&model, 2, tree.seed).iter().enumerate() {
+            let params = perturbed_params(&model, tree.seed ^ (k as u64 + 7), 0.3);
+            let (q, v, a, p) = (&s.q[..], &s.v[..], &s.a[..], &params[..]);
+            for f in 0..model.frames.len() {
+                frames_checked += 1;
+                let g = Graph::new();
+                let place = frames::build_placement(&g, &model, f);
+                let jac = eval(&g, &frames::build_jacobian(&g, &model, f), q, &zeros, &zeros, &[]);
+                let pose_at = |x: &[f64]| eval(&g, &place, x, &zeros, &zeros, &[]);
+                let pose = pose_at(q);
+                fail("placement beside the Jacobian", k, &jac[..12], &pose, 1e-14);
+                let dpose = central(q, h, pose_at);
+                // Linear rows: d(translation)/dq.
+                fail("frame Jacobian, linear", k, &jac[12..12 + 3 * n], &dpose[9 * n..], 1e-7);
+                // Angular rows: the axial vector of (dR/dq_c) Rᵀ.
+                let r = |i: usize, j: usize| pose[3 * i + j];
+                let dr = |i: usize, j: usize, c: usize| dpose[(3 * i + j) * n + c];
+                let w = |c: usize, i: usize, j: usize| (0..3).map(|m| dr(i, m, c) * r(j, m)).sum::<f64>();
+                let angular: Vec<f64> = [(2, 1), (0, 2), (1, 0)]
+                    .iter()
+                    .flat_map(|&(i, j)| (0..n).map(move |c| w(c, i, j)).collect::<Vec<_>>())
+                    .collect();
+                fail("frame Jacobian, angular", k, &jac[12 + 3 * n..], &angular, 1e-7);
+                let motion = frames::build_motion(&g, &model, f);
+                let m = eval(&g, &motion, q, v, a, &[]);
+                let jv: Vec<f64> = (0..6)
+                    .map(|row| (0..n).map(|c| jac[12 + row * n + c] * v[c]).sum())
+                    .collect();
+                fail("frame velocity = J v", k, &m[12..18], &jv, 1e-12);
+                let vel_at = |t: f64| {
+                    let qt: Vec<f64> = (0..n).map(|i| q[i] + t * v[i] + 0.5 * t * t * a[i]).collect();
+                    let vt: Vec<f64> = (0..n).map(|i| v[i] + t * a[i]).collect();
+                    eval(&g, &motion, &qt, &vt, a, &[])[12..18].to_vec()
+                };
+                let (vp, vm) = (vel_at(h), vel_at(-h));
+                let dv: Vec<f64> = (0..6).map(|i| (vp[i] - vm[i]) / (2.0 * h)).collect();
+                fail("frame classical acceleration", k, &m[18..24], &dv, 1e-6);
+            }
+            let g = Graph::new();
+            let com = frames::build_com(&g, &model);
+            let com_at = |x: &[f64]| eval(&g, &com, x, &zeros, &zeros, p);
+            let poses = reference.forward_kinematics(q);
+            let mut want = [0.0; 3];
+            let mut mass = 0.0;
+            for (i, pose) in poses.iter().enumerate() {
+                let m = p[10 * i];
+                let h = nalgebra::Vector3::new(p[10 * i + 1], p[10 * i + 2], p[10 * i + 3]);
+                let c = pose.translation * m + pose.rotation * h;
+                for d in 0..3 {
+                    want[d] += c[d];
+                }
+                mass += m;
+            }
+            fail("centre of mass", k, &com_at(q), &want.map(|x| x / mass), 1e-12);
+            let jc = eval(&g, &frames::build_com_jacobian(&g, &model), q, &zeros, &zeros, p);
+            fail("centre of mass Jacobian", k, &jc, &central(q, h, com_at), 1e-7);
+
+            let g = Graph::new();
+            let d = derivatives::rnea_derivatives(&g, &model);
+            let flat = |m: &[Vec<Expr<'_>>]| m.iter().flatten().map(|x| x.id()).collect::<Vec<_>>();
+            let dq = eval(&g, &flat(&d.dtau_dq), q, v, a, p);
+            let dv = eval(&g, &flat(&d.dtau_dv), q, v, a, p);
+            fail("∂τ/∂q", k, &dq, &central(q, h, |x| reference.rnea(x, v, a, p)), 1e-6);
+            fail("∂τ/∂v", k, &dv, &central(v, h, |x| reference.rnea(q, x, a, p)), 1e-6);
+            let tau = reference.rnea(q, v, a, p);
+            let g = Graph::new();
+            let d = derivatives::aba_derivatives_with(&g, &model, derivatives::Ddq::InverseInertia);
+            let ddq = eval(&g, &ids(&d.ddq), q, v, &tau, p);
+            fail("aba", k, &ddq, a, 1e-9);
+            // Relative to the largest acceleration the differences see.
+            let fq = central(q, h, |x| reference.aba(x, v, &tau, p));
+            let fv = central(v, h, |x| reference.aba(q, x, &tau, p));
+            let ft = central(&tau, h, |x| reference.aba(q, v, x, p));
+            let scale = a.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+            for (what, m, fd) in [("∂q̈/∂q", &d.ddq_dq, fq), ("∂q̈/∂v", &d.ddq_dv, fv), ("M⁻¹", &d.minv, ft)]
+            {
+                let got = eval(&g, &flat(m), q, v, &tau, p);
+                let e = got.iter().zip(&fd).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+                let size = fd.iter().fold(scale, |s, x| s.max(x.abs()));
+                fail(what, k, &[e / size], &[0.0], 1e-6);
+            }
+        }
+    }
+    assert!(frames_checked > 200, "only {frames_checked} frames");
+    assert!(
+        failures.is_empty(),
+        "{} failures (the first {SHOWN} shown):\n{}",
+        failures.len(),
+        failures[..failures.len().min(SHOWN)].join("\n")
+    );
+}

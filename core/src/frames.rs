@@ -229,8 +229,10 @@ mod tests {
 
     #[test]
     fn jacobian_velocity_is_j_times_v() {
-        let mut j = FrameJacobian::<f64, 2>::default();
-        j.jacobian = [[1.0, 2.0], [0.0, 1.0], [3.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 0.0]];
+        let j = FrameJacobian::<f64, 2> {
+            jacobian: [[1.0, 2.0], [0.0, 1.0], [3.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 0.0]],
+            ..Default::default()
+        };
         let v = j.velocity(&[2.0, -1.0]);
         assert_eq!(v.to_array(), [0.0, -1.0, 6.0, 0.0, -1.0, 2.0]);
     }

@@ -320,3 +320,80 @@ fn control_kernels_match_finite_differences() {
         assert!(w[5] < 1e-12, "{name}: {w:?}");
     }
 }
+
+/// The planar arm of the paper with frames declared in the description: a tool at
+/// the tip of body 2, a camera on body 1 turned a quarter turn about z, a mark on
+/// the base.
+mod with_frames {
+    dyngen::robot! {
+        name: Planar2Tool,
+        gravity: [0.0, -9.81, 0.0],
+        incidence: [[-1, 0], [1, -1], [0, 1]],
+        joints: [revolute(z), revolute(z)],
+        body_joint_vectors: {
+            (0, 1): [0.0, 0.0, 0.0],
+            (1, 1): [-0.25, 0.0, 0.0],
+            (1, 2): [0.25, 0.0, 0.0],
+            (2, 2): [-0.2, 0.0, 0.0],
+        },
+        bodies: {
+            1: cylinder(mass: 5.0, radius: 0.04, length: 0.5, axis: x),
+            2: cylinder(mass: 3.0, radius: 0.03, length: 0.4, axis: x),
+        },
+        frames: {
+            tool: (2, [0.2, 0.0, 0.0]),
+            camera: (1, [0.0, 0.05, 0.0], rest: [0.0, 0.0, 1.5707963267948966]),
+            base_mark: (0, [0.1, 0.0, 0.0]),
+        },
+    }
+}
+
+#[test]
+fn frames_declared_in_the_description() {
+    use with_frames::{Planar2Tool, Planar2ToolFrame};
+    assert_eq!(Planar2ToolFrame::from_name("tool"), Some(Planar2ToolFrame::Tool));
+    assert_eq!(Planar2ToolFrame::Tool.body(), 2);
+    assert_eq!(Planar2ToolFrame::Camera.body(), 1);
+    assert_eq!(Planar2ToolFrame::BaseMark.body(), 0);
+    assert_eq!(Planar2ToolFrame::from_name("gripper"), None);
+    let (q1, q2) = (0.4f64, -1.1f64);
+    let q = [q1, q2];
+    // The tip of a 0.5 m and a 0.4 m link in the x–y plane.
+    let tip = Planar2Tool::frame_placement(&q, Planar2ToolFrame::Tool).translation;
+    let want = [
+        0.5 * q1.cos() + 0.4 * (q1 + q2).cos(),
+        0.5 * q1.sin() + 0.4 * (q1 + q2).sin(),
+        0.0,
+    ];
+    for d in 0..3 {
+        assert!((tip[d] - want[d]).abs() < 1e-15, "tool {tip:?} vs {want:?}");
+    }
+    // Its Jacobian in world-aligned axes: the planar 2-link Jacobian.
+    let mut j = dyngen::FrameJacobian::<f64, 2>::default();
+    Planar2Tool::frame_jacobian(&q, Planar2ToolFrame::Tool, ReferenceFrame::LocalWorldAligned, &mut j);
+    let jx = [-want[1], -0.4 * (q1 + q2).sin()];
+    let jy = [want[0], 0.4 * (q1 + q2).cos()];
+    for c in 0..2 {
+        assert!((j.jacobian[0][c] - jx[c]).abs() < 1e-15 && (j.jacobian[1][c] - jy[c]).abs() < 1e-15);
+        assert_eq!(j.jacobian[5][c], 1.0);
+    }
+    // The camera: body 1's centre (0.25 m out) plus 0.05 m across, turned by q1 + π/2.
+    let cam = Planar2Tool::frame_placement(&q, Planar2ToolFrame::Camera);
+    let (s, c) = q1.sin_cos();
+    let at = [0.25 * c - 0.05 * s, 0.25 * s + 0.05 * c];
+    assert!((cam.translation[0] - at[0]).abs() < 1e-15 && (cam.translation[1] - at[1]).abs() < 1e-15);
+    let (s90, c90) = (q1 + std::f64::consts::FRAC_PI_2).sin_cos();
+    assert!((cam.rotation[(0, 0)] - c90).abs() < 1e-15 && (cam.rotation[(1, 0)] - s90).abs() < 1e-15);
+    // The base mark does not move; all its Jacobian columns are zero.
+    let mark = Planar2Tool::frame_placement(&q, Planar2ToolFrame::BaseMark);
+    assert_eq!(mark.translation, dyngen::nalgebra::Vector3::new(0.1, 0.0, 0.0));
+    Planar2Tool::frame_jacobian(&q, Planar2ToolFrame::BaseMark, ReferenceFrame::World, &mut j);
+    assert!(j.jacobian.iter().flatten().all(|&x| x == 0.0));
+    // Frames add no mass: the dynamics equal the plain arm's.
+    let p = Planar2Tool::NOMINAL_PARAMS;
+    assert_eq!(p, Planar2::NOMINAL_PARAMS);
+    assert_eq!(
+        Planar2Tool::rnea(&q, &[0.3, -0.2], &[1.0, 2.0], &p),
+        Planar2::rnea(&q, &[0.3, -0.2], &[1.0, 2.0], &p)
+    );
+}

@@ -65,6 +65,22 @@ pub struct Linearization<S: Scalar, const N: usize> {
     pub b_v: [[S; N]; N],
 }
 
+impl<S: Scalar, const N: usize> Default for Linearization<S, N> {
+    fn default() -> Self {
+        let zero = [[S::ZERO; N]; N];
+        Linearization {
+            q_next: [S::ZERO; N],
+            v_next: [S::ZERO; N],
+            a_qq: zero,
+            a_qv: zero,
+            a_vq: zero,
+            a_vv: zero,
+            b_q: zero,
+            b_v: zero,
+        }
+    }
+}
+
 impl<S: Scalar, const N: usize> Linearization<S, N> {
     /// Entry `(r, c)` of `A` (2N × 2N); `None` outside it.
     pub fn a(&self, r: usize, c: usize) -> Option<S> {
@@ -123,17 +139,7 @@ impl<S: Scalar, const N: usize> AbaDerivatives<S, N> {
     /// (`q ⊕ dt·v` is `q + dt·v` here: every joint coordinate is an angle or a
     /// displacement.)
     pub fn semi_implicit_euler(&self, q: &[S; N], v: &[S; N], dt: S) -> Linearization<S, N> {
-        let zero = [[S::ZERO; N]; N];
-        let mut l = Linearization {
-            q_next: [S::ZERO; N],
-            v_next: [S::ZERO; N],
-            a_qq: zero,
-            a_qv: zero,
-            a_vq: zero,
-            a_vv: zero,
-            b_q: zero,
-            b_v: zero,
-        };
+        let mut l = Linearization::default();
         for i in 0..N {
             l.v_next[i] = v[i] + dt * self.ddq[i];
             l.q_next[i] = q[i] + dt * l.v_next[i];

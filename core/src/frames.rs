@@ -4,7 +4,7 @@
 //! reference frames follow from the frame's placement in a few products.
 
 use crate::{Pose, Scalar};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// In which frame a velocity, an acceleration or a Jacobian is expressed, as
 /// Pinocchio's `ReferenceFrame`.
@@ -84,6 +84,12 @@ impl<S: Scalar, const N: usize> FrameJacobian<S, N> {
         }
     }
 
+    /// The Jacobian as an nalgebra matrix (6 × N). (`SMatrix::from` of the nested
+    /// array would read its rows as columns.)
+    pub fn matrix(&self) -> SMatrix<S, 6, N> {
+        SMatrix::from_fn(|r, c| self.jacobian[r][c])
+    }
+
     /// Re-expresses a `LOCAL_WORLD_ALIGNED` Jacobian (as the generated code writes it)
     /// in `reference`.
     pub(crate) fn express_from_lwa(&mut self, reference: ReferenceFrame) {
@@ -145,6 +151,69 @@ impl<S: Scalar> FrameMotion<S> {
                     angular: acc.angular,
                 }
             }
+        }
+    }
+}
+
+/// The rotation vector `ω` (`|ω| ≤ π`) with `exp([ω]×) = r`: the logarithm on SO(3)
+/// (Pinocchio's `log3`), accurate to rounding at every angle: the angle from `atan2`
+/// (an `acos` of the trace loses half the digits near 0), and near π, where the skew
+/// part vanishes, the axis from the symmetric part.
+pub fn log3<S: Scalar>(r: &Matrix3<S>) -> Vector3<S> {
+    let half = S::from_f64(0.5);
+    // Rodrigues: r = c E + s [a]× + (1 − c) a aᵀ, so the skew part is 2 s a.
+    let skew = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
+    let s = half * (skew[0] * skew[0] + skew[1] * skew[1] + skew[2] * skew[2]).sqrt();
+    let c = half * (r[(0, 0)] + r[(1, 1)] + r[(2, 2)] - S::ONE);
+    let theta = s.atan2(c);
+    if c > S::from_f64(-0.9) {
+        // θ / sin θ, 1 at θ = 0.
+        let factor = if s == S::ZERO { S::ONE } else { theta / s };
+        return skew * (half * factor);
+    }
+    // Near π: the symmetric part less c E is (1 − c) a aᵀ; the axis from its largest
+    // diagonal entry, its sign from the skew part.
+    let one_c = S::ONE - c;
+    let b = |i: usize, j: usize| half * (r[(i, j)] + r[(j, i)]) - if i == j { c } else { S::ZERO };
+    let mut i = 0;
+    for k in 1..3 {
+        if b(k, k) > b(i, i) {
+            i = k;
+        }
+    }
+    let bii = b(i, i) / one_c;
+    let ai = if bii > S::ZERO { bii.sqrt() } else { S::ZERO };
+    if ai == S::ZERO {
+        return Vector3::from_element(S::ZERO);
+    }
+    let mut axis = Vector3::from_fn(|j, _| if j == i { ai } else { b(i, j) / (one_c * ai) });
+    if axis[0] * skew[0] + axis[1] * skew[1] + axis[2] * skew[2] < S::ZERO {
+        axis = -axis;
+    }
+    axis * theta
+}
+
+impl<S: Scalar> Pose<S> {
+    /// The identity placement.
+    pub fn identity() -> Self {
+        let (o, z) = (S::ONE, S::ZERO);
+        Pose {
+            rotation: Matrix3::new(o, z, z, z, o, z, z, z, o),
+            translation: Vector3::from_element(z),
+        }
+    }
+
+    /// The error from `self` to `target` as a world-aligned twist,
+    /// `[p_target − p; log3(R_target Rᵀ)]`: what carries `self` onto `target` in unit
+    /// time to first order, so that `J_lwa Δq = error` is the Newton step of inverse
+    /// kinematics with a `LOCAL_WORLD_ALIGNED` Jacobian.
+    pub fn error_to(&self, target: &Pose<S>) -> Motion<S> {
+        Motion {
+            linear: target.translation - self.translation,
+            angular: log3(&Matrix3::from_fn(|i, j| {
+                let (a, b) = (&target.rotation, &self.rotation);
+                a[(i, 0)] * b[(j, 0)] + a[(i, 1)] * b[(j, 1)] + a[(i, 2)] * b[(j, 2)]
+            })),
         }
     }
 }
@@ -225,6 +294,64 @@ mod tests {
         // The velocity of the body point at the world origin: v_p + ω × (0 − p).
         let want = m.linear + m.angular.cross(&(-p.translation));
         assert!((w.linear - want).norm() < 1e-15);
+    }
+
+    /// `exp` of a rotation vector, by Rodrigues.
+    fn exp3(w: Vector3<f64>) -> Matrix3<f64> {
+        let t = w.norm();
+        if t == 0.0 {
+            return Matrix3::identity();
+        }
+        let a = w / t;
+        let k = Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0);
+        Matrix3::identity() + k * t.sin() + k * k * (1.0 - t.cos())
+    }
+
+    #[test]
+    fn log3_inverts_exp_at_every_angle() {
+        let axis = Vector3::new(0.3, -0.5, 0.8).normalize();
+        for t in [
+            0.0,
+            1e-12,
+            1e-7,
+            0.3,
+            2.0,
+            2.9,
+            std::f64::consts::PI - 1e-9,
+            std::f64::consts::PI,
+        ] {
+            let w = axis * t;
+            let got = log3(&exp3(w));
+            assert!(
+                (got - w).norm() < 1e-15 * (1.0 + t) || (t == std::f64::consts::PI && (got + w).norm() < 1e-15),
+                "angle {t}: {got:?} vs {w:?}"
+            );
+            assert!((exp3(got) - exp3(w)).norm() < 1e-15, "angle {t}");
+        }
+    }
+
+    #[test]
+    fn pose_error_is_the_twist_to_the_target() {
+        let p = pose();
+        let w = Vector3::new(0.1, -0.2, 0.05);
+        let target = Pose {
+            rotation: exp3(w) * p.rotation,
+            translation: p.translation + Vector3::new(0.01, 0.0, -0.02),
+        };
+        let e = p.error_to(&target);
+        assert!((e.angular - w).norm() < 1e-15);
+        assert!((e.linear - Vector3::new(0.01, 0.0, -0.02)).norm() < 1e-15);
+        assert_eq!(Pose::<f64>::identity().error_to(&Pose::identity()).to_array(), [0.0; 6]);
+    }
+
+    #[test]
+    fn jacobian_matrix_keeps_rows() {
+        let j = FrameJacobian::<f64, 2> {
+            jacobian: [[1.0, 2.0], [0.0, 1.0], [3.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 0.0]],
+            ..Default::default()
+        };
+        let m = j.matrix();
+        assert_eq!((m[(0, 1)], m[(2, 0)], m[(5, 0)]), (2.0, 3.0, 1.0));
     }
 
     #[test]

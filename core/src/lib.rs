@@ -30,7 +30,7 @@ mod scalar;
 
 pub use derivatives::{AbaDerivatives, Linearization, RneaDerivatives};
 pub use dyngen_macros::robot;
-pub use frames::{FrameJacobian, FrameMotion, Motion, ReferenceFrame};
+pub use frames::{log3, FrameJacobian, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
 pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};

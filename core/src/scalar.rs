@@ -38,6 +38,9 @@ pub trait Scalar:
     /// The hyperbolic tangent: the smooth Coulomb friction `tanh(q̇/ε)`
     /// ([`crate::Coulomb::Smooth`]).
     fn tanh(self) -> Self;
+    /// The angle of the point `(other, self)`: `atan2(y = self, x = other)`, for the
+    /// logarithm of a rotation ([`crate::log3`]).
+    fn atan2(self, other: Self) -> Self;
 }
 
 macro_rules! impl_scalar {
@@ -72,6 +75,10 @@ macro_rules! impl_scalar {
             #[inline(always)]
             fn tanh(self) -> Self {
                 num_traits::Float::tanh(self)
+            }
+            #[inline(always)]
+            fn atan2(self, other: Self) -> Self {
+                num_traits::Float::atan2(self, other)
             }
         }
     };

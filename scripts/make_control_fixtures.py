@@ -29,7 +29,6 @@ against finite differences (step 1e-6, central) and identities (see CHECKS) and
 refuses to write if any error exceeds its tolerance (1e-6 for the finite differences,
 judged relative to max(1, |f|); 1e-9 for the identities). The schema is documented in tests/fixtures/control/README.md.
 """
-import argparse
 import json
 import os
 import sys
@@ -38,15 +37,13 @@ import numpy as np
 import pinocchio as pin
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_fixtures import ROOT, FIXTURE_DIR, FIXTURES, check_model, coord_range, flat, rows, se3, to_pin_q  # noqa: E402
+from make_fixtures import ROOT, FIXTURE_DIR, FIXTURES, run_cli, check_model, coord_range, flat, rows, se3, to_pin_q  # noqa: E402
 
 CONTROL_DIR = os.path.join(FIXTURE_DIR, "control")
 SCHEMA_VERSION = 1
 GENERATOR = "scripts/make_control_fixtures.py"
 SAMPLES = 6
 SEED = 7
-# Fewer samples where a file would otherwise grow too large (none needed so far).
-SAMPLES_OVERRIDE = {}
 V_RANGE = 2.0     # v uniform in [-2, 2]^nv
 A_RANGE = 2.0     # a uniform in [-2, 2]^nv
 TAU_RANGE = 10.0  # tau uniform in [-10, 10]^nv
@@ -299,30 +296,7 @@ def write(fix, out_dir):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--all", action="store_true", help="regenerate every control fixture the project ships")
-    ap.add_argument("--urdf", help="URDF path (relative to the current directory)")
-    ap.add_argument("--name", help="fixture name: writes OUT_DIR/NAME.json")
-    ap.add_argument("--samples", type=int, default=SAMPLES)
-    ap.add_argument("--seed", type=int, default=SEED)
-    ap.add_argument("--out-dir", default=CONTROL_DIR, help="default: tests/fixtures/control of the project")
-    ap.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
-                    help="gravity in the base frame (default Pinocchio's 0 0 -9.81)")
-    args = ap.parse_args()
-
-    if args.all == bool(args.urdf or args.name):
-        ap.error("give either --all or both --urdf and --name")
-    if args.all:
-        jobs = [(os.path.join(ROOT, u), n, SAMPLES_OVERRIDE.get(n, SAMPLES), SEED, g)
-                for u, n, _s, _seed, g in FIXTURES]
-    else:
-        if not (args.urdf and args.name):
-            ap.error("--urdf and --name go together")
-        if not os.path.isfile(args.urdf):
-            ap.error(f"URDF not found: {args.urdf}")
-        jobs = [(args.urdf, args.name, args.samples, args.seed, args.gravity)]
-    for urdf, name, samples, seed, gravity in jobs:
-        write(make_fixture(urdf, name, samples, seed, gravity), args.out_dir)
+    run_cli(__doc__, make_fixture, write, CONTROL_DIR, SAMPLES, SEED, all_samples=True, what="control fixture")
 
 
 if __name__ == "__main__":

@@ -222,14 +222,18 @@ def write(fix, out_dir):
           f"seed {fix['seed']}, nv {fix['model']['nv']}, pinocchio {fix['pinocchio_version']})")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--all", action="store_true", help="regenerate every fixture the project ships")
+def run_cli(description, make, write, out_dir, samples, seed, all_samples=False, what="fixture"):
+    """The command line both fixture scripts share: --all (every robot of FIXTURES, with
+    `samples` and `seed` for all when `all_samples`, else each with FIXTURES' own) or
+    --urdf and --name for any URDF; `make(urdf, name, samples, seed, gravity)` builds a
+    fixture and `write(fixture, out_dir)` writes it."""
+    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--all", action="store_true", help=f"regenerate every {what} the project ships")
     ap.add_argument("--urdf", help="URDF path (relative to the current directory)")
     ap.add_argument("--name", help="fixture name: writes OUT_DIR/NAME.json")
-    ap.add_argument("--samples", type=int, default=50)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out-dir", default=FIXTURE_DIR, help="default: tests/fixtures of the project")
+    ap.add_argument("--samples", type=int, default=samples)
+    ap.add_argument("--seed", type=int, default=seed)
+    ap.add_argument("--out-dir", default=out_dir, help=f"default: {os.path.relpath(out_dir, ROOT)} of the project")
     ap.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                     help="gravity in the base frame (default Pinocchio's 0 0 -9.81)")
     args = ap.parse_args()
@@ -237,15 +241,22 @@ def main():
     if args.all == bool(args.urdf or args.name):
         ap.error("give either --all or both --urdf and --name")
     if args.all:
-        jobs = [(os.path.join(ROOT, u), n, s, seed, g) for u, n, s, seed, g in FIXTURES]
+        if not all_samples:
+            jobs = [(os.path.join(ROOT, u), n, s, sd, g) for u, n, s, sd, g in FIXTURES]
+        else:
+            jobs = [(os.path.join(ROOT, u), n, samples, seed, g) for u, n, _s, _sd, g in FIXTURES]
     else:
         if not (args.urdf and args.name):
             ap.error("--urdf and --name go together")
         if not os.path.isfile(args.urdf):
             ap.error(f"URDF not found: {args.urdf}")
         jobs = [(args.urdf, args.name, args.samples, args.seed, args.gravity)]
-    for urdf, name, samples, seed, gravity in jobs:
-        write(make_fixture(urdf, name, samples, seed, gravity), args.out_dir)
+    for urdf, name, n, sd, gravity in jobs:
+        write(make(urdf, name, n, sd, gravity), args.out_dir)
+
+
+def main():
+    run_cli(__doc__, make_fixture, write, FIXTURE_DIR, 50, 0)
 
 
 if __name__ == "__main__":

@@ -68,6 +68,7 @@ CHECKS = {
                       "vs drift_ref, ref in world, local"),
     "com_fd": (1e-6, "central difference of com along theta + t v vs Jcom v"),
     "rnea_da_M": (1e-9, "dtau_da of computeRNEADerivatives vs M"),
+    "Ag_linear_mass_Jcom": (1e-9, "linear rows of Ag vs total mass times Jcom"),
     "aba_ddq": (1e-9, "M ddq + rnea(q, v, 0) - tau"),
     "minv_M_identity": (1e-9, "Minv M - I"),
     "jacobian_velocity": (1e-9, "J_ref v - v_ref, ref in world, local, lwa, for a and a = 0"),
@@ -182,6 +183,8 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
         # Centre of mass.
         com = pin.centerOfMass(model, data, q).copy()
         Jcom = pin.jacobianCenterOfMass(model, data, q).copy()
+        Ag = pin.computeCentroidalMap(model, data, q).copy()
+        record("Ag_linear_mass_Jcom", Ag[:3] - data.mass[0] * Jcom)
 
         # Joint space.
         M = sym_upper(pin.crba(model, data, q))
@@ -250,6 +253,7 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
             "frames": frames_out,
             "com": flat(com),
             "Jcom": rows(Jcom),
+            "Ag": rows(Ag),
             "M": rows(M),
             "dtau_dq": rows(dtau_dq),
             "dtau_dv": rows(dtau_dv),

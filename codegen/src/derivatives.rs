@@ -213,7 +213,7 @@ fn inertia_times<'g>(b: &BodyParams<'g>, m: Motion<'g>) -> Force<'g> {
 
 /// Every body's parameters with its descendants' added, leaves first, as `crba` does
 /// (so the composite inertias are `crba`'s nodes).
-fn composites<'g>(model: &Model, x: &[JointTransform<'g>], mut c: Vec<BodyParams<'g>>) -> Vec<BodyParams<'g>> {
+pub fn composites<'g>(model: &Model, x: &[JointTransform<'g>], mut c: Vec<BodyParams<'g>>) -> Vec<BodyParams<'g>> {
     for i in (1..=model.dof()).rev() {
         let p = model.parent(i);
         if p > 0 {

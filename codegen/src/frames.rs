@@ -256,6 +256,45 @@ pub fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
     jac.iter().flatten().map(|x| x.id()).collect()
 }
 
+/// The centroidal momentum matrix `A_g` (6 × n, row-major, rows `[linear; angular]`):
+/// `h_g = A_g(q) v` is the momentum of all moving bodies, the angular part about the
+/// centre of mass, world axes (Pinocchio's `computeCentroidalMap`). Column `k` is the
+/// momentum of the bodies joint `k` carries when it moves at unit speed: their
+/// composite inertia (`crba`'s, in body `k`'s frame) times the joint's axis, rotated
+/// into world axes and moved to the centre of mass `c`:
+/// `[R_k f; R_k n + (o_k − c) × R_k f]`, `(f, n) = I_k S_k` at body `k`'s origin `o_k`.
+pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
+    let n = model.dof();
+    let all: Vec<usize> = (1..=n).collect();
+    let (world, _) = walk(g, model, &all, Walk::Placement);
+    let x: Vec<JointTransform<'_>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
+    let composite = crate::derivatives::composites(model, &x, (1..=n).map(|i| BodyParams::input(g, i)).collect());
+    // The centre of mass from the composites of the bodies on the base.
+    let (total, first) = (1..=n)
+        .filter(|&i| model.parent(i) == 0)
+        .fold((g.zero(), V3::zero(g)), |(m, h), i| {
+            let (c, b) = (&composite[i - 1], world[i].expect("walked"));
+            (m + c.m, h + b.t.scale(c.m) + b.r.mul_vec(c.h))
+        });
+    let com = first.scale(g.one() / total);
+    let mut a = vec![vec![g.zero(); n]; 6];
+    for k in 1..=n {
+        let c = &composite[k - 1];
+        let b = world[k].expect("walked");
+        let s = crate::algo::subspace(g, model, k);
+        // (f, n) = I_k S_k, as crba builds it.
+        let f = s.v.scale(c.m) + s.w.cross(c.h);
+        let m = c.inertia.mul_vec(s.w) + c.h.cross(s.v);
+        let (fw, mw) = (b.r.mul_vec(f), b.r.mul_vec(m));
+        let l = mw + (b.t - com).cross(fw);
+        for r in 0..3 {
+            a[r][k - 1] = fw.0[r];
+            a[3 + r][k - 1] = l.0[r];
+        }
+    }
+    a.iter().flatten().map(|x| x.id()).collect()
+}
+
 /// A Rust identifier for frame names: `wrist_3_link` → `Wrist3Link`, unique among
 /// the frames (a numeric suffix where two names would meet).
 fn variant_names(model: &Model) -> Vec<syn::Ident> {
@@ -477,6 +516,28 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     };
     let com_jacobian = emit_one(spec, &g, "com_jacobian".to_string());
 
+    let g = Graph::new();
+    let outputs = build_centroidal_map(&g, model);
+    let spec = FnSpec {
+        name: "centroidal_map",
+        public: true,
+        doc: format!(
+            "The centroidal momentum matrix `A_g(q)` (6 × {n}, rows `[linear; angular]`): `A_g v` is\nthe momentum of the moving bodies, the angular part about their centre of mass,\nworld axes (Pinocchio's `computeCentroidalMap`; `ccrba` computes it with `A_g v`).\n{}.",
+            sizes.params()
+        ),
+        args: vec![q(), params()],
+        ret: quote!([[S; #n_l]; 6]),
+        output: Output::InPlace {
+            place: Box::new(move |k: usize| {
+                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                quote!(out[#r][#c])
+            }),
+            clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
+        },
+        outputs,
+    };
+    let centroidal = emit_one(spec, &g, "centroidal_map".to_string());
+
     let zero_a = quote!(&[<S as ::dyngen::Scalar>::ZERO; #n_l]);
     let dispatch_doc = doc_attrs(&format!(
         "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. Walks only the bodies between the\nbase and the frame."
@@ -535,6 +596,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             #placements
             #com
             #com_jacobian
+            #centroidal
             #(#per_frame)*
         },
     ));
@@ -623,6 +685,10 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         fn center_of_mass<S: ::dyngen::Scalar>(q: &[S], params: &[S]) -> [S; 3] {
             use ::dyngen::__private::as_array;
             Self::center_of_mass(as_array(q, "q"), as_array(params, "params"))
+        }
+        fn centroidal_map<S: ::dyngen::Scalar>(q: &[S], params: &[S], a_g: &mut [S]) {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            Self::centroidal_map(as_array(q, "q"), as_array(params, "params"), as_rows_mut::<S, #n_l, 6>(a_g, "a_g"));
         }
         fn com_jacobian<S: ::dyngen::Scalar>(q: &[S], params: &[S], jacobian: &mut [S]) {
             use ::dyngen::__private::{as_array, as_rows_mut};

@@ -230,6 +230,9 @@ pub trait Robot {
     fn center_of_mass<S: Scalar>(q: &[S], params: &[S]) -> [S; 3];
     /// The centre of mass's Jacobian (3 × `NV`, world axes), row-major into `jacobian`.
     fn com_jacobian<S: Scalar>(q: &[S], params: &[S], jacobian: &mut [S]);
+    /// The centroidal momentum matrix `A_g` (6 × `NV`, rows `[linear; angular]`, the
+    /// angular part about the centre of mass, world axes), row-major into `a_g`.
+    fn centroidal_map<S: Scalar>(q: &[S], params: &[S], a_g: &mut [S]);
     /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`Robot::rnea`], each `NV × NV` row-major.
     fn rnea_derivatives<S: Scalar>(
         q: &[S],

@@ -60,6 +60,14 @@ macro_rules! bench_control {
                 black_box(&jc);
             })
         });
+        let mut ag = [[0.0; N]; 6];
+        group.bench_function("centroidal_map/generated", |b| {
+            b.iter(|| {
+                let (q, _, _) = next();
+                <$robot>::centroidal_map(black_box(q), &params, &mut ag);
+                black_box(&ag);
+            })
+        });
         let mut rd = RneaDerivatives::<f64, N>::default();
         group.bench_function("rnea_derivatives/generated", |b| {
             b.iter(|| {

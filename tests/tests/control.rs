@@ -166,6 +166,9 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         let mut jc = vec![0.0; 3 * n];
         R::com_jacobian(&q, params, &mut jc);
         worst.add("centre of mass Jacobian", who, s, &jc, &nums(&sample["Jcom"]), 1.0);
+        let mut ag = vec![0.0; 6 * n];
+        R::centroidal_map(&q, params, &mut ag);
+        worst.add("centroidal map A_g", who, s, &ag, &nums(&sample["Ag"]), 1.0);
 
         let (mut dq, mut dv, mut m) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
         R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut m);

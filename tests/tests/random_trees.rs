@@ -826,6 +826,10 @@ fn control_kernels_agree_with_differences_on_random_trees() {
             fail("centre of mass", k, &com_at(q), &want.map(|x| x / mass), 1e-12);
             let jc = eval(&g, &frames::build_com_jacobian(&g, &model), q, &zeros, &zeros, p);
             fail("centre of mass Jacobian", k, &jc, &central(q, h, com_at), 1e-7);
+            // Linear momentum: the centroidal map's first rows are m · J_c.
+            let ag = eval(&g, &frames::build_centroidal_map(&g, &model), q, &zeros, &zeros, p);
+            let mjc: Vec<f64> = jc.iter().map(|x| x * mass).collect();
+            fail("centroidal map, linear rows", k, &ag[..3 * n], &mjc, 1e-12);
 
             let g = Graph::new();
             let d = derivatives::rnea_derivatives(&g, &model);

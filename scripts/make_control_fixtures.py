@@ -68,6 +68,7 @@ CHECKS = {
                       "vs drift_ref, ref in world, local"),
     "com_fd": (1e-6, "central difference of com along theta + t v vs Jcom v"),
     "rnea_da_M": (1e-9, "dtau_da of computeRNEADerivatives vs M"),
+    "dAg_fd": (1e-6, "central difference of Ag along theta + t v, times v, vs dAg v"),
     "Ag_linear_mass_Jcom": (1e-9, "linear rows of Ag vs total mass times Jcom"),
     "aba_ddq": (1e-9, "M ddq + rnea(q, v, 0) - tau"),
     "minv_M_identity": (1e-9, "Minv M - I"),
@@ -184,6 +185,13 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
         com = pin.centerOfMass(model, data, q).copy()
         Jcom = pin.jacobianCenterOfMass(model, data, q).copy()
         Ag = pin.computeCentroidalMap(model, data, q).copy()
+        dAg = np.array(pin.computeCentroidalMapTimeVariation(model, data, q, v)).copy()
+        h = 1e-6
+        dAg_fd = (pin.computeCentroidalMap(model, data, qp(h * v)).copy()
+                  - pin.computeCentroidalMap(model, data, qp(-h * v)).copy()) / (2 * h)
+        # Pinocchio's dAg is not the time derivative of Ag (they differ by terms that
+        # vanish on v), but dAg v is: the rate of the centroidal momentum at a = 0.
+        record("dAg_fd", dAg_fd @ v - dAg @ v, 1.0)
         record("Ag_linear_mass_Jcom", Ag[:3] - data.mass[0] * Jcom)
 
         # Joint space.
@@ -254,6 +262,7 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
             "com": flat(com),
             "Jcom": rows(Jcom),
             "Ag": rows(Ag),
+            "dAg_v": flat(dAg @ v),
             "M": rows(M),
             "dtau_dq": rows(dtau_dq),
             "dtau_dv": rows(dtau_dv),

@@ -295,6 +295,19 @@ pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
     a.iter().flatten().map(|x| x.id()).collect()
 }
 
+/// `A_g` and its time variation `Ȧ_g(q, v)` (6 × n each, row-major, `A_g` first):
+/// `ḣ_g = A_g a + Ȧ_g v` (Pinocchio's `computeCentroidalMapTimeVariation`). `Ȧ_g` is one
+/// forward-mode tangent of [`build_centroidal_map`] along `q̇ = v`
+/// ([`Graph::tangents`]), so it reuses every node of `A_g`.
+pub fn build_centroidal_map_time_variation(g: &Graph, model: &Model) -> Vec<NodeId> {
+    let a_g = build_centroidal_map(g, model);
+    let dot = g.tangents(&a_g, |id| match g.node(id) {
+        crate::sym::Node::Input { arg, index } if arg == ARG_Q => Some(g.input(ARG_V, index)),
+        _ => None,
+    });
+    a_g.into_iter().chain(dot.iter().map(|x| x.id())).collect()
+}
+
 /// A Rust identifier for frame names: `wrist_3_link` → `Wrist3Link`, unique among
 /// the frames (a numeric suffix where two names would meet).
 fn variant_names(model: &Model) -> Vec<syn::Ident> {
@@ -538,6 +551,29 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     };
     let centroidal = emit_one(spec, &g, "centroidal_map".to_string());
 
+    let g = Graph::new();
+    let outputs = build_centroidal_map_time_variation(&g, model);
+    let spec = FnSpec {
+        name: "centroidal_map_time_variation",
+        public: true,
+        doc: format!(
+            "The centroidal momentum matrix and its time variation (Pinocchio's\n`computeCentroidalMapTimeVariation`): writes `(A_g(q), Ȧ_g(q, v))` to `out`\n(6 × {n} each), so that `ḣ_g = A_g a + Ȧ_g v`, the rate of the centroidal\nmomentum that whole-body controllers constrain. `q, v`: {n} positions and\nvelocities; {}.",
+            sizes.params()
+        ),
+        args: vec![q(), arg(ARG_V, "v", n), params()],
+        ret: quote!(([[S; #n_l]; 6], [[S; #n_l]; 6])),
+        output: Output::InPlace {
+            place: Box::new(move |k: usize| {
+                let (m, k) = (emit::usize_lit(k / (6 * n)), k % (6 * n));
+                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                quote!(out.#m[#r][#c])
+            }),
+            clear: quote!(*out = ([[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6], [[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6]);),
+        },
+        outputs,
+    };
+    let centroidal_dot = emit_one(spec, &g, "centroidal_map_time_variation".to_string());
+
     let zero_a = quote!(&[<S as ::dyngen::Scalar>::ZERO; #n_l]);
     let dispatch_doc = doc_attrs(&format!(
         "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. Walks only the bodies between the\nbase and the frame."
@@ -597,6 +633,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             #com
             #com_jacobian
             #centroidal
+            #centroidal_dot
             #(#per_frame)*
         },
     ));
@@ -689,6 +726,14 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         fn centroidal_map<S: ::dyngen::Scalar>(q: &[S], params: &[S], a_g: &mut [S]) {
             use ::dyngen::__private::{as_array, as_rows_mut};
             Self::centroidal_map(as_array(q, "q"), as_array(params, "params"), as_rows_mut::<S, #n_l, 6>(a_g, "a_g"));
+        }
+        fn centroidal_map_time_variation<S: ::dyngen::Scalar>(q: &[S], v: &[S], params: &[S], a_g: &mut [S], a_g_dot: &mut [S]) {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            let zero = [<S as ::dyngen::Scalar>::ZERO; #n_l];
+            let mut both = ([zero; 6], [zero; 6]);
+            Self::centroidal_map_time_variation(as_array(q, "q"), as_array(v, "v"), as_array(params, "params"), &mut both);
+            *as_rows_mut::<S, #n_l, 6>(a_g, "a_g") = both.0;
+            *as_rows_mut::<S, #n_l, 6>(a_g_dot, "a_g_dot") = both.1;
         }
         fn com_jacobian<S: ::dyngen::Scalar>(q: &[S], params: &[S], jacobian: &mut [S]) {
             use ::dyngen::__private::{as_array, as_rows_mut};

@@ -233,6 +233,9 @@ pub trait Robot {
     /// The centroidal momentum matrix `A_g` (6 × `NV`, rows `[linear; angular]`, the
     /// angular part about the centre of mass, world axes), row-major into `a_g`.
     fn centroidal_map<S: Scalar>(q: &[S], params: &[S], a_g: &mut [S]);
+    /// `A_g` and its time derivative `Ȧ_g(q, v)` (each 6 × `NV`, row-major):
+    /// `ḣ_g = A_g a + Ȧ_g v`.
+    fn centroidal_map_time_variation<S: Scalar>(q: &[S], v: &[S], params: &[S], a_g: &mut [S], a_g_dot: &mut [S]);
     /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`Robot::rnea`], each `NV × NV` row-major.
     fn rnea_derivatives<S: Scalar>(
         q: &[S],

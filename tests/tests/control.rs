@@ -169,6 +169,12 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         let mut ag = vec![0.0; 6 * n];
         R::centroidal_map(&q, params, &mut ag);
         worst.add("centroidal map A_g", who, s, &ag, &nums(&sample["Ag"]), 1.0);
+        // Ȧ_g v (Pinocchio's dAg is another matrix with the same product with v).
+        let (mut a_g, mut a_dot) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+        R::centroidal_map_time_variation(&q, &v, params, &mut a_g, &mut a_dot);
+        assert_eq!(a_g, ag, "{who}: A_g beside its time variation");
+        let dagv: Vec<f64> = (0..6).map(|r| (0..n).map(|c| a_dot[r * n + c] * v[c]).sum()).collect();
+        worst.add("Ȧ_g v", who, s, &dagv, &nums(&sample["dAg_v"]), 1.0);
 
         let (mut dq, mut dv, mut m) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
         R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut m);

@@ -830,6 +830,18 @@ fn control_kernels_agree_with_differences_on_random_trees() {
             let ag = eval(&g, &frames::build_centroidal_map(&g, &model), q, &zeros, &zeros, p);
             let mjc: Vec<f64> = jc.iter().map(|x| x * mass).collect();
             fail("centroidal map, linear rows", k, &ag[..3 * n], &mjc, 1e-12);
+            // Ȧ_g: the derivative of A_g along q + t v.
+            let g = Graph::new();
+            let both = frames::build_centroidal_map_time_variation(&g, &model);
+            let got = eval(&g, &both, q, v, &zeros, p);
+            fail("A_g beside Ȧ_g", k, &got[..6 * n], &ag, 1e-15);
+            let along = |t: f64| {
+                let qt: Vec<f64> = (0..n).map(|i| q[i] + t * v[i]).collect();
+                eval(&g, &both[..6 * n], &qt, v, &zeros, p)
+            };
+            let (ap, am) = (along(h), along(-h));
+            let fd: Vec<f64> = ap.iter().zip(&am).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+            fail("Ȧ_g", k, &got[6 * n..], &fd, 1e-6);
 
             let g = Graph::new();
             let d = derivatives::rnea_derivatives(&g, &model);

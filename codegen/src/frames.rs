@@ -1,7 +1,7 @@
 //! Frames in generated code: every link of the description (and every frame a `robot!`
 //! description declares) is a named frame with a placement, a Jacobian, a velocity
-//! and a classical acceleration, and the robot gets its centre of mass and the
-//! centre of mass's Jacobian. Each frame's functions walk only the bodies between the
+//! and a classical acceleration, and the robot gets its centre of mass, the centre of
+//! mass's Jacobian and the centroidal momentum matrix with its time variation. Each frame's functions walk only the bodies between the
 //! base and the frame, so only the Jacobian columns of the joints on that path are
 //! computed; the others are exact zeros.
 //!

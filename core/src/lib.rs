@@ -2,9 +2,11 @@
 //!
 //! What generated robot code needs, and nothing more: the [`Robot`] trait, the
 //! [`Scalar`] trait, the small spatial value types of the API ([`Pose`], [`Wrench`],
-//! [`BodyRegressor`]), the model a generated robot carries ([`RobotModel`]), the joint
-//! models beyond rigid bodies ([`JointParams`], [`Coulomb`]), and the [`robot!`]
-//! macro. `no_std`: maths come from the standard library (feature `std`, the default)
+//! [`BodyRegressor`]), what the control kernels return ([`FrameJacobian`],
+//! [`FrameMotion`], [`Motion`] in a [`ReferenceFrame`], [`RneaDerivatives`],
+//! [`AbaDerivatives`] and the [`Linearization`] of a time step, [`log3`]), the model a
+//! generated robot carries ([`RobotModel`]), the joint models beyond rigid bodies
+//! ([`JointParams`], [`Coulomb`]), and the [`robot!`] macro. `no_std`: maths come from the standard library (feature `std`, the default)
 //! or from `libm` (feature `libm`).
 //!
 //! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a

@@ -148,14 +148,36 @@ pub struct AbaParts<'g> {
 
 /// The parts of [`aba_derivatives_with`], before the products with `−M⁻¹`.
 pub fn aba_derivative_parts<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaParts<'g> {
+    parts(g, model, how, false)
+}
+
+/// [`aba_derivative_parts`] with each joint's rotor inertia `Ia` (read from
+/// `joint_params[4(j−1)]`, [`algo::ARG_JOINT_PARAMS`]) on the diagonal of `M`:
+/// `q̈ = (M + diag(Ia))⁻¹ (τ − h)`, the rigid `∂τ/∂q`, `∂τ/∂v` at `a = q̈` (`Ia·q̈` does
+/// not depend on `q` or `v`), and `(M + diag(Ia))⁻¹`. `τ` is the torque left once
+/// friction is taken off (friction's `∂/∂v` is added at run time).
+pub fn aba_joints_derivative_parts<'g>(g: &'g Graph, model: &Model) -> AbaParts<'g> {
+    parts(g, model, Ddq::InverseInertia, true)
+}
+
+fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<'g> {
     let n = model.dof();
+    let mass_matrix = || {
+        let mut m = algo::crba(g, model);
+        if armature {
+            for (i, row) in m.iter_mut().enumerate() {
+                row[i] = row[i] + g.input(algo::ARG_JOINT_PARAMS, (4 * i) as u32);
+            }
+        }
+        m
+    };
     let (ddq, minv) = match how {
         Ddq::Aba => {
             let ddq = algo::aba(g, model, algo::Armature::None);
-            (ddq, inverse_inertia(g, model, &algo::crba(g, model)))
+            (ddq, inverse_inertia(g, model, &mass_matrix()))
         }
         Ddq::InverseInertia => {
-            let minv = inverse_inertia(g, model, &algo::crba(g, model));
+            let minv = inverse_inertia(g, model, &mass_matrix());
             let h = algo::rnea(g, model, Inputs::NoAcceleration).tau;
             g.mark("joint accelerations M⁻¹ (tau − h)");
             let b: Vec<Expr<'g>> = (0..n).map(|i| g.input(ARG_TAU, i as u32) - h[i]).collect();

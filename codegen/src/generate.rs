@@ -863,6 +863,70 @@ fn derivative_items(
     ));
     reports.push(r);
 
+    // With the joint models: the rotor inertias in M, friction taken off τ first and
+    // its slope added to ∂τ/∂v before the products.
+    let g = Graph::new();
+    let d = derivatives::aba_joints_derivative_parts(&g, model);
+    let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
+    outputs.extend(ids(&d.dtau_dq));
+    outputs.extend(ids(&d.dtau_dv));
+    outputs.extend(ids(&d.minv));
+    let nj_l = emit::usize_lit(4 * n);
+    let joints_doc = doc_attrs(&format!(
+        "[`Self::aba_derivatives`] of [`Self::aba_joints`], the forward dynamics with the joint\nmodels: `ddq = (M + diag(Ia))⁻¹ (tau − h − Fv·v − Fc·c(v) − F0)`, its derivatives\n`−(M + diag(Ia))⁻¹ ∂τ/∂q` and `−(M + diag(Ia))⁻¹ (∂τ/∂v + diag(Fv + Fc·c′(v)))`, and\n`(M + diag(Ia))⁻¹` in `minv`. With `Coulomb::Sign`, `c′ = 0` (the model is not\ndifferentiable at `v = 0`); `Coulomb::smooth(ε)` gives a smooth linearisation. {}; {}.",
+        sizes.params(),
+        sizes.joint_params()
+    ));
+    let spec = FnSpec {
+        name: "__aba_joints_derivative_parts",
+        public: false,
+        doc: "The generated part of [`Self::aba_joints_derivatives`].".to_string(),
+        args: vec![
+            arg(ARG_Q, "q", n),
+            arg(ARG_V, "v", n),
+            arg(ARG_TAU, "tau", n),
+            arg(ARG_PARAMS, "params", 10 * n),
+            arg(ARG_JOINT_PARAMS, "joint_params", 4 * n),
+        ],
+        ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
+        output: Output::InPlace {
+            place: Box::new(place(&[
+                ("ddq", false),
+                ("ddq_dq", true),
+                ("ddq_dv", true),
+                ("minv", true),
+            ])),
+            clear: clear.clone(),
+        },
+        outputs,
+    };
+    let (parts, mut r) = emit::emit_fn(&g, &spec, max_statements);
+    r.name = "aba_joints_derivatives".to_string();
+    items.push((
+        "aba_joints_derivatives".to_string(),
+        quote! {
+            #joints_doc
+            #[inline]
+            pub fn aba_joints_derivatives<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
+                joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
+                out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
+            ) {
+                let mut driving = *tau;
+                for j in 0..#n_l {
+                    driving[j] -= ::dyngen::__private::joint_at(joint_params, j).friction(v[j], coulomb);
+                }
+                Self::__aba_joints_derivative_parts(q, v, &driving, params, joint_params, out);
+                for j in 0..#n_l {
+                    out.ddq_dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
+                }
+                ::dyngen::__private::times_minus_minv(out);
+            }
+            #parts
+        },
+    ));
+    reports.push(r);
+
     let g = Graph::new();
     let m = algo::crba(&g, model);
     let minv = derivatives::inverse_inertia(&g, model, &m);

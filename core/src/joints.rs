@@ -62,6 +62,19 @@ impl<S: Scalar> Coulomb<S> {
         }
     }
 
+    /// `c'(q̇)`, the slope of the model: 0 for `sign` (away from `q̇ = 0`),
+    /// `(1 − tanh²(q̇/ε)) / ε` for the smooth model.
+    #[inline]
+    pub fn slope(self, v: S) -> S {
+        match self {
+            Coulomb::Smooth { epsilon } if epsilon > S::ZERO => {
+                let t = (v / epsilon).tanh();
+                (S::ONE - t * t) / epsilon
+            }
+            _ => S::ZERO,
+        }
+    }
+
     /// `c(q̇)`: `sign(q̇)` or `tanh(q̇/ε)`.
     #[inline]
     pub fn eval(self, v: S) -> S {
@@ -123,6 +136,12 @@ impl<S: Scalar> JointParams<S> {
     #[inline]
     pub fn friction(&self, v: S, coulomb: Coulomb<S>) -> S {
         self.viscous * v + self.coulomb * coulomb.eval(v) + self.offset
+    }
+
+    /// `∂/∂q̇` of the friction torque: `Fv + Fc·c'(q̇)`.
+    #[inline]
+    pub fn friction_slope(&self, v: S, coulomb: Coulomb<S>) -> S {
+        self.viscous + self.coulomb * coulomb.slope(v)
     }
 
     /// The whole joint torque `Ia·q̈ + Fv·q̇ + Fc·c(q̇) + F0`.

@@ -406,3 +406,66 @@ fn frames_declared_in_the_description() {
         Planar2::rnea(&q, &[0.3, -0.2], &[1.0, 2.0], &p)
     );
 }
+
+/// `aba_joints_derivatives` (rotor inertias, viscous and smooth Coulomb friction, an
+/// offset) against central differences of the generated `aba_joints`.
+macro_rules! joints_derivatives_fd {
+    ($robot:ty) => {{
+        const N: usize = <$robot>::NV;
+        let params = <$robot>::NOMINAL_PARAMS;
+        let mut jp = [0.0; 4 * N];
+        for j in 0..N {
+            jp[4 * j..4 * j + 4].copy_from_slice(&[0.05 + 0.01 * j as f64, 0.8, 1.5 - 0.1 * j as f64, 0.2]);
+        }
+        let coulomb = dyngen::Coulomb::smooth(0.05).unwrap();
+        let q: [f64; N] = std::array::from_fn(|i| 0.3 * i as f64 - 0.7);
+        let v: [f64; N] = std::array::from_fn(|i| 0.04 * i as f64 - 0.1);
+        let tau: [f64; N] = std::array::from_fn(|i| 2.0 - 0.5 * i as f64);
+        let mut d = dyngen::AbaDerivatives::<f64, N>::default();
+        <$robot>::aba_joints_derivatives(&q, &v, &tau, &params, &jp, coulomb, &mut d);
+        let aba = |q: &[f64; N], v: &[f64; N], tau: &[f64; N]| <$robot>::aba_joints(q, v, tau, &params, &jp, coulomb);
+        let ddq = aba(&q, &v, &tau);
+        let mut worst = rel_err(&d.ddq, &ddq, 1.0);
+        let h = 1e-6;
+        let scale = ddq.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for c in 0..N {
+            let step = |x: &[f64; N], s: f64| {
+                let mut y = *x;
+                y[c] += s;
+                y
+            };
+            let dq: Vec<f64> = aba(&step(&q, h), &v, &tau)
+                .iter()
+                .zip(aba(&step(&q, -h), &v, &tau))
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect();
+            let dv: Vec<f64> = aba(&q, &step(&v, h), &tau)
+                .iter()
+                .zip(aba(&q, &step(&v, -h), &tau))
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect();
+            let dt: Vec<f64> = aba(&q, &v, &step(&tau, h))
+                .iter()
+                .zip(aba(&q, &v, &step(&tau, -h)))
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect();
+            for r in 0..N {
+                for (got, want) in [(d.ddq_dq[r][c], dq[r]), (d.ddq_dv[r][c], dv[r]), (d.minv[r][c], dt[r])] {
+                    worst = worst.max((got - want).abs() / scale);
+                }
+            }
+        }
+        worst
+    }};
+}
+
+#[test]
+fn aba_joints_derivatives_match_finite_differences() {
+    for (name, e) in [
+        ("ur5", joints_derivatives_fd!(Ur5)),
+        ("panda", joints_derivatives_fd!(Panda)),
+    ] {
+        println!("{name}: aba_joints derivatives against differences {e:.1e}");
+        assert!(e < 1e-6, "{name}: {e:e}");
+    }
+}

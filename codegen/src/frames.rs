@@ -747,3 +747,51 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         reports,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dyngen_model::{Frame, Placement};
+
+    /// Link names become distinct Rust identifiers, whatever characters they hold.
+    #[test]
+    fn frame_names_become_distinct_identifiers() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../robots/ur5/ur5.urdf");
+        let mut model = dyngen_model::load_urdf(&path).expect("the UR5 loads");
+        model.frames.clear();
+        for name in [
+            "wrist_3_link",
+            "3d-camera",
+            "self",
+            "link_1",
+            "link1",
+            "Link-1",
+            "",
+            "ü",
+        ] {
+            model.frames.push(Frame {
+                name: name.to_string(),
+                body: 0,
+                placement: Placement::IDENTITY,
+            });
+        }
+        let names: Vec<String> = variant_names(&model).iter().map(|i| i.to_string()).collect();
+        assert_eq!(
+            names,
+            [
+                "Wrist3Link",
+                "Frame3dCamera",
+                "FrameSelf",
+                "Link1",
+                "Link14",
+                "Link15",
+                "Frame",
+                "Frame7"
+            ]
+        );
+        let mut unique = names.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), names.len());
+    }
+}

@@ -68,6 +68,7 @@ CHECKS = {
                       "vs drift_ref, ref in world, local"),
     "com_fd": (1e-6, "central difference of com along theta + t v vs Jcom v"),
     "rnea_da_M": (1e-9, "dtau_da of computeRNEADerivatives vs M"),
+    "dJ_fd": (1e-6, "central difference of J_ref along theta + t v vs dJ_ref (getFrameJacobianTimeVariation), every ref"),
     "dAg_fd": (1e-6, "central difference of Ag along theta + t v, times v, vs dAg v"),
     "Ag_linear_mass_Jcom": (1e-9, "linear rows of Ag vs total mass times Jcom"),
     "aba_ddq": (1e-9, "M ddq + rnea(q, v, 0) - tau"),
@@ -241,8 +242,21 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
                 dd = dvel[k, r] + np.concatenate([np.cross(vr[3:], vr[:3]), np.zeros(3)]) * (key != "lwa")
                 record("drift_fd" if key == "lwa" else "drift_fd_refs", dd - fr0["acc_" + key], vel_big)
 
+        # Jacobian time variation: Pinocchio's dJ is d/dt J along q + t v in each frame.
+        pin.computeJointJacobiansTimeVariation(model, data, q, v)
+        pin.updateFramePlacements(model, data)
+        djac = [[pin.getFrameJacobianTimeVariation(model, data, fid, rf).copy() for _, rf in REFS] for fid in fids]
+        def jac_at(t):
+            pin.computeJointJacobians(model, data, qp(t * v))
+            pin.updateFramePlacements(model, data)
+            return [[pin.getFrameJacobian(model, data, fid, rf).copy() for _, rf in REFS] for fid in fids]
+        jplus, jminus = jac_at(1e-6), jac_at(-1e-6)
+        for k in range(len(fids)):
+            for r in range(len(REFS)):
+                record("dJ_fd", (jplus[k][r] - jminus[k][r]) / 2e-6 - djac[k][r], 1.0)
+
         frames_out = []
-        for fr, fr0 in zip(kin, kin0):
+        for k, (fr, fr0) in enumerate(zip(kin, kin0)):
             e = {"oMf": se3(fr["oMf"])}
             for key, _ in REFS:
                 e["J_" + key] = rows(fr["J_" + key])
@@ -252,6 +266,8 @@ def make_fixture(urdf, name, samples, seed, gravity=None):
                 e["acc_" + key] = flat(fr["acc_" + key])
             for key, _ in REFS:
                 e["drift_" + key] = flat(fr0["acc_" + key])
+            for r, (key, _) in enumerate(REFS):
+                e["dJ_" + key] = rows(djac[k][r])
             frames_out.append(e)
         out_samples.append({
             "q": flat(theta),

@@ -184,6 +184,18 @@ pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     out
 }
 
+/// Frame `f`'s placement (12), `LOCAL_WORLD_ALIGNED` Jacobian (6 × n) and its time
+/// variation `J̇(q, v)` (6 × n): one forward-mode tangent of the Jacobian along `q̇ = v`.
+pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
+    let mut out = build_jacobian(g, model, f);
+    let dot = g.tangents(&out[12..], |id| match g.node(id) {
+        crate::sym::Node::Input { arg, index } if arg == ARG_Q => Some(g.input(ARG_V, index)),
+        _ => None,
+    });
+    out.extend(dot.iter().map(|x| x.id()));
+    out
+}
+
 /// Frame `f`'s placement (12), velocity (6) and classical acceleration (6) of its
 /// origin, `LOCAL_WORLD_ALIGNED`.
 pub fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
@@ -383,13 +395,15 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     // Per frame: placement, Jacobian, motion; private, dispatched by the enum.
     let mut placement_fns = Vec::new();
     let mut jacobian_fns = Vec::new();
+    let mut jacobian_dot_fns = Vec::new();
     let mut motion_fns = Vec::new();
     let mut per_frame = Vec::new();
     for (f, frame) in model.frames.iter().enumerate() {
         let label = &frame.name;
-        let (pn, jn, mn) = (
+        let (pn, jn, dn, mn) = (
             format!("__frame_placement_{f}"),
             format!("__frame_jacobian_{f}"),
+            format!("__frame_jacobian_dot_{f}"),
             format!("__frame_motion_{f}"),
         );
         let g = Graph::new();
@@ -414,9 +428,13 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             } else if k < 12 {
                 let i = emit::usize_lit(k - 9);
                 quote!(out.placement.translation[#i])
-            } else {
+            } else if k < 12 + 6 * n {
                 let (r, c) = (emit::usize_lit((k - 12) / n), emit::usize_lit((k - 12) % n));
                 quote!(out.jacobian[#r][#c])
+            } else {
+                let k = k - 12 - 6 * n;
+                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
+                quote!(out.jacobian_dot[#r][#c])
             }
         };
         let spec = FnSpec {
@@ -432,6 +450,22 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             outputs,
         };
         t.extend(emit_one(spec, &g, format!("frame_jacobian[{label}]")));
+
+        let g = Graph::new();
+        let outputs = build_jacobian_time_variation(&g, model, f);
+        let spec = FnSpec {
+            name: &dn,
+            public: false,
+            doc: format!("The placement, `LOCAL_WORLD_ALIGNED` Jacobian and its time variation of frame `{label}`."),
+            args: vec![q(), arg(ARG_V, "v", n)],
+            ret: quote!(::dyngen::FrameJacobianTimeVariation<S, #n_l>),
+            output: Output::InPlace {
+                place: Box::new(place),
+                clear: quote!(*out = ::core::default::Default::default();),
+            },
+            outputs,
+        };
+        t.extend(emit_one(spec, &g, format!("frame_jacobian_time_variation[{label}]")));
 
         let g = Graph::new();
         let outputs = build_motion(&g, model, f);
@@ -461,13 +495,15 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
         per_frame.push(t);
         let v = &variants[f];
-        let (pn, jn, mn) = (
+        let (pn, jn, dn, mn) = (
             format_ident!("{}", pn),
             format_ident!("{}", jn),
+            format_ident!("{}", dn),
             format_ident!("{}", mn),
         );
         placement_fns.push(quote!(#fty::#v => Self::#pn(q)));
         jacobian_fns.push(quote!(#fty::#v => Self::#jn(q, out)));
+        jacobian_dot_fns.push(quote!(#fty::#v => Self::#dn(q, v, out)));
         motion_fns.push(quote!(#fty::#v => Self::#mn(q, v, a)));
     }
 
@@ -581,6 +617,9 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let jacobian_doc = doc_attrs(&format!(
         "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`."
     ));
+    let jacobian_dot_doc = doc_attrs(&format!(
+        "Frame `frame`'s placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × {n} each)\nin `reference` (Pinocchio's `getFrameJacobianTimeVariation`), written to `out`:\n`ẍ = J q̈ + J̇ q̇`. `J̇` is the time derivative of `J` along `q̇ = v`."
+    ));
     let motion_doc = doc_attrs(
         "Frame `frame`'s placement, velocity and classical acceleration at `(q, v, a)`,\n`LOCAL_WORLD_ALIGNED`; `FrameMotion::velocity_in` and\n`FrameMotion::classical_acceleration_in` express them in another reference frame.",
     );
@@ -609,6 +648,15 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             ) {
                 match frame { #(#jacobian_fns,)* }
                 ::dyngen::__private::express_jacobian(out, reference);
+            }
+            #jacobian_dot_doc
+            #[inline]
+            pub fn frame_jacobian_time_variation<S: ::dyngen::Scalar>(
+                q: &[S; #n_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+                out: &mut ::dyngen::FrameJacobianTimeVariation<S, #n_l>,
+            ) {
+                match frame { #(#jacobian_dot_fns,)* }
+                ::dyngen::__private::express_jacobian_time_variation(out, v, reference);
             }
             #motion_doc
             #[inline]
@@ -713,6 +761,17 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             let mut j = ::dyngen::FrameJacobian::<S, #n_l>::default();
             Self::frame_jacobian(as_array(q, "q"), frame, reference, &mut j);
             *as_rows_mut::<S, #n_l, 6>(jacobian, "jacobian") = j.jacobian;
+            Some(j.placement)
+        }
+        fn frame_jacobian_time_variation<S: ::dyngen::Scalar>(
+            q: &[S], v: &[S], frame: usize, reference: ::dyngen::ReferenceFrame, jacobian: &mut [S], jacobian_dot: &mut [S],
+        ) -> ::core::option::Option<::dyngen::Pose<S>> {
+            use ::dyngen::__private::{as_array, as_rows_mut};
+            let frame = #fty::from_index(frame)?;
+            let mut j = ::dyngen::FrameJacobianTimeVariation::<S, #n_l>::default();
+            Self::frame_jacobian_time_variation(as_array(q, "q"), as_array(v, "v"), frame, reference, &mut j);
+            *as_rows_mut::<S, #n_l, 6>(jacobian, "jacobian") = j.jacobian;
+            *as_rows_mut::<S, #n_l, 6>(jacobian_dot, "jacobian_dot") = j.jacobian_dot;
             Some(j.placement)
         }
         fn frame_motion<S: ::dyngen::Scalar>(q: &[S], v: &[S], a: &[S], frame: usize) -> ::core::option::Option<::dyngen::FrameMotion<S>> {

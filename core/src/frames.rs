@@ -106,6 +106,90 @@ impl<S: Scalar, const N: usize> FrameJacobian<S, N> {
     }
 }
 
+/// A frame's placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × N each,
+/// rows `[linear; angular]`), both in the same reference frame, the output of the
+/// generated `frame_jacobian_time_variation` (Pinocchio's
+/// `getFrameJacobianTimeVariation`): `ẍ = J q̈ + J̇ q̇` in that frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameJacobianTimeVariation<S: Scalar, const N: usize> {
+    pub placement: Pose<S>,
+    pub jacobian: [[S; N]; 6],
+    pub jacobian_dot: [[S; N]; 6],
+}
+
+impl<S: Scalar, const N: usize> Default for FrameJacobianTimeVariation<S, N> {
+    fn default() -> Self {
+        FrameJacobianTimeVariation {
+            placement: Pose::default(),
+            jacobian: [[S::ZERO; N]; 6],
+            jacobian_dot: [[S::ZERO; N]; 6],
+        }
+    }
+}
+
+impl<S: Scalar, const N: usize> FrameJacobianTimeVariation<S, N> {
+    /// Re-expresses `LOCAL_WORLD_ALIGNED` `J` and `J̇` (as the generated code writes
+    /// them) in `reference`, with the joint velocities `v` they were taken at:
+    /// `LOCAL`: `J̇_l = Rᵀ (J̇ − ω × J)`; `WORLD`: `J̇_w = [J̇_lin + ṗ × J_ang + p × J̇_ang;
+    /// J̇_ang]`, `ω` and `ṗ` the frame's angular and linear velocity.
+    pub(crate) fn express_from_lwa(&mut self, v: &[S; N], reference: ReferenceFrame) {
+        if reference == ReferenceFrame::LocalWorldAligned {
+            return;
+        }
+        let col = |m: &[[S; N]; 6], k: usize, r0: usize| Vector3::new(m[r0][k], m[r0 + 1][k], m[r0 + 2][k]);
+        let mut w = Vector3::from_element(S::ZERO);
+        let mut pdot = Vector3::from_element(S::ZERO);
+        for k in 0..N {
+            pdot += col(&self.jacobian, k, 0) * v[k];
+            w += col(&self.jacobian, k, 3) * v[k];
+        }
+        let p = self.placement.translation;
+        for k in 0..N {
+            let (jl, ja) = (col(&self.jacobian, k, 0), col(&self.jacobian, k, 3));
+            let (dl, da) = (col(&self.jacobian_dot, k, 0), col(&self.jacobian_dot, k, 3));
+            let (j, dj) = match reference {
+                ReferenceFrame::World => (
+                    Motion {
+                        linear: jl + p.cross(&ja),
+                        angular: ja,
+                    },
+                    Motion {
+                        linear: dl + pdot.cross(&ja) + p.cross(&da),
+                        angular: da,
+                    },
+                ),
+                _ => {
+                    let j = Motion {
+                        linear: jl,
+                        angular: ja,
+                    };
+                    let d = Motion {
+                        linear: dl - w.cross(&jl),
+                        angular: da - w.cross(&ja),
+                    };
+                    (rotate_back(&self.placement, &j), rotate_back(&self.placement, &d))
+                }
+            };
+            let (j, dj) = (j.to_array(), dj.to_array());
+            for r in 0..6 {
+                self.jacobian[r][k] = j[r];
+                self.jacobian_dot[r][k] = dj[r];
+            }
+        }
+    }
+}
+
+/// Support for generated code: the conversion the generated
+/// `frame_jacobian_time_variation` applies.
+#[doc(hidden)]
+pub fn __express_jacobian_time_variation<S: Scalar, const N: usize>(
+    j: &mut FrameJacobianTimeVariation<S, N>,
+    v: &[S; N],
+    reference: ReferenceFrame,
+) {
+    j.express_from_lwa(v, reference);
+}
+
 /// A frame's placement, velocity and classical acceleration, `LOCAL_WORLD_ALIGNED`,
 /// as the generated `frame_motion` computes them.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -32,7 +32,7 @@ mod scalar;
 
 pub use derivatives::{AbaDerivatives, Linearization, RneaDerivatives};
 pub use dyngen_macros::robot;
-pub use frames::{log3, FrameJacobian, FrameMotion, Motion, ReferenceFrame};
+pub use frames::{log3, FrameJacobian, FrameJacobianTimeVariation, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
 pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
@@ -44,6 +44,7 @@ pub use scalar::Scalar;
 pub mod __private {
     pub use crate::derivatives::__times_minus_minv as times_minus_minv;
     pub use crate::frames::__express_jacobian as express_jacobian;
+    pub use crate::frames::__express_jacobian_time_variation as express_jacobian_time_variation;
 
     /// A slice as a fixed-size array, with a message naming the argument when the
     /// length is wrong.

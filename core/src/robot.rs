@@ -223,6 +223,17 @@ pub trait Robot {
         reference: ReferenceFrame,
         jacobian: &mut [S],
     ) -> Option<Pose<S>>;
+    /// Frame `frame`'s Jacobian and its time variation `J̇(q, v)` (each 6 × `NV`,
+    /// row-major) in `reference`; returns the frame's placement, `None` when there is no
+    /// such frame.
+    fn frame_jacobian_time_variation<S: Scalar>(
+        q: &[S],
+        v: &[S],
+        frame: usize,
+        reference: ReferenceFrame,
+        jacobian: &mut [S],
+        jacobian_dot: &mut [S],
+    ) -> Option<Pose<S>>;
     /// Frame `frame`'s placement, velocity and classical acceleration,
     /// `LOCAL_WORLD_ALIGNED`; `None` when there is no such frame.
     fn frame_motion<S: Scalar>(q: &[S], v: &[S], a: &[S], frame: usize) -> Option<FrameMotion<S>>;

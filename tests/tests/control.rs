@@ -141,6 +141,10 @@ fn check<R: Robot>(fixture: &str) -> Worst {
                     &nums(&want[format!("acc_{key}").as_str()]),
                     1.0,
                 );
+                let (mut j2, mut jdot) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+                R::frame_jacobian_time_variation(&q, &v, *f, reference, &mut j2, &mut jdot).unwrap();
+                worst.add("jacobian beside J̇", who, s, &j2, &jac, 1e-300);
+                worst.add("J̇", who, s, &jdot, &nums(&want[format!("dJ_{key}").as_str()]), 1.0);
                 let drift = R::frame_motion(&q, &v, &zero, *f)
                     .unwrap()
                     .classical_acceleration_in(reference)

@@ -793,6 +793,16 @@ fn control_kernels_agree_with_differences_on_random_trees() {
                     .flat_map(|&(i, j)| (0..n).map(move |c| w(c, i, j)).collect::<Vec<_>>())
                     .collect();
                 fail("frame Jacobian, angular", k, &jac[12 + 3 * n..], &angular, 1e-7);
+                // J̇: the derivative of the Jacobian along q + t v.
+                let jd = frames::build_jacobian_time_variation(&g, &model, f);
+                let jd_val = eval(&g, &jd, q, v, &zeros, &[]);
+                let jac_at = |t: f64| {
+                    let qt: Vec<f64> = (0..n).map(|i| q[i] + t * v[i]).collect();
+                    eval(&g, &jd[12..12 + 6 * n], &qt, v, &zeros, &[])
+                };
+                let (jp, jm) = (jac_at(h), jac_at(-h));
+                let fd: Vec<f64> = jp.iter().zip(&jm).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+                fail("frame Jacobian time variation", k, &jd_val[12 + 6 * n..], &fd, 1e-6);
                 let motion = frames::build_motion(&g, &model, f);
                 let m = eval(&g, &motion, q, v, a, &[]);
                 let jv: Vec<f64> = (0..6)

@@ -6,6 +6,8 @@ environment outside the repository. From the project root, with its python:
 
     python scripts/make_mjcf_fixtures.py            # writes tests/fixtures/mjcf/
 
+(c) For the hand-written `small.xml`, MuJoCo's values as in (b): `small.json`.
+
 For each of `robots/ur5/ur5.urdf` and `robots/panda/panda.urdf`:
 
 (a) MuJoCo's URDF importer reads a copy of the URDF with
@@ -96,6 +98,16 @@ def main():
             json.dump(ref, f, indent=1)
             f.write("\n")
         print(f"{name}: {xml}, {len(ref['samples'])} states, joints {ref['joints']}")
+    # The hand-written file: MuJoCo's values for it, so every feature it uses (classes,
+    # degrees, euler, joint pos, slide, merged body) is checked against MuJoCo too.
+    xml = os.path.join(args.out_dir, "small.xml")
+    ref = reference(xml)
+    ref["robot"] = "small"
+    ref["source"] = "tests/fixtures/mjcf/small.xml (hand-written)"
+    with open(os.path.join(args.out_dir, "small.json"), "w") as f:
+        json.dump(ref, f, indent=1)
+        f.write("\n")
+    print(f"small: {len(ref['samples'])} states, joints {ref['joints']}")
 
 
 if __name__ == "__main__":

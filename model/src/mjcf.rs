@@ -341,9 +341,7 @@ impl<'t> Reader<'t> {
                 other => self.error(
                     Element::Robot,
                     t.line,
-                    ErrorKind::InvalidMjcf(format!(
-                        "<compiler angle=\"{other}\"> is neither `radian` nor `degree`"
-                    )),
+                    ErrorKind::InvalidMjcf(format!("<compiler angle=\"{other}\"> is neither `radian` nor `degree`")),
                 ),
             }
         }
@@ -368,7 +366,9 @@ impl<'t> Reader<'t> {
                 other => self.error(
                     Element::Robot,
                     t.line,
-                    ErrorKind::InvalidMjcf(format!("<compiler autolimits=\"{other}\"> is neither `true` nor `false`")),
+                    ErrorKind::InvalidMjcf(format!(
+                        "<compiler autolimits=\"{other}\"> is neither `true` nor `false`"
+                    )),
                 ),
             }
         }
@@ -728,9 +728,7 @@ impl<'t> Reader<'t> {
                 self.error(
                     el.clone(),
                     t.line,
-                    ErrorKind::InvalidMjcf(format!(
-                        "<joint limited=\"{other}\"> is not `true`, `false` or `auto`"
-                    )),
+                    ErrorKind::InvalidMjcf(format!("<joint limited=\"{other}\"> is not `true`, `false` or `auto`")),
                 );
                 false
             }
@@ -896,9 +894,21 @@ pub fn quat_matrix(q: [f64; 4]) -> Option<Mat3> {
     }
     let [w, x, y, z] = q.map(|c| c / n);
     Some([
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
     ])
 }
 

@@ -6,9 +6,7 @@
 //! and its line.
 
 use dyngen_model::regressor::joint_torque_regressor;
-use dyngen_model::{
-    load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors,
-};
+use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -69,7 +67,12 @@ fn against_mujoco(name: &str) -> (f64, f64) {
     let model = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
     let text = std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap();
     let reference: Value = serde_json::from_str(&text).unwrap();
-    let joints: Vec<&str> = reference["joints"].as_array().unwrap().iter().map(|j| j.as_str().unwrap()).collect();
+    let joints: Vec<&str> = reference["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
     let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     assert_eq!(ours, joints, "{name}: joint order");
     assert_eq!(model.gravity.to_vec(), numbers(&reference["gravity"]));
@@ -109,7 +112,10 @@ fn compare_with_urdf(name: &str, urdf: &str) -> [f64; 4] {
         placement = placement.max(max_abs_diff(&a.origin.translation, &b.origin.translation));
         axis = axis.max(max_abs_diff(&a.axis, &b.axis));
         let (la, lb) = (a.limits.unwrap(), b.limits.unwrap());
-        limits = limits.max(max_abs_diff(&[la.lower, la.upper, la.effort], &[lb.lower, lb.upper, lb.effort]));
+        limits = limits.max(max_abs_diff(
+            &[la.lower, la.upper, la.effort],
+            &[lb.lower, lb.upper, lb.effort],
+        ));
     }
     for (a, b) in from_mjcf.bodies.iter().zip(&from_urdf.bodies) {
         assert_eq!((&a.name, &a.merged), (&b.name, &b.merged));
@@ -126,7 +132,10 @@ fn compare_with_urdf(name: &str, urdf: &str) -> [f64; 4] {
     for (a, b) in frames.iter().zip(&from_urdf.frames) {
         assert_eq!((&a.name, a.body), (&b.name, b.body));
         placement = placement.max(max_abs_diff(&a.placement.translation, &b.placement.translation));
-        placement = placement.max(max_abs_diff(&flat3(&a.placement.rotation), &flat3(&b.placement.rotation)));
+        placement = placement.max(max_abs_diff(
+            &flat3(&a.placement.rotation),
+            &flat3(&b.placement.rotation),
+        ));
     }
     eprintln!(
         "{name}: placements {placement:.1e}, axes {axis:.1e}, inertials (relative) {inertial:.1e}, limits {limits:.1e}"
@@ -155,17 +164,32 @@ fn small_gives_its_documented_numbers() {
     assert_eq!(model.base, "world");
     let close = |a: &[f64], b: &[f64]| max_abs_diff(a, b) < 1e-15;
     let [shoulder, slider] = [&model.joints[0], &model.joints[1]];
-    assert_eq!((shoulder.name.as_str(), shoulder.kind, shoulder.parent), ("shoulder", JointKind::Revolute, 0));
-    assert!(close(&flat3(&shoulder.origin.rotation), &[0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]));
+    assert_eq!(
+        (shoulder.name.as_str(), shoulder.kind, shoulder.parent),
+        ("shoulder", JointKind::Revolute, 0)
+    );
+    assert!(close(
+        &flat3(&shoulder.origin.rotation),
+        &[0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    ));
     assert!(close(&shoulder.origin.translation, &[0.0, 0.0, 0.35]));
     assert!(close(&shoulder.axis, &[0.0, 1.0, 0.0]));
     let l = shoulder.limits.unwrap();
-    assert!(close(&[l.lower, l.upper], &[-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2]));
+    assert!(close(
+        &[l.lower, l.upper],
+        &[-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2]
+    ));
     assert_eq!((shoulder.dynamics.damping, shoulder.dynamics.friction), (0.5, 0.1));
 
-    assert_eq!((slider.name.as_str(), slider.kind, slider.parent), ("slider", JointKind::Prismatic, 1));
+    assert_eq!(
+        (slider.name.as_str(), slider.kind, slider.parent),
+        ("slider", JointKind::Prismatic, 1)
+    );
     assert!(close(&slider.origin.translation, &[0.0, 0.0, 0.45]));
-    assert!(close(&flat3(&slider.origin.rotation), &flat3(&dyngen_model::math::IDENTITY)));
+    assert!(close(
+        &flat3(&slider.origin.rotation),
+        &flat3(&dyngen_model::math::IDENTITY)
+    ));
     assert!(close(&slider.axis, &[1.0, 0.0, 0.0]));
     let l = slider.limits.unwrap();
     assert_eq!((l.lower, l.upper), (-0.2, 0.3));
@@ -174,7 +198,10 @@ fn small_gives_its_documented_numbers() {
     let upper = &model.bodies[0].inertial;
     assert_eq!(upper.mass, 2.0);
     assert!(close(&upper.com, &[0.0, 0.0, 0.2]));
-    assert!(close(&flat3(&upper.inertia), &[0.05, 0.0, 0.0, 0.0, 0.04, 0.0, 0.0, 0.0, 0.02]));
+    assert!(close(
+        &flat3(&upper.inertia),
+        &[0.05, 0.0, 0.0, 0.0, 0.04, 0.0, 0.0, 0.0, 0.02]
+    ));
     let fore = &model.bodies[1];
     assert_eq!(fore.merged, ["tip"]);
     assert_eq!(fore.inertial.mass, 1.5);
@@ -236,13 +263,28 @@ fn ball_joint_is_refused() {
         "<joint name=\"j\" type=\"ball\"/>",
         "</body>",
     ]);
-    only_error(&text, Element::Joint("j".into()), 5, "joint type `ball` is not supported yet");
+    only_error(
+        &text,
+        Element::Joint("j".into()),
+        5,
+        "joint type `ball` is not supported yet",
+    );
 }
 
 #[test]
 fn free_joints_are_refused() {
-    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"f\" type=\"free\"/>", "</body>"]);
-    only_error(&text, Element::Joint("f".into()), 5, "joint type `free` is not supported yet");
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"f\" type=\"free\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("f".into()),
+        5,
+        "joint type `free` is not supported yet",
+    );
     let text = mjcf(&["<body name=\"a\">", INERTIAL, "<freejoint name=\"f\"/>", "</body>"]);
     only_error(&text, Element::Joint("f".into()), 5, "<freejoint> is not supported yet");
 }
@@ -295,20 +337,37 @@ fn bad_numbers_name_their_line() {
     ]);
     let e = errors(&text);
     assert_eq!(e.errors.len(), 2, "{e}");
-    assert_eq!((&e.errors[0].element, e.errors[0].line), (&Element::Link("a".into()), Some(3)));
-    assert_eq!((&e.errors[1].element, e.errors[1].line), (&Element::Joint("j".into()), Some(4)));
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Link("a".into()), Some(3))
+    );
+    assert_eq!(
+        (&e.errors[1].element, e.errors[1].line),
+        (&Element::Joint("j".into()), Some(4))
+    );
     let message = e.to_string();
-    assert!(message.contains("line 3: link `a`: <body pos=\"0 0\"> is not 3 numbers"), "{message}");
-    assert!(message.contains("line 4: joint `j`: <joint range=\"-1 one\"> is not 2 numbers"), "{message}");
+    assert!(
+        message.contains("line 3: link `a`: <body pos=\"0 0\"> is not 3 numbers"),
+        "{message}"
+    );
+    assert!(
+        message.contains("line 4: joint `j`: <joint range=\"-1 one\"> is not 2 numbers"),
+        "{message}"
+    );
 }
 
 #[test]
 fn include_is_refused() {
     let text = "<mujoco model=\"t\">\n  <include file=\"arm.xml\"/>\n  <worldbody/>\n</mujoco>\n";
     let e = errors(text);
-    assert_eq!((&e.errors[0].element, e.errors[0].line), (&Element::Robot, Some(2)), "{e}");
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Robot, Some(2)),
+        "{e}"
+    );
     assert!(
-        e.to_string().contains("line 2: robot: <include file=\"arm.xml\"> is not supported yet"),
+        e.to_string()
+            .contains("line 2: robot: <include file=\"arm.xml\"> is not supported yet"),
         "{e}"
     );
 }
@@ -321,10 +380,25 @@ fn unknown_class_is_refused() {
         "<joint name=\"j\" class=\"nowhere\"/>",
         "</body>",
     ]);
-    let kind = only_error(&text, Element::Joint("j".into()), 5, "default class `nowhere` is not defined");
+    let kind = only_error(
+        &text,
+        Element::Joint("j".into()),
+        5,
+        "default class `nowhere` is not defined",
+    );
     assert_eq!(kind, ErrorKind::UnknownClass("nowhere".into()));
-    let text = mjcf(&["<body name=\"a\" childclass=\"gone\">", INERTIAL, "<joint name=\"j\"/>", "</body>"]);
-    only_error(&text, Element::Link("a".into()), 3, "default class `gone` is not defined");
+    let text = mjcf(&[
+        "<body name=\"a\" childclass=\"gone\">",
+        INERTIAL,
+        "<joint name=\"j\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Link("a".into()),
+        3,
+        "default class `gone` is not defined",
+    );
 }
 
 #[test]
@@ -346,12 +420,20 @@ fn errors_are_all_collected_with_the_file_name() {
     let lines: Vec<&str> = message.lines().collect();
     assert_eq!(lines.len(), 2, "{message}");
     assert!(lines[0].ends_with("bad.xml:4: joint `b`: joint type `ball` is not supported yet; only hinge and slide joints are (a ball joint is three hinges about orthogonal axes through one point, in a chain of bodies)"), "{message}");
-    assert!(lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"), "{message}");
+    assert!(
+        lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"),
+        "{message}"
+    );
 }
 
 #[test]
 fn armature_is_left_out_with_a_warning() {
-    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"j\" armature=\"0.1\"/>", "</body>"]);
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\" armature=\"0.1\"/>",
+        "</body>",
+    ]);
     let model = parse_mjcf(&text).unwrap();
     assert_eq!(model.warnings.len(), 1);
     let w = model.warnings[0].warning_message();
@@ -361,7 +443,11 @@ fn armature_is_left_out_with_a_warning() {
 #[test]
 fn not_mujoco_and_too_deep_are_refused() {
     let e = errors("<robot name=\"r\"/>\n");
-    assert!(e.to_string().contains("line 1: robot: the document element is <robot>, not <mujoco>"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("line 1: robot: the document element is <robot>, not <mujoco>"),
+        "{e}"
+    );
     let deep = format!("<mujoco>\n{}{}</mujoco>", "<a>".repeat(300), "</a>".repeat(300));
     let e = errors(&deep);
     assert!(matches!(e.errors[0].kind, ErrorKind::TooDeep { .. }), "{e}");

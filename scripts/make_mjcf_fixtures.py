@@ -6,8 +6,6 @@ environment outside the repository. From the project root, with its python:
 
     python scripts/make_mjcf_fixtures.py            # writes tests/fixtures/mjcf/
 
-(c) For the hand-written `small.xml`, MuJoCo's values as in (b): `small.json`.
-
 For each of `robots/ur5/ur5.urdf` and `robots/panda/panda.urdf`:
 
 (a) MuJoCo's URDF importer reads a copy of the URDF with
@@ -20,6 +18,9 @@ For each of `robots/ur5/ur5.urdf` and `robots/panda/panda.urdf`:
     fixed states, MuJoCo's joint-space mass matrix (`mj_fullM` after `mj_forward`) and
     bias forces `qfrc_bias` (gravity + Coriolis/centrifugal, dyngen's
     `nonlinear_effects`): `NAME.json`.
+
+(c) For the hand-written `small.xml` (not written by this script), MuJoCo's values as
+    in (b): `small.json`.
 
 Gravity is MuJoCo's default `0 0 -9.81`. No armature, damping or friction is set, so
 `qfrc_bias` and `M` are the rigid-body terms alone.

@@ -94,6 +94,16 @@ pub enum ErrorKind {
         friction: f64,
     },
     NoMovingJoint,
+    /// An MJCF construct the MJCF front end does not read yet (ball and free joints,
+    /// several joints in one body, `<include>`, `<frame>`): what it is and what to do.
+    NotSupported(String),
+    /// An MJCF `class` or `childclass` naming no `<default class>`.
+    UnknownClass(String),
+    /// An MJCF element or attribute that is not valid MJCF: what is wrong.
+    InvalidMjcf(String),
+    /// Something the description says that the model cannot hold and leaves out
+    /// (an MJCF joint's `armature`): only ever a warning.
+    Ignored(String),
 }
 
 impl fmt::Display for ModelError {
@@ -199,6 +209,11 @@ impl fmt::Display for ErrorKind {
                  give values ≥ 0"
             ),
             ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
+            ErrorKind::NotSupported(m) | ErrorKind::InvalidMjcf(m) | ErrorKind::Ignored(m) => write!(f, "{m}"),
+            ErrorKind::UnknownClass(c) => write!(
+                f,
+                "default class `{c}` is not defined; define it with <default class=\"{c}\"> inside <default>"
+            ),
         }
     }
 }
@@ -207,6 +222,9 @@ impl ModelError {
     /// The message of a problem accepted with a warning ([`Model::warnings`](crate::Model)):
     /// what is wrong, and why it was let through.
     pub fn warning_message(&self) -> String {
+        if let ErrorKind::Ignored(_) = self.kind {
+            return self.to_string();
+        }
         format!(
             "{self}; accepted as written: within the relative tolerance of {:e} for CAD rounding (the nearest \
              physical inertia is used where consistency is needed; a strict build refuses it)",

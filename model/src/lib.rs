@@ -2,7 +2,7 @@
 //!
 //! The robot description every other dyngen crate builds on: a checked fixed-base
 //! kinematic tree ([`Model`]) in regular labelling, the front ends that produce it
-//! (URDF here; the `robot!` DSL lives in `dyngen-codegen`), the paper's graph theory
+//! (URDF and MJCF here; the `robot!` DSL lives in `dyngen-codegen`), the paper's graph theory
 //! ([`graph`]), a URDF writer so any model can be opened in standard tools, the
 //! numeric joint torque regressor ([`regressor`]) and the base-parameter analysis
 //! built on it ([`base`]), with the project's parameter names ([`names`]).
@@ -27,6 +27,7 @@ pub mod graph;
 mod ir;
 pub mod joint_params;
 pub mod math;
+pub mod mjcf;
 pub mod names;
 pub mod principal;
 pub mod regressor;
@@ -42,6 +43,7 @@ pub use desc::{
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+pub use mjcf::{load_mjcf, load_mjcf_with, load_robot, parse_mjcf, parse_mjcf_with};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, load_urdf_with, parse_urdf, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

@@ -1,0 +1,560 @@
+//! The MJCF front end: MuJoCo's own conversions of the UR5 and Panda URDFs give the
+//! URDF's model (to MuJoCo's printed rounding), the mass matrix and bias forces of the
+//! models read from MJCF equal MuJoCo's (`tests/fixtures/mjcf/*.json`, written by
+//! `scripts/make_mjcf_fixtures.py`), the hand-written `small.xml` gives its documented
+//! numbers, and one test per refused construct checks the message names the element
+//! and its line.
+
+use dyngen_model::regressor::joint_torque_regressor;
+use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
+use serde_json::Value;
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn fixture(name: &str) -> PathBuf {
+    root().join("tests/fixtures/mjcf").join(name)
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+fn flat3(m: &[[f64; 3]; 3]) -> Vec<f64> {
+    m.iter().flatten().copied().collect()
+}
+
+/// `τ = Y(q, v, a) π` with the model's nominal parameters.
+fn torque(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
+    let pi = model.standard_params();
+    joint_torque_regressor(model, q, v, a)
+        .unwrap()
+        .iter()
+        .map(|row| row.iter().zip(&pi).map(|(y, p)| y * p).sum())
+        .collect()
+}
+
+/// Mass matrix (columns `τ(q, 0, e_k) − τ(q, 0, 0)`) and bias `τ(q, v, 0)`.
+fn dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let n = model.dof();
+    let zero = vec![0.0; n];
+    let g = torque(model, q, &zero, &zero);
+    let mut m = vec![vec![0.0; n]; n];
+    for k in 0..n {
+        let mut e = zero.clone();
+        e[k] = 1.0;
+        let col = torque(model, q, &zero, &e);
+        for r in 0..n {
+            m[r][k] = col[r] - g[r];
+        }
+    }
+    (m, torque(model, q, v, &zero))
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    match v {
+        Value::Array(a) => a.iter().flat_map(numbers).collect(),
+        Value::Number(x) => vec![x.as_f64().unwrap()],
+        _ => panic!("not a number: {v}"),
+    }
+}
+
+/// Largest difference of `M` and of the bias from MuJoCo's, over the fixture's states.
+fn against_mujoco(name: &str) -> (f64, f64) {
+    let model = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
+    let text = std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let joints: Vec<&str> = reference["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
+    let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(ours, joints, "{name}: joint order");
+    assert_eq!(model.gravity.to_vec(), numbers(&reference["gravity"]));
+    let (mut dm, mut db) = (0.0f64, 0.0f64);
+    for s in reference["samples"].as_array().unwrap() {
+        let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        let (m, bias) = dynamics(&model, &q, &v);
+        let m: Vec<f64> = m.into_iter().flatten().collect();
+        dm = dm.max(max_abs_diff(&m, &numbers(&s["M"])));
+        db = db.max(max_abs_diff(&bias, &numbers(&s["bias"])));
+    }
+    eprintln!("{name}: |M - M_mujoco| <= {dm:.2e}, |bias - bias_mujoco| <= {db:.2e}");
+    (dm, db)
+}
+
+#[test]
+fn mass_matrix_and_bias_equal_mujocos() {
+    for name in ["ur5", "panda", "small"] {
+        let (dm, db) = against_mujoco(name);
+        assert!(dm < 1e-12 && db < 1e-11, "{name}: M {dm:e}, bias {db:e}");
+    }
+}
+
+/// MuJoCo prints 6 significant digits: a rounded quaternion is normalised back to
+/// the exact rotation when its entries are equal (`0.707107 0.707107 0 0`), but
+/// centres of mass, inertias, limits and general principal axes differ from the
+/// URDF's by up to half a unit in the sixth digit.
+fn compare_with_urdf(name: &str, urdf: &str) -> [f64; 4] {
+    let from_mjcf = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
+    let from_urdf = load_urdf(&root().join(urdf)).unwrap();
+    assert_eq!(from_mjcf.dof(), from_urdf.dof());
+    assert_eq!(from_mjcf.base, "world");
+    let (mut placement, mut axis, mut inertial, mut limits) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (a, b) in from_mjcf.joints.iter().zip(&from_urdf.joints) {
+        assert_eq!((&a.name, a.kind, a.parent), (&b.name, b.kind, b.parent));
+        placement = placement.max(max_abs_diff(&flat3(&a.origin.rotation), &flat3(&b.origin.rotation)));
+        placement = placement.max(max_abs_diff(&a.origin.translation, &b.origin.translation));
+        axis = axis.max(max_abs_diff(&a.axis, &b.axis));
+        let (la, lb) = (a.limits.unwrap(), b.limits.unwrap());
+        limits = limits.max(max_abs_diff(
+            &[la.lower, la.upper, la.effort],
+            &[lb.lower, lb.upper, lb.effort],
+        ));
+    }
+    for (a, b) in from_mjcf.bodies.iter().zip(&from_urdf.bodies) {
+        assert_eq!((&a.name, &a.merged), (&b.name, &b.merged));
+        let (ia, ib) = (a.inertial, b.inertial);
+        // Relative to the body's largest moment for the tensor, absolute for the rest.
+        let scale = ib.inertia.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        inertial = inertial.max((ia.mass - ib.mass).abs() / ib.mass);
+        inertial = inertial.max(max_abs_diff(&ia.com, &ib.com));
+        inertial = inertial.max(max_abs_diff(&flat3(&ia.inertia), &flat3(&ib.inertia)) / scale);
+    }
+    // The URDF's frames are the MJCF's without `world`.
+    let frames: Vec<_> = from_mjcf.frames.iter().filter(|f| f.name != "world").collect();
+    assert_eq!(frames.len(), from_urdf.frames.len());
+    for (a, b) in frames.iter().zip(&from_urdf.frames) {
+        assert_eq!((&a.name, a.body), (&b.name, b.body));
+        placement = placement.max(max_abs_diff(&a.placement.translation, &b.placement.translation));
+        placement = placement.max(max_abs_diff(
+            &flat3(&a.placement.rotation),
+            &flat3(&b.placement.rotation),
+        ));
+    }
+    eprintln!(
+        "{name}: placements {placement:.1e}, axes {axis:.1e}, inertials (relative) {inertial:.1e}, limits {limits:.1e}"
+    );
+    [placement, axis, inertial, limits]
+}
+
+#[test]
+fn mujocos_ur5_is_the_urdfs() {
+    let [placement, axis, inertial, limits] = compare_with_urdf("ur5", "robots/ur5/ur5.urdf");
+    assert!(placement < 1e-12 && axis == 0.0, "{placement:e} {axis:e}");
+    assert!(inertial < 5e-6 && limits < 5e-6, "{inertial:e} {limits:e}");
+}
+
+#[test]
+fn mujocos_panda_is_the_urdfs() {
+    let [placement, axis, inertial, limits] = compare_with_urdf("panda", "robots/panda/panda.urdf");
+    assert!(placement < 1e-12 && axis == 0.0, "{placement:e} {axis:e}");
+    assert!(inertial < 5e-6 && limits < 5e-6, "{inertial:e} {limits:e}");
+}
+
+#[test]
+fn small_gives_its_documented_numbers() {
+    let model = load_robot(&fixture("small.xml")).unwrap();
+    assert_eq!(model.name, "small");
+    assert_eq!(model.base, "world");
+    let close = |a: &[f64], b: &[f64]| max_abs_diff(a, b) < 1e-15;
+    let [shoulder, slider] = [&model.joints[0], &model.joints[1]];
+    assert_eq!(
+        (shoulder.name.as_str(), shoulder.kind, shoulder.parent),
+        ("shoulder", JointKind::Revolute, 0)
+    );
+    assert!(close(
+        &flat3(&shoulder.origin.rotation),
+        &[0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    ));
+    assert!(close(&shoulder.origin.translation, &[0.0, 0.0, 0.35]));
+    assert!(close(&shoulder.axis, &[0.0, 1.0, 0.0]));
+    let l = shoulder.limits.unwrap();
+    assert!(close(
+        &[l.lower, l.upper],
+        &[-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2]
+    ));
+    assert_eq!((shoulder.dynamics.damping, shoulder.dynamics.friction), (0.5, 0.1));
+
+    assert_eq!(
+        (slider.name.as_str(), slider.kind, slider.parent),
+        ("slider", JointKind::Prismatic, 1)
+    );
+    assert!(close(&slider.origin.translation, &[0.0, 0.0, 0.45]));
+    assert!(close(
+        &flat3(&slider.origin.rotation),
+        &flat3(&dyngen_model::math::IDENTITY)
+    ));
+    assert!(close(&slider.axis, &[1.0, 0.0, 0.0]));
+    let l = slider.limits.unwrap();
+    assert_eq!((l.lower, l.upper), (-0.2, 0.3));
+    assert_eq!((slider.dynamics.damping, slider.dynamics.friction), (0.5, 0.1));
+
+    let upper = &model.bodies[0].inertial;
+    assert_eq!(upper.mass, 2.0);
+    assert!(close(&upper.com, &[0.0, 0.0, 0.2]));
+    assert!(close(
+        &flat3(&upper.inertia),
+        &[0.05, 0.0, 0.0, 0.0, 0.04, 0.0, 0.0, 0.0, 0.02]
+    ));
+    let fore = &model.bodies[1];
+    assert_eq!(fore.merged, ["tip"]);
+    assert_eq!(fore.inertial.mass, 1.5);
+    assert!(close(&fore.inertial.com, &[0.4 / 3.0, 0.0, 0.0]));
+    // 0.004 0.002 0.003 about fore's centre, 1e-4 each for the tip, plus the
+    // parallel-axis terms of 1 kg at -1/30 and 0.5 kg at +2/30 along x (y and z only).
+    let d = 1.0 * (1.0f64 / 30.0).powi(2) + 0.5 * (2.0f64 / 30.0).powi(2);
+    let expected = [0.0041, 0.0, 0.0, 0.0, 0.0021 + d, 0.0, 0.0, 0.0, 0.0031 + d];
+    assert!(max_abs_diff(&flat3(&fore.inertial.inertia), &expected) < 1e-15);
+    let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["world", "base", "upper", "fore", "tip"]);
+}
+
+#[test]
+fn load_robot_dispatches_on_the_extension() {
+    let urdf = load_robot(&root().join("robots/ur5/ur5.urdf")).unwrap();
+    assert_eq!(urdf, load_urdf(&root().join("robots/ur5/ur5.urdf")).unwrap());
+    let e = load_robot(&root().join("README.md")).unwrap_err();
+    assert!(e.to_string().contains("unknown file type"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------
+// Errors: each names its element and line.
+
+/// A document whose worldbody holds `lines`, so that `lines[k]` sits on line `k + 3`.
+fn mjcf(lines: &[&str]) -> String {
+    let mut text = String::from("<mujoco model=\"t\">\n<worldbody>\n");
+    for l in lines {
+        text.push_str(l);
+        text.push('\n');
+    }
+    text.push_str("</worldbody>\n</mujoco>\n");
+    text
+}
+
+const INERTIAL: &str = r#"<inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>"#;
+
+fn errors(text: &str) -> ModelErrors {
+    parse_mjcf(text).expect_err("should be refused")
+}
+
+/// The only error, checked for its element, line and a part of its message.
+fn only_error(text: &str, element: Element, line: usize, says: &str) -> ErrorKind {
+    let e = errors(text);
+    assert_eq!(e.errors.len(), 1, "{e}");
+    let err = &e.errors[0];
+    assert_eq!((&err.element, err.line), (&element, Some(line)), "{e}");
+    let message = e.to_string();
+    assert!(message.starts_with(&format!("line {line}: {element}: ")), "{message}");
+    assert!(message.contains(says), "{message}");
+    err.kind.clone()
+}
+
+#[test]
+fn ball_joint_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\" type=\"ball\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("j".into()),
+        5,
+        "joint type `ball` is not supported yet",
+    );
+}
+
+#[test]
+fn free_joints_are_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"f\" type=\"free\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("f".into()),
+        5,
+        "joint type `free` is not supported yet",
+    );
+    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<freejoint name=\"f\"/>", "</body>"]);
+    only_error(&text, Element::Joint("f".into()), 5, "<freejoint> is not supported yet");
+}
+
+#[test]
+fn two_joints_in_one_body_are_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j1\" axis=\"1 0 0\"/>",
+        "<joint name=\"j2\" axis=\"0 1 0\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("j2".into()),
+        6,
+        "body `a` already has a joint; several joints in one body are not supported yet",
+    );
+}
+
+#[test]
+fn missing_inertial_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        "<geom type=\"sphere\" size=\"0.1\"/>",
+        "</body>",
+    ]);
+    let kind = only_error(&text, Element::Link("a".into()), 3, "has no <inertial>");
+    assert_eq!(kind, ErrorKind::MissingInertial);
+    // A massless marker at the end of a chain is fine.
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "<body name=\"marker\" pos=\"0 0 1\"/>",
+        "</body>",
+    ]);
+    assert_eq!(parse_mjcf(&text).unwrap().bodies[0].merged, ["marker"]);
+}
+
+#[test]
+fn bad_numbers_name_their_line() {
+    let text = mjcf(&[
+        "<body name=\"a\" pos=\"0 0\">",
+        "<joint name=\"j\" range=\"-1 one\"/>",
+        INERTIAL,
+        "</body>",
+    ]);
+    let e = errors(&text);
+    assert_eq!(e.errors.len(), 2, "{e}");
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Link("a".into()), Some(3))
+    );
+    assert_eq!(
+        (&e.errors[1].element, e.errors[1].line),
+        (&Element::Joint("j".into()), Some(4))
+    );
+    let message = e.to_string();
+    assert!(
+        message.contains("line 3: link `a`: <body pos=\"0 0\"> is not 3 numbers"),
+        "{message}"
+    );
+    assert!(
+        message.contains("line 4: joint `j`: <joint range=\"-1 one\"> is not 2 numbers"),
+        "{message}"
+    );
+}
+
+#[test]
+fn include_is_refused() {
+    let text = "<mujoco model=\"t\">\n  <include file=\"arm.xml\"/>\n  <worldbody/>\n</mujoco>\n";
+    let e = errors(text);
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Robot, Some(2)),
+        "{e}"
+    );
+    assert!(
+        e.to_string()
+            .contains("line 2: robot: <include file=\"arm.xml\"> is not supported yet"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_class_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\" class=\"nowhere\"/>",
+        "</body>",
+    ]);
+    let kind = only_error(
+        &text,
+        Element::Joint("j".into()),
+        5,
+        "default class `nowhere` is not defined",
+    );
+    assert_eq!(kind, ErrorKind::UnknownClass("nowhere".into()));
+    let text = mjcf(&[
+        "<body name=\"a\" childclass=\"gone\">",
+        INERTIAL,
+        "<joint name=\"j\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Link("a".into()),
+        3,
+        "default class `gone` is not defined",
+    );
+}
+
+#[test]
+fn errors_are_all_collected_with_the_file_name() {
+    let dir = std::env::temp_dir().join(format!("dyngen-mjcf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.xml");
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"b\" type=\"ball\"/>",
+        INERTIAL,
+        "<body name=\"c\"><joint name=\"d\"/></body>",
+        "</body>",
+    ]);
+    std::fs::write(&path, text).unwrap();
+    let e = load_mjcf(&path).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let message = e.to_string();
+    let lines: Vec<&str> = message.lines().collect();
+    assert_eq!(lines.len(), 2, "{message}");
+    assert!(lines[0].ends_with("bad.xml:4: joint `b`: joint type `ball` is not supported yet; only hinge and slide joints are (a ball joint is three hinges about orthogonal axes through one point, in a chain of bodies)"), "{message}");
+    assert!(
+        lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"),
+        "{message}"
+    );
+}
+
+#[test]
+fn armature_is_left_out_with_a_warning() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\" armature=\"0.1\"/>",
+        "</body>",
+    ]);
+    let model = parse_mjcf(&text).unwrap();
+    assert_eq!(model.warnings.len(), 1);
+    let w = model.warnings[0].warning_message();
+    assert!(w.starts_with("line 5: joint `j`: armature = 0.1 is left out"), "{w}");
+}
+
+#[test]
+fn not_mujoco_and_too_deep_are_refused() {
+    let e = errors("<robot name=\"r\"/>\n");
+    assert!(
+        e.to_string()
+            .contains("line 1: robot: the document element is <robot>, not <mujoco>"),
+        "{e}"
+    );
+    let deep = format!("<mujoco>\n{}{}</mujoco>", "<a>".repeat(300), "</a>".repeat(300));
+    let e = errors(&deep);
+    assert!(matches!(e.errors[0].kind, ErrorKind::TooDeep { .. }), "{e}");
+}
+
+/// Orientations against MuJoCo's `xmat` of a body at `q = 0` (MuJoCo 4.0.0, printed
+/// with `repr`), for every way of writing one; angles in degrees, the default.
+#[test]
+fn orientations_are_mujocos() {
+    let cases: [(&str, &str, [f64; 9]); 6] = [
+        (
+            "xyz",
+            r#"euler="30 40 50""#,
+            [
+                0.49240387650610407,
+                -0.5868240888334653,
+                0.6427876096865394,
+                0.8700019037522058,
+                0.3104684609733674,
+                -0.383022221559489,
+                0.025201386257487357,
+                0.7478280708194913,
+                0.6634139481689385,
+            ],
+        ),
+        (
+            "zyX",
+            r#"euler="30 40 50""#,
+            [
+                0.6634139481689386,
+                -0.5,
+                0.5566703992264195,
+                0.7386058147591561,
+                0.5566703992264195,
+                -0.38023613325019795,
+                -0.11976386674980224,
+                0.6634139481689385,
+                0.7386058147591562,
+            ],
+        ),
+        (
+            "XYZ",
+            r#"euler="30 40 50""#,
+            [
+                0.4924038765061042,
+                -0.4568259925856712,
+                0.7408430568614908,
+                0.5868240888334654,
+                0.8028723374794715,
+                0.10504046113295201,
+                -0.6427876096865395,
+                0.383022221559489,
+                0.6634139481689386,
+            ],
+        ),
+        (
+            "xyz",
+            r#"axisangle="1 2 3 70""#,
+            [
+                0.3890187045166923,
+                -0.659433128159501,
+                0.6432825172674365,
+                0.8474273729235955,
+                0.5300143880897634,
+                0.03084795029895926,
+                -0.3612911501212944,
+                0.5331347839933247,
+                0.7650071940448816,
+            ],
+        ),
+        (
+            "xyz",
+            r#"xyaxes="1 1 0 -1 2 0.5""#,
+            [
+                0.7071067811865472,
+                -0.6882472016116852,
+                0.16222142113076252,
+                0.7071067811865475,
+                0.6882472016116852,
+                -0.1622214211307625,
+                0.0,
+                0.22941573387056174,
+                0.973328526784575,
+            ],
+        ),
+        (
+            "xyz",
+            r#"zaxis="1 -2 2""#,
+            [
+                0.9333333333333333,
+                0.13333333333333336,
+                0.3333333333333333,
+                0.13333333333333336,
+                0.7333333333333332,
+                -0.6666666666666666,
+                -0.3333333333333333,
+                0.6666666666666666,
+                0.6666666666666665,
+            ],
+        ),
+    ];
+    for (seq, attr, expected) in cases {
+        let text = format!(
+            r#"<mujoco><compiler eulerseq="{seq}"/><worldbody><body name="a" {attr}>{INERTIAL}<joint name="j"/></body></worldbody></mujoco>"#
+        );
+        let model = parse_mjcf(&text).unwrap();
+        let d = max_abs_diff(&flat3(&model.joints[0].origin.rotation), &expected);
+        assert!(d < 1e-15, "{seq} {attr}: {d:e}");
+    }
+}

@@ -35,11 +35,11 @@ impl ModelArgs {
     }
 }
 
-/// Reads, parses and checks the URDF at `path` (all errors as `file:line: message`),
+/// Reads, parses and checks the URDF or MJCF (`.xml`) at `path` (all errors as `file:line: message`),
 /// prints its warnings (`strict`: refuses them), then sets the gravity when given.
 pub fn load_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Result<Model> {
     // The model's errors already read `file:line: message`.
-    let mut model = dyngen_model::load_urdf_with(path, strict).map_err(|e| CliError::Input(e.to_string()))?;
+    let mut model = dyngen_model::load_robot_with(path, strict).map_err(|e| CliError::Input(e.to_string()))?;
     for w in &model.warnings {
         let at = w.line.map(|l| format!(":{l}")).unwrap_or_default();
         let message = ModelError {

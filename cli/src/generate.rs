@@ -16,7 +16,7 @@ Use the file with `include!(\"arm.rs\");` in a crate that depends on `dyngen`.";
 
 #[derive(Debug, clap::Args)]
 pub struct GenerateArgs {
-    /// The robot description (URDF).
+    /// The robot description (URDF, or MJCF as `.xml`).
     pub urdf: PathBuf,
 
     /// Name of the generated type (a Rust identifier such as `Ur5`).

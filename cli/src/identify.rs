@@ -132,7 +132,7 @@ pub enum Method {
 
 #[derive(Debug, clap::Args)]
 pub struct IdentifyArgs {
-    /// The robot description (URDF); its inertials are the nominal parameters.
+    /// The robot description (URDF, or MJCF as `.xml`); its inertials are the nominal parameters.
     pub urdf: PathBuf,
 
     /// Measured data (CSV: t, q1..qn[, v1..vn, a1..an], tau1..taun[, wrenches]).

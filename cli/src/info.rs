@@ -15,7 +15,7 @@ Examples:
 
 #[derive(Debug, clap::Args)]
 pub struct InfoArgs {
-    /// The robot description (URDF).
+    /// The robot description (URDF, or MJCF as `.xml`).
     pub urdf: PathBuf,
 
     #[command(flatten)]

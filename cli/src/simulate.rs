@@ -47,7 +47,7 @@ pub enum CriterionArg {
 
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
-    /// The robot description (URDF); its inertials are the nominal parameters.
+    /// The robot description (URDF, or MJCF as `.xml`); its inertials are the nominal parameters.
     pub urdf: PathBuf,
 
     /// Output CSV file. An existing file is kept unless --force.

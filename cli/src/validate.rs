@@ -26,7 +26,7 @@ better than by zero torque.";
 
 #[derive(Debug, clap::Args)]
 pub struct ValidateArgs {
-    /// The robot description (URDF) the parameters were identified for.
+    /// The robot description (URDF, or MJCF as `.xml`) the parameters were identified for.
     pub urdf: PathBuf,
     /// The identified parameters (JSON from `dyngen identify --params-json`).
     pub params: PathBuf,

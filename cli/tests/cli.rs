@@ -26,6 +26,27 @@ fn help_has_examples() {
     }
 }
 
+/// An MJCF file (`.xml`) goes through the same commands: MuJoCo's own export of the
+/// UR5 gives the same base-parameter count as the URDF.
+#[test]
+fn info_and_generate_read_mjcf() {
+    let mjcf = ur5().parent().unwrap().join("../../tests/fixtures/mjcf/ur5.xml");
+    let o = run!("info", &mjcf);
+    assert_ok(&o);
+    let out = stdout(&o);
+    let base_line = out
+        .lines()
+        .find(|l| l.contains("base (identifiable from joint torques)"))
+        .unwrap();
+    assert_eq!(base_line.split_whitespace().last(), Some("36"), "{base_line}");
+    let dir = temp_dir("cli", "mjcf_generate");
+    let file = dir.join("ur5_mjcf.rs");
+    let o = run!("generate", &mjcf, "--name", "Ur5Mjcf", "-o", &file);
+    assert_ok(&o);
+    let code = std::fs::read_to_string(&file).unwrap();
+    assert!(code.contains("pub struct Ur5Mjcf") && code.contains("pub enum Ur5MjcfFrame"));
+}
+
 #[test]
 fn info_prints_topology_matrices_and_base_count() {
     let o = run!("info", ur5());

@@ -109,7 +109,7 @@ impl Config {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
         }
-        let model = dyngen_model::load_urdf_with(&urdf, self.strict).map_err(Error::Model)?;
+        let model = dyngen_model::load_robot_with(&urdf, self.strict).map_err(Error::Model)?;
         for w in &model.warnings {
             println!("cargo:warning={}: {}", urdf.display(), w.warning_message());
         }

@@ -59,7 +59,7 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
         }
         RobotSource::Urdf(lit) => {
             let path = manifest_path(&lit.value());
-            let model = dyngen_model::load_urdf(&path).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
+            let model = dyngen_model::load_robot(&path).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
             (model, Some(path))
         }
     };

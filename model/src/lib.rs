@@ -43,7 +43,7 @@ pub use desc::{
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
-pub use mjcf::{load_mjcf, load_mjcf_with, load_robot, parse_mjcf, parse_mjcf_with};
+pub use mjcf::{load_mjcf, load_mjcf_with, load_robot, load_robot_with, parse_mjcf, parse_mjcf_with};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, load_urdf_with, parse_urdf, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

@@ -71,21 +71,19 @@ pub fn load_mjcf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
     build(&text, strict).map_err(|errors| ModelErrors { file, errors })
 }
 
-/// Loads a robot by its file name: `.urdf` as URDF ([`load_urdf`](crate::load_urdf),
-/// siblings by joint name), `.xml` or `.mjcf` as MJCF ([`load_mjcf`], siblings in
-/// declaration order).
+/// Loads a robot by its file name: `.xml` or `.mjcf` as MJCF ([`load_mjcf`], siblings
+/// in declaration order), anything else as URDF ([`load_urdf`](crate::load_urdf),
+/// siblings by joint name), as the command line and `build.rs` did before MJCF.
 pub fn load_robot(path: &Path) -> Result<Model, ModelErrors> {
+    load_robot_with(path, false)
+}
+
+/// [`load_robot`]; `strict` refuses CAD-rounded inertias, as for URDF and MJCF.
+pub fn load_robot_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("urdf") => crate::load_urdf(path),
-        Some("xml" | "mjcf") => load_mjcf(path),
-        _ => Err(ModelErrors {
-            file: Some(path.display().to_string()),
-            errors: vec![robot_error(
-                None,
-                ErrorKind::Io("unknown file type; name a URDF `.urdf` and an MJCF (MuJoCo) file `.xml`".into()),
-            )],
-        }),
+        Some("xml" | "mjcf") => load_mjcf_with(path, strict),
+        _ => crate::load_urdf_with(path, strict),
     }
 }
 

@@ -219,8 +219,11 @@ fn small_gives_its_documented_numbers() {
 fn load_robot_dispatches_on_the_extension() {
     let urdf = load_robot(&root().join("robots/ur5/ur5.urdf")).unwrap();
     assert_eq!(urdf, load_urdf(&root().join("robots/ur5/ur5.urdf")).unwrap());
+    let mjcf = load_robot(&fixture("small.xml")).unwrap();
+    assert_eq!(mjcf, load_mjcf(&fixture("small.xml")).unwrap());
+    // Anything but `.xml` and `.mjcf` is read as URDF.
     let e = load_robot(&root().join("README.md")).unwrap_err();
-    assert!(e.to_string().contains("unknown file type"), "{e}");
+    assert!(e.to_string().contains("README.md"), "{e}");
 }
 
 // ---------------------------------------------------------------------------------

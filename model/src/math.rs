@@ -57,6 +57,27 @@ pub fn matrix_to_rpy(r: &Mat3) -> Vec3 {
     }
 }
 
+/// The rotation of a unit quaternion `[w, x, y, z]`.
+pub fn quaternion_to_matrix([w, x, y, z]: [f64; 4]) -> Mat3 {
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
 pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
     let mut m = [[0.0; 3]; 3];
     for (i, row) in m.iter_mut().enumerate() {

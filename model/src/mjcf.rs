@@ -890,24 +890,7 @@ pub fn quat_matrix(q: [f64; 4]) -> Option<Mat3> {
     if n == 0.0 || !n.is_finite() {
         return None;
     }
-    let [w, x, y, z] = q.map(|c| c / n);
-    Some([
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ])
+    Some(math::quaternion_to_matrix(q.map(|c| c / n)))
 }
 
 /// Rotation by `angle` about the unit `axis` (Rodrigues); quarter turns exact.

@@ -206,30 +206,14 @@ fn unit_vector(rng: &mut SplitMix64) -> Vec3 {
 
 /// A uniformly distributed rotation, from a random unit quaternion.
 fn random_rotation(rng: &mut SplitMix64) -> Mat3 {
-    let [w, x, y, z] = loop {
+    let q = loop {
         let v = [0; 4].map(|_| rng.uniform(-1.0, 1.0));
         let r = v.iter().map(|c| c * c).sum::<f64>().sqrt();
         if (0.1..=1.0).contains(&r) {
             break v.map(|c| c / r);
         }
     };
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
+    math::quaternion_to_matrix(q)
 }
 
 /// Half the time ±x, ±y or ±z exactly; otherwise a random direction of random

@@ -263,6 +263,11 @@ fn optimised_excitation_is_better_conditioned_and_within_limits() {
     assert_limits(&result.excitation, &design.limits);
     // Deterministic for a seed.
     assert_eq!(design.optimise(&r), result);
+    // The progress callback counts every evaluation, in order, and changes nothing.
+    let mut seen = Vec::new();
+    let watched = design.optimise_with_progress(&r, &mut |done| seen.push(done));
+    assert_eq!(watched, result);
+    assert_eq!(seen, (1..=result.evaluations).collect::<Vec<_>>());
 
     design.start_at_rest = true;
     design.max_evaluations = 120;

@@ -151,6 +151,17 @@ impl ExcitationDesign {
     /// Panics if `limits` does not have one entry per joint, or `start_at_rest` with
     /// fewer than 2 harmonics.
     pub fn optimise(&self, dynamics: &dyn Dynamics) -> OptimisedExcitation {
+        self.optimise_with_progress(dynamics, &mut |_| {})
+    }
+
+    /// [`ExcitationDesign::optimise`], calling `progress(evaluations)` after each
+    /// objective evaluation (at most [`ExcitationDesign::max_evaluations`]), for a
+    /// progress bar: on a large tree one evaluation takes tens of milliseconds.
+    pub fn optimise_with_progress(
+        &self,
+        dynamics: &dyn Dynamics,
+        progress: &mut dyn FnMut(usize),
+    ) -> OptimisedExcitation {
         let n = dynamics.nv();
         let harmonics = self.harmonics;
         assert_eq!(
@@ -210,7 +221,13 @@ impl ExcitationDesign {
         }
 
         let mut evaluations = 0;
-        let mut f = |x: &[f64]| objective.value(&layout.decode(x));
+        let mut done = 0;
+        let mut f = |x: &[f64]| {
+            let y = objective.value(&layout.decode(x));
+            done += 1;
+            progress(done);
+            y
+        };
         let mut best = (x.clone(), f64::INFINITY);
         let runs = self.restarts.max(1);
         for run in 0..runs {

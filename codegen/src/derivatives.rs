@@ -206,7 +206,7 @@ fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<
 
 fn dot<'g>(a: &[Expr<'g>], b: &[Expr<'g>]) -> Expr<'g> {
     let mut terms = a.iter().zip(b).map(|(&x, &y)| x * y);
-    let first = terms.next().expect("non-empty");
+    let first = terms.next().expect("non-empty"); // ok: a model has at least one joint
     terms.fold(first, |s, t| s + t)
 }
 
@@ -464,7 +464,7 @@ pub fn inverse_inertia<'g>(g: &'g Graph, model: &Model, m: &[Vec<Expr<'g>>]) -> 
             let mut sum = g.zero();
             let mut l = parent(k);
             loop {
-                sum = sum + h[k - 1][l - 1] * ninv[l][i].expect("ancestors are filled first");
+                sum = sum + h[k - 1][l - 1] * ninv[l][i].expect("ancestors are filled first"); // ok: regular labelling
                 if l == i {
                     break;
                 }

@@ -49,6 +49,12 @@ enum Walk {
     Motion,
 }
 
+/// What [`walk`] computed for body or joint `i`. Every function walks the bodies it
+/// reads (each one's parent first), so this never fails.
+fn walked<T: Copy>(computed: &[Option<T>], i: usize) -> T {
+    computed[i].expect("a body is walked before it is read") // ok: an invariant of `walk`'s callers
+}
+
 /// The bodies from the base to `body`, base side first (body 0 excluded).
 fn path(model: &Model, body: usize) -> Vec<usize> {
     let mut p = Vec::new();
@@ -83,7 +89,7 @@ fn walk<'g>(
     });
     let mut joints = vec![None; n + 1];
     for &k in bodies {
-        let p = world[model.parent(k)].expect("parents are walked before their children");
+        let p = walked(&world, model.parent(k));
         let x = JointTransform::new(g, model, k);
         let joint = &model.joints[k - 1];
         let r0 = p.r.mul(&x.origin);
@@ -144,7 +150,7 @@ fn v3_ids<'a>(v: &'a V3<'_>) -> impl Iterator<Item = NodeId> + 'a {
 pub fn build_placement(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let b = model.frames[f].body;
     let (world, _) = walk(g, model, &path(model, b), Walk::Placement);
-    let (r, t, _) = frame_pose(g, model, f, &world[b].expect("walked"));
+    let (r, t, _) = frame_pose(g, model, f, &walked(&world, b));
     pose_ids(&r, &t)
 }
 
@@ -154,7 +160,7 @@ pub fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
     let (world, _) = walk(g, model, &all, Walk::Placement);
     (0..model.frames.len())
         .flat_map(|f| {
-            let (r, t, _) = frame_pose(g, model, f, &world[model.frames[f].body].expect("walked"));
+            let (r, t, _) = frame_pose(g, model, f, &walked(&world, model.frames[f].body));
             pose_ids(&r, &t)
         })
         .collect()
@@ -166,10 +172,10 @@ pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let b = model.frames[f].body;
     let on_path = path(model, b);
     let (world, joints) = walk(g, model, &on_path, Walk::Placement);
-    let (r, p, _) = frame_pose(g, model, f, &world[b].expect("walked"));
+    let (r, p, _) = frame_pose(g, model, f, &walked(&world, b));
     let mut jac = vec![vec![g.zero(); n]; 6];
     for &k in &on_path {
-        let j = joints[k].expect("walked");
+        let j = walked(&joints, k);
         let (lin, ang) = if j.revolute {
             (j.z.cross(p - j.o), j.z)
         } else {
@@ -201,7 +207,7 @@ pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<
 pub fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let bi = model.frames[f].body;
     let (world, _) = walk(g, model, &path(model, bi), Walk::Motion);
-    let b = world[bi].expect("walked");
+    let b = walked(&world, bi);
     let (r, p, e) = frame_pose(g, model, f, &b);
     let v = b.v + b.w.cross(e);
     let acc = b.acc + b.wd.cross(e) + b.w.cross(b.w.cross(e));
@@ -215,7 +221,7 @@ pub fn build_motion(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
 fn moments<'g>(g: &'g Graph, model: &Model, world: &[Option<WorldBody<'g>>]) -> Vec<(Expr<'g>, V3<'g>)> {
     (1..=model.dof())
         .map(|i| {
-            let b = world[i].expect("walked");
+            let b = walked(world, i);
             let p = BodyParams::input(g, i);
             (p.m, b.t.scale(p.m) + b.r.mul_vec(p.h))
         })
@@ -254,7 +260,7 @@ pub fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
     let inv = g.one() / total;
     let mut jac = vec![vec![g.zero(); n]; 3];
     for k in 1..=n {
-        let j = joints[k].expect("walked");
+        let j = walked(&joints, k);
         let (mk, hk) = sub[k - 1];
         let col = if j.revolute {
             j.z.cross(hk - j.o.scale(mk)).scale(inv)
@@ -285,14 +291,14 @@ pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
     let (total, first) = (1..=n)
         .filter(|&i| model.parent(i) == 0)
         .fold((g.zero(), V3::zero(g)), |(m, h), i| {
-            let (c, b) = (&composite[i - 1], world[i].expect("walked"));
+            let (c, b) = (&composite[i - 1], walked(&world, i));
             (m + c.m, h + b.t.scale(c.m) + b.r.mul_vec(c.h))
         });
     let com = first.scale(g.one() / total);
     let mut a = vec![vec![g.zero(); n]; 6];
     for k in 1..=n {
         let c = &composite[k - 1];
-        let b = world[k].expect("walked");
+        let b = walked(&world, k);
         let s = crate::algo::subspace(g, model, k);
         // (f, n) = I_k S_k, as crba builds it.
         let f = s.v.scale(c.m) + s.w.cross(c.h);

@@ -37,6 +37,18 @@ pub enum Output<'a> {
     InPlace { place: Place<'a>, clear: TokenStream },
 }
 
+/// A row-major matrix `[[S; cols]; rows]` written through `out`, zeroed first:
+/// output `k` is `out[k / cols][k % cols]`.
+pub fn matrix_output(cols: usize) -> Output<'static> {
+    Output::InPlace {
+        place: Box::new(move |k: usize| {
+            let (r, c) = (usize_lit(k / cols), usize_lit(k % cols));
+            quote!(out[#r][#c])
+        }),
+        clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
+    }
+}
+
 /// A function to emit: its signature pieces and symbolic outputs.
 pub struct FnSpec<'a> {
     pub name: &'a str,

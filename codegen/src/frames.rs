@@ -374,17 +374,6 @@ pub(crate) struct FrameFns {
     pub reports: Vec<FnReport>,
 }
 
-/// A row-major matrix of `n` columns written through `out` (zeroed first).
-fn matrix_output(n: usize) -> Output<'static> {
-    Output::InPlace {
-        place: Box::new(move |k: usize| {
-            let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
-            quote!(out[#r][#c])
-        }),
-        clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
-    }
-}
-
 fn arg(id: u8, name: &'static str, len: usize) -> Arg {
     Arg { id, name, len }
 }
@@ -571,7 +560,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         ),
         args: vec![q(), params()],
         ret: quote!([[S; #n_l]; 3]),
-        output: matrix_output(n),
+        output: emit::matrix_output(n),
         outputs,
     };
     let com_jacobian = emit_one(spec, &g, "com_jacobian".to_string());
@@ -587,7 +576,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         ),
         args: vec![q(), params()],
         ret: quote!([[S; #n_l]; 6]),
-        output: matrix_output(n),
+        output: emit::matrix_output(n),
         outputs,
     };
     let centroidal = emit_one(spec, &g, "centroidal_map".to_string());

@@ -619,17 +619,7 @@ impl Algorithm {
             Shape::Matrix { rows, cols } => {
                 let (r, c) = (sizes.of(rows), sizes.of(cols));
                 let (r_lit, c_lit) = (emit::usize_lit(r), emit::usize_lit(c));
-                let place = move |k: usize| {
-                    let (i, j) = (emit::usize_lit(k / c), emit::usize_lit(k % c));
-                    quote!(out[#i][#j])
-                };
-                (
-                    quote!([[S; #c_lit]; #r_lit]),
-                    Output::InPlace {
-                        place: Box::new(place),
-                        clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
-                    },
-                )
+                (quote!([[S; #c_lit]; #r_lit]), emit::matrix_output(c))
             }
         };
         FnSpec {
@@ -939,13 +929,7 @@ fn derivative_items(
         ),
         args: vec![arg(ARG_Q, "q", n), arg(ARG_PARAMS, "params", 10 * n)],
         ret: quote!([[S; #n_l]; #n_l]),
-        output: Output::InPlace {
-            place: Box::new(move |k: usize| {
-                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
-                quote!(out[#r][#c])
-            }),
-            clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
-        },
+        output: emit::matrix_output(n),
         outputs: ids(&minv),
     };
     let (t, r) = emit::emit_fn(&g, &spec, max_statements);

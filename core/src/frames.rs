@@ -147,29 +147,24 @@ impl<S: Scalar, const N: usize> FrameJacobianTimeVariation<S, N> {
         for k in 0..N {
             let (jl, ja) = (col(&self.jacobian, k, 0), col(&self.jacobian, k, 3));
             let (dl, da) = (col(&self.jacobian_dot, k, 0), col(&self.jacobian_dot, k, 3));
-            let (j, dj) = match reference {
-                ReferenceFrame::World => (
-                    Motion {
-                        linear: jl + p.cross(&ja),
-                        angular: ja,
-                    },
-                    Motion {
-                        linear: dl + pdot.cross(&ja) + p.cross(&da),
-                        angular: da,
-                    },
-                ),
-                _ => {
-                    let j = Motion {
-                        linear: jl,
-                        angular: ja,
-                    };
-                    let d = Motion {
+            let j = Motion {
+                linear: jl,
+                angular: ja,
+            };
+            let dj = match reference {
+                ReferenceFrame::World => Motion {
+                    linear: dl + pdot.cross(&ja) + p.cross(&da),
+                    angular: da,
+                },
+                _ => rotate_back(
+                    &self.placement,
+                    &Motion {
                         linear: dl - w.cross(&jl),
                         angular: da - w.cross(&ja),
-                    };
-                    (rotate_back(&self.placement, &j), rotate_back(&self.placement, &d))
-                }
+                    },
+                ),
             };
+            let j = velocity_from_lwa(&self.placement, &j, reference);
             let (j, dj) = (j.to_array(), dj.to_array());
             for r in 0..6 {
                 self.jacobian[r][k] = j[r];

@@ -154,20 +154,31 @@ pub struct JointTransform<'g> {
 impl<'g> JointTransform<'g> {
     pub fn new(g: &'g Graph, model: &Model, j: usize) -> JointTransform<'g> {
         let joint = &model.joints[j - 1];
-        let q = g.input(ARG_Q, (j - 1) as u32);
+        let qo = model.q_offset(j) as u32;
+        let q = |k: u32| g.input(ARG_Q, qo + k);
         let origin = M3::constant(g, joint.origin.rotation);
         let t0 = V3::constant(g, joint.origin.translation);
         let axis = joint.axis;
         match joint.kind {
             JointKind::Revolute | JointKind::Continuous => JointTransform {
                 origin,
-                motion: rotation_about(g, axis, q),
+                motion: rotation_about(g, axis, q(0)),
                 translation: t0,
             },
             JointKind::Prismatic => JointTransform {
                 origin,
                 motion: M3::constant(g, dyngen_model::math::IDENTITY),
-                translation: t0 + origin.mul_vec(V3::constant(g, axis).scale(q)),
+                translation: t0 + origin.mul_vec(V3::constant(g, axis).scale(q(0))),
+            },
+            JointKind::Spherical => JointTransform {
+                origin,
+                motion: quaternion_rotation([q(0), q(1), q(2), q(3)]),
+                translation: t0,
+            },
+            JointKind::FreeFlyer => JointTransform {
+                origin,
+                motion: quaternion_rotation([q(3), q(4), q(5), q(6)]),
+                translation: t0 + origin.mul_vec(V3([q(0), q(1), q(2)])),
             },
         }
     }
@@ -185,6 +196,62 @@ impl<'g> JointTransform<'g> {
     pub fn rotation(&self) -> M3<'g> {
         self.origin.mul(&self.motion)
     }
+}
+
+/// The rotation of a unit quaternion stored `[x, y, z, w]` (Pinocchio's order), by
+/// the formula Eigen's `toRotationMatrix` uses (no normalisation).
+pub fn quaternion_rotation<'g>([x, y, z, w]: [Expr<'g>; 4]) -> M3<'g> {
+    let g = x.graph();
+    let two = g.constant(2.0);
+    let (tx, ty, tz) = (two * x, two * y, two * z);
+    let (twx, twy, twz) = (tx * w, ty * w, tz * w);
+    let (txx, txy, txz) = (tx * x, ty * x, tz * x);
+    let (tyy, tyz, tzz) = (ty * y, tz * y, tz * z);
+    let one = g.one();
+    M3([
+        [one - (tyy + tzz), txy - twz, txz + twy],
+        [txy + twz, one - (txx + tzz), tyz - twx],
+        [txz - twy, tyz + twx, one - (txx + tyy)],
+    ])
+}
+
+/// The time derivative of position coordinate `index` of `model` at velocity `v`
+/// (inputs [`ARG_Q`] and [`ARG_V`]): `v` itself for a joint with an axis; for a
+/// quaternion `q̇ = ½ q ⊗ (ω, 0)` with `ω` in the child frame; for a free flyer's
+/// position `ṗ = R(q) v`. `None` if `index` is out of range. What forward-mode
+/// tangents along the motion ([`Graph::tangents`]) seed each `q` with.
+pub fn q_dot<'g>(g: &'g Graph, model: &Model, index: usize) -> Option<Expr<'g>> {
+    let mut j = 1;
+    while j <= model.dof() && model.q_offset(j) + model.joints[j - 1].kind.nq() <= index {
+        j += 1;
+    }
+    let joint = model.joints.get(j - 1)?;
+    let (k, qo, vo) = (
+        index - model.q_offset(j),
+        model.q_offset(j) as u32,
+        model.v_offset(j) as u32,
+    );
+    let q = |i: u32| g.input(ARG_Q, qo + i);
+    let v = |i: u32| g.input(ARG_V, vo + i);
+    let quaternion_rate = |first: u32, w0: u32, k: usize| {
+        let (qv, qw) = (V3([q(first), q(first + 1), q(first + 2)]), q(first + 3));
+        let w = V3([v(w0), v(w0 + 1), v(w0 + 2)]);
+        let half = g.constant(0.5);
+        if k < 3 {
+            (w.scale(qw) + qv.cross(w)).0[k] * half
+        } else {
+            -(qv.dot(w) * half)
+        }
+    };
+    Some(match joint.kind {
+        JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => v(0),
+        JointKind::Spherical => quaternion_rate(0, 0, k),
+        JointKind::FreeFlyer if k < 3 => {
+            let r = quaternion_rotation([q(3), q(4), q(5), q(6)]);
+            r.mul_vec(V3([v(0), v(1), v(2)])).0[k]
+        }
+        JointKind::FreeFlyer => quaternion_rate(3, 3, k - 3),
+    })
 }
 
 /// Rodrigues' formula `R = c E + s [a]× + (1 − c) a aᵀ`, with the numeric
@@ -375,22 +442,68 @@ impl<'g> JointTransform<'g> {
     }
 }
 
-/// Joint `j`'s motion subspace in its own frame: `(0, axis)` for rotation,
-/// `(axis, 0)` for translation.
-pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Motion<'g> {
+/// Joint `j`'s motion subspace in its own frame, one motion per degree of freedom:
+/// `(0, axis)` for rotation, `(axis, 0)` for translation, the three unit angular
+/// motions for a ball joint, the six unit motions (linear first) for a free flyer.
+pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Vec<Motion<'g>> {
+    let joint = &model.joints[j - 1];
+    let unit = |k: usize| {
+        let mut e = [0.0; 3];
+        e[k] = 1.0;
+        V3::constant(g, e)
+    };
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => vec![Motion {
+            v: V3::zero(g),
+            w: V3::constant(g, joint.axis),
+        }],
+        JointKind::Prismatic => vec![Motion {
+            v: V3::constant(g, joint.axis),
+            w: V3::zero(g),
+        }],
+        JointKind::Spherical => (0..3)
+            .map(|k| Motion {
+                v: V3::zero(g),
+                w: unit(k),
+            })
+            .collect(),
+        JointKind::FreeFlyer => (0..6)
+            .map(|k| Motion {
+                v: if k < 3 { unit(k) } else { V3::zero(g) },
+                w: if k < 3 { V3::zero(g) } else { unit(k - 3) },
+            })
+            .collect(),
+    }
+}
+
+/// `S_j x`: joint `j`'s motion for its coordinates `x` (velocities or accelerations).
+pub fn subspace_times<'g>(g: &'g Graph, model: &Model, j: usize, x: &[Expr<'g>]) -> Motion<'g> {
     let joint = &model.joints[j - 1];
     let axis = V3::constant(g, joint.axis);
-    if joint.kind.is_revolute() {
-        Motion {
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => Motion {
             v: V3::zero(g),
-            w: axis,
-        }
-    } else {
-        Motion {
-            v: axis,
+            w: axis.scale(x[0]),
+        },
+        JointKind::Prismatic => Motion {
+            v: axis.scale(x[0]),
             w: V3::zero(g),
-        }
+        },
+        JointKind::Spherical => Motion {
+            v: V3::zero(g),
+            w: V3([x[0], x[1], x[2]]),
+        },
+        JointKind::FreeFlyer => Motion {
+            v: V3([x[0], x[1], x[2]]),
+            w: V3([x[3], x[4], x[5]]),
+        },
     }
+}
+
+/// The velocity coordinates of joint `j`: `v_offset(j)..v_offset(j) + nv`.
+pub fn dofs(model: &Model, j: usize) -> std::ops::Range<usize> {
+    let o = model.v_offset(j);
+    o..o + model.joints[j - 1].kind.nv()
 }
 
 /// Which of `v` and `a` are inputs; the others are zero (and fold away).
@@ -422,16 +535,16 @@ pub struct Kinematics<'g> {
 
 /// The forward Newton–Euler pass.
 pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics<'g> {
-    let qd = |j: usize| {
+    let qd = |d: usize| {
         if inputs == Inputs::Static {
             g.zero()
         } else {
-            g.input(ARG_V, (j - 1) as u32)
+            g.input(ARG_V, d as u32)
         }
     };
-    let qdd = |j: usize| {
+    let qdd = |d: usize| {
         if inputs == Inputs::Full {
-            g.input(ARG_A, (j - 1) as u32)
+            g.input(ARG_A, d as u32)
         } else {
             g.zero()
         }
@@ -439,8 +552,9 @@ pub fn kinematics<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Kinematics
     kinematics_with(g, model, qd, qdd)
 }
 
-/// The forward Newton–Euler pass with joint `j`'s velocity `qd(j)` and acceleration
-/// `qdd(j)` given as expressions (each asked for once per joint, velocity first).
+/// The forward Newton–Euler pass with the velocity `qd(d)` and acceleration `qdd(d)`
+/// of each velocity coordinate `d` given as expressions (asked for joint by joint,
+/// a joint's velocities first).
 pub fn kinematics_with<'g>(
     g: &'g Graph,
     model: &Model,
@@ -461,8 +575,9 @@ pub fn kinematics_with<'g>(
         let p = joint.parent;
         let xj = &x[j - 1];
         let axis = V3::constant(g, joint.axis);
-        let qd = qd(j);
-        let qdd = qdd(j);
+        let qds: Vec<Expr<'g>> = dofs(model, j).map(&qd).collect();
+        let qdds: Vec<Expr<'g>> = dofs(model, j).map(&qdd).collect();
+        let (qd, qdd) = (qds[0], qdds[0]);
         let t = xj.translation;
         let mp = motion[p];
         // Acceleration of the joint-frame origin, still in parent axes.
@@ -470,20 +585,34 @@ pub fn kinematics_with<'g>(
         let w_in = xj.to_child(mp.w);
         let wd_in = xj.to_child(mp.wd);
         let a_in = xj.to_child(a_origin);
-        let m = if joint.kind.is_revolute() {
-            let wq = axis.scale(qd);
-            BodyMotion {
-                w: w_in + wq,
-                wd: wd_in + axis.scale(qdd) + w_in.cross(wq),
-                acc: a_in,
+        let m = match joint.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                let wq = axis.scale(qd);
+                BodyMotion {
+                    w: w_in + wq,
+                    wd: wd_in + axis.scale(qdd) + w_in.cross(wq),
+                    acc: a_in,
+                }
             }
-        } else {
-            let vq = axis.scale(qd);
-            let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
-            BodyMotion {
-                w: w_in,
-                wd: wd_in,
-                acc: a_in + two_w_vq + axis.scale(qdd),
+            JointKind::Prismatic => {
+                let vq = axis.scale(qd);
+                let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
+                BodyMotion {
+                    w: w_in,
+                    wd: wd_in,
+                    acc: a_in + two_w_vq + axis.scale(qdd),
+                }
+            }
+            JointKind::Spherical | JointKind::FreeFlyer => {
+                // The joint's velocity (ω_q, v_q) and acceleration (ω̇_q, a_q) in body
+                // axes: ω̇ = ω̇_in + ω̇_q + ω_in × ω_q, a = a_in + a_q + 2 ω_in × v_q + ω_q × v_q.
+                let (vq, aq) = (subspace_times(g, model, j, &qds), subspace_times(g, model, j, &qdds));
+                let two_w_vq = w_in.cross(vq.v).scale(g.constant(2.0));
+                BodyMotion {
+                    w: w_in + vq.w,
+                    wd: wd_in + aq.w + w_in.cross(vq.w),
+                    acc: a_in + aq.v + two_w_vq + vq.w.cross(vq.v),
+                }
             }
         };
         motion.push(m);
@@ -507,11 +636,11 @@ pub fn rnea<'g>(g: &'g Graph, model: &Model, inputs: Inputs) -> Rnea<'g> {
     rnea_from(g, model, k)
 }
 
-/// [`rnea`] with the joint accelerations given as expressions (`a[j − 1]` for joint
-/// `j`), e.g. the outputs of [`aba`]; `q`, `v` and the parameters are inputs.
+/// [`rnea`] with the accelerations given as expressions (`a[d]` for velocity
+/// coordinate `d`), e.g. the outputs of [`aba`]; `q`, `v` and the parameters are inputs.
 pub fn rnea_with_acceleration<'g>(g: &'g Graph, model: &Model, a: &[Expr<'g>]) -> Rnea<'g> {
-    assert_eq!(a.len(), model.dof(), "one acceleration per joint");
-    let k = kinematics_with(g, model, |j| g.input(ARG_V, (j - 1) as u32), |j| a[j - 1]);
+    assert_eq!(a.len(), model.nv(), "one acceleration per velocity coordinate");
+    let k = kinematics_with(g, model, |d| g.input(ARG_V, d as u32), |d| a[d]);
     rnea_from(g, model, k)
 }
 
@@ -533,7 +662,12 @@ fn rnea_from<'g>(g: &'g Graph, model: &Model, k: Kinematics<'g>) -> Rnea<'g> {
         }
     }
     g.mark("joint torques");
-    let tau = (1..=n).map(|j| f[j - 1].dot(subspace(g, model, j))).collect();
+    let tau = (1..=n)
+        .flat_map(|j| {
+            let fj = f[j - 1];
+            subspace(g, model, j).into_iter().map(move |s| fj.dot(s))
+        })
+        .collect();
     Rnea { tau, wrenches: f }
 }
 
@@ -549,22 +683,25 @@ pub fn torque_regressor<'g>(
     model: &Model,
     columns: impl Fn(usize) -> Vec<BodyParams<'g>>,
 ) -> Vec<Vec<Option<Expr<'g>>>> {
-    let n = model.dof();
+    let (n, nv) = (model.dof(), model.nv());
     let k = kinematics(g, model, Inputs::Full);
-    // s[i][j]: S_j in body i's frame (1-based), where joint j supports body i.
-    let mut s: Vec<Vec<Option<Motion<'g>>>> = vec![vec![None; n + 1]; n + 1];
-    let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![Vec::new(); n];
+    // s[i][d]: the motion of velocity coordinate d in body i's frame (body i 1-based),
+    // where d's joint supports body i.
+    let mut s: Vec<Vec<Option<Motion<'g>>>> = vec![vec![None; nv]; n + 1];
+    let mut y: Vec<Vec<Option<Expr<'g>>>> = vec![Vec::new(); nv];
     for i in 1..=n {
         mark_body(g, model, i, "regressor columns");
         let p = model.parent(i);
-        for j in 1..i {
-            s[i][j] = s[p][j].map(|sj| k.x[i - 1].motion_to_child(sj));
+        for d in 0..model.v_offset(i) {
+            s[i][d] = s[p][d].map(|sd| k.x[i - 1].motion_to_child(sd));
         }
-        s[i][i] = Some(subspace(g, model, i));
+        for (d, sd) in dofs(model, i).zip(subspace(g, model, i)) {
+            s[i][d] = Some(sd);
+        }
         let wrenches: Vec<Force<'g>> = columns(i).iter().map(|b| b.wrench(&k.motion[i])).collect();
-        for (j, row) in y.iter_mut().enumerate() {
+        for (d, row) in y.iter_mut().enumerate() {
             for w in &wrenches {
-                row.push(s[i][j + 1].map(|sj| w.dot(sj)));
+                row.push(s[i][d].map(|sd| w.dot(sd)));
             }
         }
     }
@@ -616,7 +753,7 @@ pub fn wrench_regressor<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Option<Expr<
     y
 }
 
-/// Composite rigid-body algorithm: the joint-space inertia matrix `M(q)` (n × n,
+/// Composite rigid-body algorithm: the joint-space inertia matrix `M(q)` (nv × nv,
 /// symmetric; entries for joints on different branches are exact zeros).
 pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
     let n = model.dof();
@@ -636,24 +773,35 @@ pub fn crba<'g>(g: &'g Graph, model: &Model) -> Vec<Vec<Expr<'g>>> {
             };
         }
     }
-    let mut m = vec![vec![g.zero(); n]; n];
+    let nv = model.nv();
+    let mut m = vec![vec![g.zero(); nv]; nv];
     for i in 1..=n {
         mark_body(g, model, i, "row and column of M");
         let si = subspace(g, model, i);
         let c = &composite[i - 1];
-        // F = I_c S_i: the momentum of the composite body moving along S_i.
-        let mut f = Force {
-            f: si.v.scale(c.m) + si.w.cross(c.h),
-            n: c.inertia.mul_vec(si.w) + c.h.cross(si.v),
-        };
-        m[i - 1][i - 1] = f.dot(si);
-        let mut j = i;
-        while model.parent(j) != 0 {
-            f = x[j - 1].force_to_parent(f);
-            j = model.parent(j);
-            let e = f.dot(subspace(g, model, j));
-            m[i - 1][j - 1] = e;
-            m[j - 1][i - 1] = e;
+        for (a, sa) in dofs(model, i).zip(&si) {
+            // F = I_c S_a: the momentum of the composite body moving along S_a.
+            let mut f = Force {
+                f: sa.v.scale(c.m) + sa.w.cross(c.h),
+                n: c.inertia.mul_vec(sa.w) + c.h.cross(sa.v),
+            };
+            for (b, sb) in dofs(model, i).zip(&si) {
+                if b <= a {
+                    let e = f.dot(*sb);
+                    m[a][b] = e;
+                    m[b][a] = e;
+                }
+            }
+            let mut j = i;
+            while model.parent(j) != 0 {
+                f = x[j - 1].force_to_parent(f);
+                j = model.parent(j);
+                for (b, sb) in dofs(model, j).zip(subspace(g, model, j)) {
+                    let e = f.dot(sb);
+                    m[a][b] = e;
+                    m[b][a] = e;
+                }
+            }
         }
     }
     m
@@ -731,6 +879,30 @@ impl<'g> Inertia6<'g> {
         }
     }
 
+    /// `self − Σ_a U_a W_aᵀ` for `W = U D⁻¹` with `D` symmetric (so the result is).
+    fn minus_products(&self, u: &[Force<'g>], w: &[Force<'g>]) -> Inertia6<'g> {
+        let mut out = *self;
+        for (ua, wa) in u.iter().zip(w) {
+            out.m = out.m.sub(&M3::outer(ua.f, wa.f));
+            out.h = out.h.sub(&M3::outer(ua.f, wa.n));
+            out.j = out.j.sub(&M3::outer(ua.n, wa.n));
+        }
+        let sym = |m: M3<'g>| {
+            let mut a = m.0;
+            for r in 0..3 {
+                for c in 0..r {
+                    a[r][c] = a[c][r];
+                }
+            }
+            M3(a)
+        };
+        Inertia6 {
+            m: sym(out.m),
+            h: out.h,
+            j: sym(out.j),
+        }
+    }
+
     /// The same inertia seen from the parent frame: rotate every block, then shift
     /// the reference point: `H' = H − M S(p)`, `J' = J − Hᵀ S(p) + S(p) H − S(p) M S(p)`.
     fn in_parent(&self, x: &JointTransform<'g>) -> Inertia6<'g> {
@@ -769,13 +941,49 @@ pub enum Armature {
     Input,
 }
 
+/// The inverse of a small symmetric positive definite matrix (a joint's `D = Sᵀ Iᴬ S`),
+/// by `LDLᵀ`: one division per row. A 1 × 1 matrix is one division.
+pub fn spd_inverse<'g>(g: &'g Graph, a: &[Vec<Expr<'g>>]) -> Vec<Vec<Expr<'g>>> {
+    let k = a.len();
+    let mut l = vec![vec![g.zero(); k]; k];
+    let mut d = vec![g.zero(); k];
+    let mut inv_d = vec![g.zero(); k];
+    for j in 0..k {
+        d[j] = (0..j).fold(a[j][j], |acc, m| acc - l[j][m] * l[j][m] * d[m]);
+        inv_d[j] = g.one() / d[j];
+        for i in j + 1..k {
+            let e = (0..j).fold(a[i][j], |acc, m| acc - l[i][m] * l[j][m] * d[m]);
+            l[i][j] = e * inv_d[j];
+        }
+    }
+    // L⁻¹ (unit lower triangular), then A⁻¹ = L⁻ᵀ D⁻¹ L⁻¹.
+    let mut li = vec![vec![g.zero(); k]; k];
+    for c in 0..k {
+        li[c][c] = g.one();
+        for r in c + 1..k {
+            li[r][c] = -(c..r).fold(g.zero(), |acc, m| acc + l[r][m] * li[m][c]);
+        }
+    }
+    let mut inv = vec![vec![g.zero(); k]; k];
+    for r in 0..k {
+        for c in 0..=r {
+            let e = (r..k).fold(g.zero(), |acc, m| acc + li[m][r] * inv_d[m] * li[m][c]);
+            inv[r][c] = e;
+            inv[c][r] = e;
+        }
+    }
+    inv
+}
+
 /// Featherstone's articulated-body algorithm: `a = M(q)⁻¹ (tau − h(q, v))`, with
-/// `tau` read from the `a` argument slot. One division per joint.
+/// `tau` read from the `a` argument slot. One division per degree of freedom: a
+/// joint with an axis divides by `D = Sᵀ Iᴬ S`; a ball joint or a free flyer inverts
+/// its 3 × 3 or 6 × 6 `D` ([`spd_inverse`]).
 pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>> {
     let n = model.dof();
     g.mark("joint transforms");
     let x: Vec<JointTransform<'g>> = (1..=n).map(|j| JointTransform::new(g, model, j)).collect();
-    let s: Vec<Motion<'g>> = (1..=n).map(|j| subspace(g, model, j)).collect();
+    let s: Vec<Vec<Motion<'g>>> = (1..=n).map(|j| subspace(g, model, j)).collect();
     // Pass 1: velocities, velocity-product accelerations, bias forces.
     let mut v = vec![Motion::zero(g)];
     let mut c = vec![Motion::zero(g)];
@@ -788,7 +996,12 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
     for i in 1..=n {
         mark_body(g, model, i, "velocity and bias force");
         let p = model.parent(i);
-        let vj = s[i - 1].scale(g.input(ARG_V, (i - 1) as u32));
+        let vj = if s[i - 1].len() == 1 {
+            s[i - 1][0].scale(g.input(ARG_V, model.v_offset(i) as u32))
+        } else {
+            let qd: Vec<Expr<'g>> = dofs(model, i).map(|d| g.input(ARG_V, d as u32)).collect();
+            subspace_times(g, model, i, &qd)
+        };
         let vi = x[i - 1].motion_to_child(v[p]) + vj;
         let inertia = Inertia6::rigid(g, &BodyParams::input(g, i));
         pa.push(vi.cross_force(inertia.apply(vi)));
@@ -796,29 +1009,67 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
         v.push(vi);
         ia.push(inertia);
     }
-    // Pass 2: articulated inertias and bias forces, leaves first.
-    let mut u_vec = vec![Force::zero(g); n + 1];
-    let mut inv_d = vec![g.zero(); n + 1];
-    let mut u = vec![g.zero(); n + 1];
+    // Pass 2: articulated inertias and bias forces, leaves first. Per joint:
+    // U = Iᴬ S, D⁻¹, u = tau − Sᵀ pᴬ.
+    let mut u_vec = vec![Vec::new(); n + 1];
+    let mut inv_d = vec![Vec::new(); n + 1];
+    let mut u = vec![Vec::new(); n + 1];
     for i in (1..=n).rev() {
         mark_body(g, model, i, "articulated inertia");
-        let ui = ia[i].apply(s[i - 1]);
-        let d = match armature {
-            Armature::None => ui.dot(s[i - 1]),
-            Armature::Input => ui.dot(s[i - 1]) + g.input(ARG_JOINT_PARAMS, (4 * (i - 1)) as u32),
+        let ui: Vec<Force<'g>> = s[i - 1].iter().map(|sk| ia[i].apply(*sk)).collect();
+        let rotor = |d: usize| g.input(ARG_JOINT_PARAMS, (4 * d) as u32);
+        let id: Vec<Vec<Expr<'g>>> = if ui.len() == 1 {
+            let d = match armature {
+                Armature::None => ui[0].dot(s[i - 1][0]),
+                Armature::Input => ui[0].dot(s[i - 1][0]) + rotor(model.v_offset(i)),
+            };
+            vec![vec![g.one() / d]]
+        } else {
+            let d: Vec<Vec<Expr<'g>>> = dofs(model, i)
+                .zip(&ui)
+                .map(|(a, ua)| {
+                    dofs(model, i)
+                        .zip(&s[i - 1])
+                        .map(|(b, sb)| match armature {
+                            Armature::Input if a == b => ua.dot(*sb) + rotor(a),
+                            _ => ua.dot(*sb),
+                        })
+                        .collect()
+                })
+                .collect();
+            spd_inverse(g, &d)
         };
-        let id = g.one() / d;
-        let tau = g.input(ARG_TAU, (i - 1) as u32);
-        let ui_scalar = tau - pa[i].dot(s[i - 1]);
+        let ui_scalar: Vec<Expr<'g>> = dofs(model, i)
+            .zip(&s[i - 1])
+            .map(|(d, sk)| g.input(ARG_TAU, d as u32) - pa[i].dot(*sk))
+            .collect();
         let p = model.parent(i);
         if p > 0 {
-            let a_ia = ia[i].minus_outer(&ui, id);
-            let a_pa = pa[i]
-                + a_ia.apply(c[i])
-                + Force {
-                    f: ui.f.scale(ui_scalar * id),
-                    n: ui.n.scale(ui_scalar * id),
-                };
+            let (a_ia, gain) = if ui.len() == 1 {
+                (ia[i].minus_outer(&ui[0], id[0][0]), vec![ui_scalar[0] * id[0][0]])
+            } else {
+                // W = U D⁻¹: Iᴬ − U D⁻¹ Uᵀ = Iᴬ − Σ_a U_a W_aᵀ, and D⁻¹ u.
+                let w: Vec<Force<'g>> = (0..ui.len())
+                    .map(|a| {
+                        (0..ui.len()).fold(Force::zero(g), |acc, b| {
+                            acc + Force {
+                                f: ui[b].f.scale(id[a][b]),
+                                n: ui[b].n.scale(id[a][b]),
+                            }
+                        })
+                    })
+                    .collect();
+                let gain = (0..ui.len())
+                    .map(|a| (0..ui.len()).fold(g.zero(), |acc, b| acc + id[a][b] * ui_scalar[b]))
+                    .collect();
+                (ia[i].minus_products(&ui, &w), gain)
+            };
+            let a_pa = ui.iter().zip(&gain).fold(pa[i] + a_ia.apply(c[i]), |acc, (uk, gk)| {
+                acc + Force {
+                    f: uk.f.scale(*gk),
+                    n: uk.n.scale(*gk),
+                }
+            });
             ia[p] = ia[p].add(&a_ia.in_parent(&x[i - 1]));
             pa[p] = pa[p] + x[i - 1].force_to_parent(a_pa);
         }
@@ -831,14 +1082,23 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
         v: V3::constant(g, model.gravity.map(|x| -x)),
         w: V3::zero(g),
     }];
-    let mut qdd = Vec::with_capacity(n);
+    let mut qdd = Vec::with_capacity(model.nv());
     for i in 1..=n {
         mark_body(g, model, i, "acceleration");
         let p = model.parent(i);
         let a_prime = x[i - 1].motion_to_child(acc[p]) + c[i];
-        let qi = (u[i] - u_vec[i].dot(a_prime)) * inv_d[i];
-        acc.push(a_prime + s[i - 1].scale(qi));
-        qdd.push(qi);
+        if s[i - 1].len() == 1 {
+            let qi = (u[i][0] - u_vec[i][0].dot(a_prime)) * inv_d[i][0][0];
+            acc.push(a_prime + s[i - 1][0].scale(qi));
+            qdd.push(qi);
+        } else {
+            let r: Vec<Expr<'g>> = (0..u[i].len()).map(|k| u[i][k] - u_vec[i][k].dot(a_prime)).collect();
+            let qi: Vec<Expr<'g>> = (0..r.len())
+                .map(|a| (0..r.len()).fold(g.zero(), |acc, b| acc + inv_d[i][a][b] * r[b]))
+                .collect();
+            acc.push(a_prime + subspace_times(g, model, i, &qi));
+            qdd.extend(qi);
+        }
     }
     qdd
 }

@@ -191,7 +191,7 @@ fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<
     let (dq, dv) = match how {
         Ddq::Aba => spatial_partials(g, model, &qd, &ddq),
         Ddq::InverseInertia => {
-            let k = algo::kinematics_with(g, model, |j| qd[j - 1], |j| ddq[j - 1]);
+            let k = algo::kinematics_with(g, model, |d| qd[d], |d| ddq[d]);
             let r = algo::rnea_with_acceleration(g, model, &ddq);
             rnea_partials(g, model, &qd, &k, &r.wrenches)
         }
@@ -202,6 +202,15 @@ fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<
         dtau_dv: dv,
         minv,
     }
+}
+
+/// Joint `j`'s motion subspace, one column: the derivatives are built for models
+/// whose joints all have one degree of freedom ([`Model::multi_dof_joint`] is
+/// `None`; the generator does not emit them otherwise).
+fn one_dof<'g>(g: &'g Graph, model: &Model, j: usize) -> Motion<'g> {
+    let s = algo::subspace(g, model, j);
+    assert_eq!(s.len(), 1, "derivatives need joints with one degree of freedom");
+    s[0]
 }
 
 fn dot<'g>(a: &[Expr<'g>], b: &[Expr<'g>]) -> Expr<'g> {
@@ -327,7 +336,7 @@ fn spatial_partials<'g>(
     }];
     let mut f: Vec<Force<'g>> = Vec::with_capacity(n);
     for i in 1..=n {
-        let s = algo::subspace(g, model, i);
+        let s = one_dof(g, model, i);
         let bias = v[i].cross_motion(s.scale(qd[i - 1]));
         let ai = x[i - 1].motion_to_child(a[model.parent(i)]) + bias + s.scale(qdd[i - 1]);
         let body = BodyParams::input(g, i);
@@ -349,7 +358,7 @@ fn velocities<'g>(g: &'g Graph, model: &Model, x: &[JointTransform<'g>], qd: &[E
     let n = model.dof();
     let mut v = vec![Motion::zero(g); n + 1];
     for i in 1..=n {
-        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + algo::subspace(g, model, i).scale(qd[i - 1]);
+        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + one_dof(g, model, i).scale(qd[i - 1]);
     }
     v
 }
@@ -365,7 +374,7 @@ fn partials<'g>(
     wrenches: &[Force<'g>],
 ) -> (Vec<Vec<Expr<'g>>>, Vec<Vec<Expr<'g>>>) {
     let n = model.dof();
-    let s: Vec<Motion<'g>> = (1..=n).map(|j| algo::subspace(g, model, j)).collect();
+    let s: Vec<Motion<'g>> = (1..=n).map(|j| one_dof(g, model, j)).collect();
     g.mark("derivatives: composite inertias, inertia rates and momenta");
     let own: Vec<BodyParams<'g>> = (1..=n).map(|j| BodyParams::input(g, j)).collect();
     let ic = composites(model, x, own.clone());
@@ -697,7 +706,7 @@ mod tests {
             let fq: Vec<Vec<Expr>> = (0..n).map(|c| column(ARG_Q, c)).collect();
             let fv: Vec<Vec<Expr>> = (0..n).map(|c| column(ARG_V, c)).collect();
             let qd: Vec<Expr> = (0..n).map(|i| g.input(ARG_V, i as u32)).collect();
-            let k = algo::kinematics_with(&g, &model, |j| qd[j - 1], |j| ddq[j - 1]);
+            let k = algo::kinematics_with(&g, &model, |d| qd[d], |d| ddq[d]);
             let r = algo::rnea_with_acceleration(&g, &model, &ddq);
             let (aq, av) = rnea_partials(&g, &model, &qd, &k, &r.wrenches);
             let transpose = |m: &[Vec<Expr>]| -> Vec<NodeId> {

@@ -15,7 +15,7 @@ use crate::algo::{BodyParams, JointTransform, ARG_A, ARG_PARAMS, ARG_Q, ARG_V, M
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
 use crate::generate::{doc_attrs, Record, Sizes};
 use crate::sym::{Expr, Graph, NodeId};
-use dyngen_model::Model;
+use dyngen_model::{JointKind, Model};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
@@ -32,12 +32,27 @@ struct WorldBody<'g> {
     acc: V3<'g>,
 }
 
-/// Joint `k`'s axis `z` and origin `o` in the world (the origin is body `k`'s).
+/// One degree of freedom of a joint in world axes: a rotation about the axis `z`
+/// through the joint's origin, or a translation along `z`.
+#[derive(Clone, Copy)]
+enum WorldDof<'g> {
+    Rotation(V3<'g>),
+    Translation(V3<'g>),
+}
+
+/// Joint `k`'s degrees of freedom (the first `nv` of `dofs`) and origin `o` in the
+/// world (the origin is body `k`'s).
 #[derive(Clone, Copy)]
 struct WorldJoint<'g> {
-    z: V3<'g>,
+    dofs: [WorldDof<'g>; 6],
+    nv: usize,
     o: V3<'g>,
-    revolute: bool,
+}
+
+impl<'g> WorldJoint<'g> {
+    fn dofs(&self) -> &[WorldDof<'g>] {
+        &self.dofs[..self.nv]
+    }
 }
 
 /// What a walk from the base computes.
@@ -93,13 +108,36 @@ fn walk<'g>(
         let x = JointTransform::new(g, model, k);
         let joint = &model.joints[k - 1];
         let r0 = p.r.mul(&x.origin);
-        let z = r0.mul_vec(V3::constant(g, joint.axis));
         let d = p.r.mul_vec(x.translation);
         let t = p.t + d;
-        let revolute = joint.kind.is_revolute();
-        joints[k] = Some(WorldJoint { z, o: t, revolute });
+        let r = r0.mul(&x.motion);
+        let column = |c: usize| V3([r.0[0][c], r.0[1][c], r.0[2][c]]);
+        let mut dofs = [WorldDof::Translation(zero); 6];
+        match joint.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                dofs[0] = WorldDof::Rotation(r0.mul_vec(V3::constant(g, joint.axis)));
+            }
+            JointKind::Prismatic => dofs[0] = WorldDof::Translation(r0.mul_vec(V3::constant(g, joint.axis))),
+            JointKind::Spherical => {
+                for c in 0..3 {
+                    dofs[c] = WorldDof::Rotation(column(c));
+                }
+            }
+            JointKind::FreeFlyer => {
+                for c in 0..3 {
+                    dofs[c] = WorldDof::Translation(column(c));
+                    dofs[3 + c] = WorldDof::Rotation(column(c));
+                }
+            }
+        }
+        let wj = WorldJoint {
+            dofs,
+            nv: joint.kind.nv(),
+            o: t,
+        };
+        joints[k] = Some(wj);
         let mut b = WorldBody {
-            r: r0.mul(&x.motion),
+            r,
             t,
             w: zero,
             v: zero,
@@ -107,22 +145,51 @@ fn walk<'g>(
             acc: zero,
         };
         if what == Walk::Motion {
-            let qd = g.input(ARG_V, (k - 1) as u32);
-            let qdd = g.input(ARG_A, (k - 1) as u32);
-            let zqd = z.scale(qd);
             // The parent's velocity and acceleration carried to the joint origin.
             let v = p.v + p.w.cross(d);
             let acc = p.acc + p.wd.cross(d) + p.w.cross(p.w.cross(d));
-            if revolute {
-                b.w = p.w + zqd;
-                b.wd = p.wd + z.scale(qdd) + p.w.cross(zqd);
-                b.v = v;
-                b.acc = acc;
-            } else {
-                b.w = p.w;
-                b.wd = p.wd;
-                b.v = v + zqd;
-                b.acc = acc + z.scale(qdd) + p.w.cross(zqd).scale(g.constant(2.0));
+            let rates: Vec<(WorldDof<'g>, Expr<'g>, Expr<'g>)> = wj
+                .dofs()
+                .iter()
+                .zip(crate::algo::dofs(model, k))
+                .map(|(dof, i)| (*dof, g.input(ARG_V, i as u32), g.input(ARG_A, i as u32)))
+                .collect();
+            match rates.as_slice() {
+                [(WorldDof::Rotation(z), qd, qdd)] => {
+                    let zqd = z.scale(*qd);
+                    b.w = p.w + zqd;
+                    b.wd = p.wd + z.scale(*qdd) + p.w.cross(zqd);
+                    b.v = v;
+                    b.acc = acc;
+                }
+                [(WorldDof::Translation(z), qd, qdd)] => {
+                    let zqd = z.scale(*qd);
+                    b.w = p.w;
+                    b.wd = p.wd;
+                    b.v = v + zqd;
+                    b.acc = acc + z.scale(*qdd) + p.w.cross(zqd).scale(g.constant(2.0));
+                }
+                _ => {
+                    // ω = ω_p + ω_q, ω̇ = ω̇_p + ω̇_q + ω_p × ω_q, v = v_p + v_q,
+                    // a = a_p + a_q + 2 ω_p × v_q + ω_q × v_q (world axes, at the origin).
+                    let (mut wq, mut wdq, mut vq, mut aq) = (zero, zero, zero, zero);
+                    for (dof, qd, qdd) in &rates {
+                        match dof {
+                            WorldDof::Rotation(z) => {
+                                wq = wq + z.scale(*qd);
+                                wdq = wdq + z.scale(*qdd);
+                            }
+                            WorldDof::Translation(z) => {
+                                vq = vq + z.scale(*qd);
+                                aq = aq + z.scale(*qdd);
+                            }
+                        }
+                    }
+                    b.w = p.w + wq;
+                    b.wd = p.wd + wdq + p.w.cross(wq);
+                    b.v = v + vq;
+                    b.acc = acc + aq + p.w.cross(vq).scale(g.constant(2.0)) + wq.cross(vq);
+                }
             }
         }
         world[k] = Some(b);
@@ -168,21 +235,21 @@ pub fn build_placements(g: &Graph, model: &Model) -> Vec<NodeId> {
 
 /// Frame `f`'s placement (12) and `LOCAL_WORLD_ALIGNED` Jacobian (6 × n, row-major).
 pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
-    let n = model.dof();
     let b = model.frames[f].body;
     let on_path = path(model, b);
     let (world, joints) = walk(g, model, &on_path, Walk::Placement);
     let (r, p, _) = frame_pose(g, model, f, &walked(&world, b));
-    let mut jac = vec![vec![g.zero(); n]; 6];
+    let mut jac = vec![vec![g.zero(); model.nv()]; 6];
     for &k in &on_path {
         let j = walked(&joints, k);
-        let (lin, ang) = if j.revolute {
-            (j.z.cross(p - j.o), j.z)
-        } else {
-            (j.z, V3::zero(g))
-        };
-        for (row, e) in lin.0.iter().chain(ang.0.iter()).enumerate() {
-            jac[row][k - 1] = *e;
+        for (dof, c) in j.dofs().iter().zip(crate::algo::dofs(model, k)) {
+            let (lin, ang) = match dof {
+                WorldDof::Rotation(z) => (z.cross(p - j.o), *z),
+                WorldDof::Translation(z) => (*z, V3::zero(g)),
+            };
+            for (row, e) in lin.0.iter().chain(ang.0.iter()).enumerate() {
+                jac[row][c] = *e;
+            }
         }
     }
     let mut out = pose_ids(&r, &p);
@@ -195,7 +262,7 @@ pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
 pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let mut out = build_jacobian(g, model, f);
     let dot = g.tangents(&out[12..], |id| match g.node(id) {
-        crate::sym::Node::Input { arg, index } if arg == ARG_Q => Some(g.input(ARG_V, index)),
+        crate::sym::Node::Input { arg, index } if arg == ARG_Q => crate::algo::q_dot(g, model, index as usize),
         _ => None,
     });
     out.extend(dot.iter().map(|x| x.id()));
@@ -258,17 +325,18 @@ pub fn build_com_jacobian(g: &Graph, model: &Model) -> Vec<NodeId> {
         .filter(|&i| model.parent(i) == 0)
         .fold(g.zero(), |m, i| m + sub[i - 1].0);
     let inv = g.one() / total;
-    let mut jac = vec![vec![g.zero(); n]; 3];
+    let mut jac = vec![vec![g.zero(); model.nv()]; 3];
     for k in 1..=n {
         let j = walked(&joints, k);
         let (mk, hk) = sub[k - 1];
-        let col = if j.revolute {
-            j.z.cross(hk - j.o.scale(mk)).scale(inv)
-        } else {
-            j.z.scale(mk * inv)
-        };
-        for r in 0..3 {
-            jac[r][k - 1] = col.0[r];
+        for (dof, c) in j.dofs().iter().zip(crate::algo::dofs(model, k)) {
+            let col = match dof {
+                WorldDof::Rotation(z) => z.cross(hk - j.o.scale(mk)).scale(inv),
+                WorldDof::Translation(z) => z.scale(mk * inv),
+            };
+            for r in 0..3 {
+                jac[r][c] = col.0[r];
+            }
         }
     }
     jac.iter().flatten().map(|x| x.id()).collect()
@@ -295,19 +363,23 @@ pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
             (m + c.m, h + b.t.scale(c.m) + b.r.mul_vec(c.h))
         });
     let com = first.scale(g.one() / total);
-    let mut a = vec![vec![g.zero(); n]; 6];
+    let mut a = vec![vec![g.zero(); model.nv()]; 6];
     for k in 1..=n {
         let c = &composite[k - 1];
         let b = walked(&world, k);
-        let s = crate::algo::subspace(g, model, k);
-        // (f, n) = I_k S_k, as crba builds it.
-        let f = s.v.scale(c.m) + s.w.cross(c.h);
-        let m = c.inertia.mul_vec(s.w) + c.h.cross(s.v);
-        let (fw, mw) = (b.r.mul_vec(f), b.r.mul_vec(m));
-        let l = mw + (b.t - com).cross(fw);
-        for r in 0..3 {
-            a[r][k - 1] = fw.0[r];
-            a[3 + r][k - 1] = l.0[r];
+        for (s, col) in crate::algo::subspace(g, model, k)
+            .into_iter()
+            .zip(crate::algo::dofs(model, k))
+        {
+            // (f, n) = I_k S_k, as crba builds it.
+            let f = s.v.scale(c.m) + s.w.cross(c.h);
+            let m = c.inertia.mul_vec(s.w) + c.h.cross(s.v);
+            let (fw, mw) = (b.r.mul_vec(f), b.r.mul_vec(m));
+            let l = mw + (b.t - com).cross(fw);
+            for r in 0..3 {
+                a[r][col] = fw.0[r];
+                a[3 + r][col] = l.0[r];
+            }
         }
     }
     a.iter().flatten().map(|x| x.id()).collect()
@@ -320,7 +392,7 @@ pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
 pub fn build_centroidal_map_time_variation(g: &Graph, model: &Model) -> Vec<NodeId> {
     let a_g = build_centroidal_map(g, model);
     let dot = g.tangents(&a_g, |id| match g.node(id) {
-        crate::sym::Node::Input { arg, index } if arg == ARG_Q => Some(g.input(ARG_V, index)),
+        crate::sym::Node::Input { arg, index } if arg == ARG_Q => crate::algo::q_dot(g, model, index as usize),
         _ => None,
     });
     a_g.into_iter().chain(dot.iter().map(|x| x.id())).collect()
@@ -380,9 +452,10 @@ fn arg(id: u8, name: &'static str, len: usize) -> Arg {
 
 /// The frame enum and every frame function of the robot type `ty`.
 pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statements: usize) -> FrameFns {
-    let n = sizes.n;
+    // Columns, velocities and accelerations go by velocity coordinate.
+    let n = sizes.nv;
     let nf = model.frames.len();
-    let [n_l, nf_l] = [n, nf].map(emit::usize_lit);
+    let [n_l, nq_l, nf_l] = [n, sizes.nq, nf].map(emit::usize_lit);
     let fty = frame_type(ty);
     let variants = variant_names(model);
     let mut items = Vec::new();
@@ -394,7 +467,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         reports.push(report);
         tokens
     };
-    let q = || arg(ARG_Q, "q", n);
+    let q = || arg(ARG_Q, "q", sizes.nq);
     let pose_ret = Record::Pose.ty();
     let assemble_pose = |outs: &[TokenStream]| Record::Pose.build(outs);
 
@@ -532,7 +605,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     };
     let placements = emit_one(spec, &g, "frame_placements".to_string());
 
-    let params = || arg(ARG_PARAMS, "params", 10 * n);
+    let params = || arg(ARG_PARAMS, "params", 10 * sizes.n);
     let g = Graph::new();
     let outputs = build_com(&g, model);
     let spec = FnSpec {
@@ -632,13 +705,13 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             pub const NFRAMES: usize = #nf_l;
             #dispatch_doc
             #[inline]
-            pub fn frame_placement<S: ::dyngen::Scalar>(q: &[S; #n_l], frame: #fty) -> ::dyngen::Pose<S> {
+            pub fn frame_placement<S: ::dyngen::Scalar>(q: &[S; #nq_l], frame: #fty) -> ::dyngen::Pose<S> {
                 match frame { #(#placement_fns,)* }
             }
             #jacobian_doc
             #[inline]
             pub fn frame_jacobian<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame, out: &mut ::dyngen::FrameJacobian<S, #n_l>,
+                q: &[S; #nq_l], frame: #fty, reference: ::dyngen::ReferenceFrame, out: &mut ::dyngen::FrameJacobian<S, #n_l>,
             ) {
                 match frame { #(#jacobian_fns,)* }
                 ::dyngen::__private::express_jacobian(out, reference);
@@ -646,7 +719,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             #jacobian_dot_doc
             #[inline]
             pub fn frame_jacobian_time_variation<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+                q: &[S; #nq_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
                 out: &mut ::dyngen::FrameJacobianTimeVariation<S, #n_l>,
             ) {
                 match frame { #(#jacobian_dot_fns,)* }
@@ -654,20 +727,20 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             }
             #motion_doc
             #[inline]
-            pub fn frame_motion<S: ::dyngen::Scalar>(q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty) -> ::dyngen::FrameMotion<S> {
+            pub fn frame_motion<S: ::dyngen::Scalar>(q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty) -> ::dyngen::FrameMotion<S> {
                 match frame { #(#motion_fns,)* }
             }
             #velocity_doc
             #[inline]
             pub fn frame_velocity<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+                q: &[S; #nq_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
             ) -> ::dyngen::Motion<S> {
                 Self::frame_motion(q, v, #zero_a, frame).velocity_in(reference)
             }
             #acc_doc
             #[inline]
             pub fn frame_classical_acceleration<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
+                q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
             ) -> ::dyngen::Motion<S> {
                 Self::frame_motion(q, v, a, frame).classical_acceleration_in(reference)
             }

@@ -131,8 +131,12 @@ fn base_params_ids(g: &Graph, bp: &BaseParams, joints: Option<usize>) -> Vec<Nod
 
 /// The sizes a generated robot's signatures and docs are written with.
 pub(crate) struct Sizes {
-    /// Joints = moving bodies = degrees of freedom.
+    /// Joints = moving bodies.
     pub(crate) n: usize,
+    /// Position and velocity coordinates (equal to `n` when every joint has one
+    /// degree of freedom).
+    pub(crate) nq: usize,
+    pub(crate) nv: usize,
     /// Base parameters of the standard and the principal parameterisation, and of
     /// the standard and joint parameters together.
     pub(crate) nb: usize,
@@ -143,22 +147,31 @@ pub(crate) struct Sizes {
 impl Sizes {
     fn of(&self, len: Len) -> usize {
         match len {
-            Len::Dof => self.n,
+            Len::Q => self.nq,
+            Len::V => self.nv,
             Len::Params => 10 * self.n,
             Len::Theta => 4 * self.n,
             Len::Base => self.nb,
             Len::PrincipalBase => self.nbt,
             Len::WrenchRows => 6 * self.n,
-            Len::JointParams => 4 * self.n,
+            Len::JointParams => 4 * self.nv,
             Len::BaseJoints => self.nbj,
         }
     }
 
     pub(crate) fn state(&self) -> String {
-        format!(
-            "`q, v, a`: {} joint positions (rad or m), velocities, accelerations",
-            self.n
-        )
+        if self.nq == self.nv {
+            format!(
+                "`q, v, a`: {} joint positions (rad or m), velocities, accelerations",
+                self.n
+            )
+        } else {
+            format!(
+                "`q`: {} positions (a unit quaternion `[x, y, z, w]` per ball joint and free flyer);
+`v, a`: {} velocities and accelerations",
+                self.nq, self.nv
+            )
+        }
     }
 
     pub(crate) fn params(&self) -> String {
@@ -170,8 +183,8 @@ impl Sizes {
 
     pub(crate) fn joint_params(&self) -> String {
         format!(
-            "`joint_params`: {} joint parameters `[Ia, Fv, Fc, F0]`, 4 per joint (`Self::NOMINAL_JOINT_PARAMS` for the description's)",
-            4 * self.n
+            "`joint_params`: {} joint parameters `[Ia, Fv, Fc, F0]`, 4 per velocity coordinate (`Self::NOMINAL_JOINT_PARAMS` for the description's)",
+            4 * self.nv
         )
     }
 }
@@ -179,7 +192,10 @@ impl Sizes {
 /// A length in a generated signature, in terms of the robot's sizes.
 #[derive(Clone, Copy)]
 enum Len {
-    Dof,
+    /// `nq` positions.
+    Q,
+    /// `nv` velocities (rows of the dynamics).
+    V,
     Params,
     Theta,
     Base,
@@ -207,10 +223,10 @@ enum In {
 impl In {
     fn arg(self, sizes: &Sizes) -> Arg {
         let (id, name, len) = match self {
-            In::Q => (ARG_Q, "q", Len::Dof),
-            In::V => (ARG_V, "v", Len::Dof),
-            In::A => (ARG_A, "a", Len::Dof),
-            In::Tau => (ARG_TAU, "tau", Len::Dof),
+            In::Q => (ARG_Q, "q", Len::Q),
+            In::V => (ARG_V, "v", Len::V),
+            In::A => (ARG_A, "a", Len::V),
+            In::Tau => (ARG_TAU, "tau", Len::V),
             In::Params => (ARG_PARAMS, "params", Len::Params),
             In::Theta => (ARG_PARAMS, "theta", Len::Theta),
             In::JointParams => (ARG_JOINT_PARAMS, "joint_params", Len::JointParams),
@@ -313,13 +329,13 @@ const ALGORITHMS: &[Algorithm] = &[
         name: "rnea",
         args: QVAP,
         out: "tau",
-        shape: Shape::Vector(Len::Dof),
+        shape: Shape::Vector(Len::V),
         doc: |s| {
             format!(
                 "Inverse dynamics, `tau = M(q) a + C(q, v) v + g(q)`, by the unrolled Newton–Euler\nrecursion. {};\n{}. Returns the {} joint torques (N·m) or forces (N).",
                 s.state(),
                 s.params(),
-                s.n
+                s.nv
             )
         },
         build: |g, model, _| algo::rnea(g, model, Inputs::Full).tau.iter().map(|x| x.id()).collect(),
@@ -328,7 +344,7 @@ const ALGORITHMS: &[Algorithm] = &[
         name: "nonlinear_effects",
         args: &[In::Q, In::V, In::Params],
         out: "tau",
-        shape: Shape::Vector(Len::Dof),
+        shape: Shape::Vector(Len::V),
         doc: |s| {
             format!(
                 "Coriolis, centrifugal and gravity terms `h(q, v) = C(q, v) v + g(q)`, equal to\n`rnea(q, v, 0)`. {}.",
@@ -347,7 +363,7 @@ const ALGORITHMS: &[Algorithm] = &[
         name: "generalized_gravity",
         args: &[In::Q, In::Params],
         out: "tau",
-        shape: Shape::Vector(Len::Dof),
+        shape: Shape::Vector(Len::V),
         doc: |s| format!("Gravity torques `g(q)`, equal to `rnea(q, 0, 0)`. {}.", s.params()),
         build: |g, model, _| {
             algo::rnea(g, model, Inputs::Static)
@@ -365,7 +381,7 @@ const ALGORITHMS: &[Algorithm] = &[
         doc: |s| {
             format!(
                 "Every body's pose in the base frame, body 1 first: `x_base = rotation · x_body +\ntranslation`. `q`: {} joint positions.",
-                s.n
+                s.nq
             )
         },
         build: |g, model, _| {
@@ -393,14 +409,14 @@ const ALGORITHMS: &[Algorithm] = &[
         args: &[In::Q, In::Params],
         out: "m",
         shape: Shape::Matrix {
-            rows: Len::Dof,
-            cols: Len::Dof,
+            rows: Len::V,
+            cols: Len::V,
         },
         doc: |s| {
             format!(
                 "The joint-space inertia matrix `M(q)` ({n} × {n}, symmetric positive definite) by the\ncomposite-rigid-body algorithm; entries of joints on different branches are not\ncomputed. {}.",
                 s.params(),
-                n = s.n
+                n = s.nv
             )
         },
         build: |g, model, _| algo::crba(g, model).iter().flatten().map(|x| x.id()).collect(),
@@ -409,12 +425,12 @@ const ALGORITHMS: &[Algorithm] = &[
         name: "aba",
         args: &[In::Q, In::V, In::Tau, In::Params],
         out: "a",
-        shape: Shape::Vector(Len::Dof),
+        shape: Shape::Vector(Len::V),
         doc: |s| {
             format!(
                 "Forward dynamics, `a = M(q)⁻¹ (tau − h(q, v))`, by the articulated-body algorithm.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.\nReturns the {n} joint accelerations; `aba(q, v, rnea(q, v, a)) = a`.",
                 s.params(),
-                n = s.n
+                n = s.nv
             )
         },
         build: |g, model, _| {
@@ -429,13 +445,13 @@ const ALGORITHMS: &[Algorithm] = &[
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
-            rows: Len::Dof,
+            rows: Len::V,
             cols: Len::Params,
         },
         doc: |s| {
             format!(
                 "The joint torque regressor `Y(q, v, a)` ({} × {}): `tau = Y · params` for any\nstandard parameters. Blocks of joints that do not support a body are structural\nzeros, never computed. {}.",
-                s.n,
+                s.nv,
                 10 * s.n,
                 s.state()
             )
@@ -447,13 +463,13 @@ const ALGORITHMS: &[Algorithm] = &[
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
-            rows: Len::Dof,
+            rows: Len::V,
             cols: Len::Base,
         },
         doc: |s| {
             format!(
                 "The base regressor `Y_b(q, v, a)` ({} × {b}): `tau = Y_b · β` with `β = K · params`\n(`Self::base_params`), the {b} identifiable combinations listed in\n`Self::BASE_GROUPINGS`. {}.",
-                s.n,
+                s.nv,
                 s.state(),
                 b = s.nb
             )
@@ -468,13 +484,13 @@ const ALGORITHMS: &[Algorithm] = &[
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
-            rows: Len::Dof,
+            rows: Len::V,
             cols: Len::Theta,
         },
         doc: |s| {
             format!(
                 "The regressor in the paper's parameters ({} × {}): `tau = Y_θ · theta` with\n`theta = (m, J1, J2, J3)` per body, each body's centre of mass and principal axes\nfixed by the description (`Self::NOMINAL_THETA` for its values). {}.",
-                s.n,
+                s.nv,
                 4 * s.n,
                 s.state()
             )
@@ -486,13 +502,13 @@ const ALGORITHMS: &[Algorithm] = &[
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
-            rows: Len::Dof,
+            rows: Len::V,
             cols: Len::PrincipalBase,
         },
         doc: |s| {
             format!(
                 "The base regressor of the principal parameterisation ({} × {}): `tau = Y · β_θ`\nwith `β_θ = K_θ · theta` (`Self::principal_base_params`), groupings in\n`Self::PRINCIPAL_BASE_GROUPINGS`. {}.",
-                s.n,
+                s.nv,
                 s.nbt,
                 s.state()
             )
@@ -692,6 +708,8 @@ impl Algorithm {
 pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> GeneratedCode {
     let sizes = Sizes {
         n: model.dof(),
+        nq: model.nq(),
+        nv: model.nv(),
         nb: bases.standard.count(),
         nbt: bases.principal.count(),
         nbj: bases.joints.count(),
@@ -711,16 +729,32 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     functions.extend(joints.reports);
     items.extend(joints.items);
     methods.extend(joints.methods);
-    let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
-    functions.extend(derivative_reports);
-    items.extend(derivative_items);
-    methods.push(derivative_methods(sizes.n));
+    // The derivatives (closed form over one-coordinate joints) are generated when
+    // every joint has one degree of freedom; the type then implements
+    // `dyngen::RobotDerivatives`.
+    let derivatives = if model.multi_dof_joint().is_none() {
+        let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
+        functions.extend(derivative_reports);
+        items.extend(derivative_items);
+        Some(derivative_methods(sizes.n))
+    } else {
+        None
+    };
     let ty = format_ident!("{}", name);
     let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
     functions.extend(frames.reports);
     items.extend(frames.items);
     methods.push(frames.methods);
     let mut tokens = robot_type(model, &ty, bases, &functions, &items, &methods);
+    if let Some(methods) = derivatives {
+        tokens.extend(quote! {
+            #[automatically_derived]
+            #[allow(clippy::all)]
+            impl ::dyngen::RobotDerivatives for #ty {
+                #methods
+            }
+        });
+    }
     tokens.extend(frames.enum_item);
     GeneratedCode {
         tokens,
@@ -745,6 +779,8 @@ fn derivative_items(
     // 772 ns, but the UR5's and rnea_derivatives got slower); rnea_derivatives was
     // unchanged within 2 %. rustc schedules large straight-line functions poorly.
     let max_statements = max_statements.min(DERIVATIVE_MAX_STATEMENTS);
+    // Only models whose joints all have one degree of freedom get these, so
+    // n = nq = nv.
     let n = sizes.n;
     let (n_l, np_l) = (emit::usize_lit(n), emit::usize_lit(10 * n));
     let arg = |id, name, len| Arg { id, name, len };
@@ -998,6 +1034,8 @@ fn model_expr(model: &Model) -> TokenStream {
             dyngen_model::JointKind::Revolute => quote!(Revolute),
             dyngen_model::JointKind::Continuous => quote!(Continuous),
             dyngen_model::JointKind::Prismatic => quote!(Prismatic),
+            dyngen_model::JointKind::Spherical => quote!(Spherical),
+            dyngen_model::JointKind::FreeFlyer => quote!(FreeFlyer),
         };
         let parent = emit::usize_lit(j.parent);
         let rotation = mat3(&j.origin.rotation);
@@ -1103,6 +1141,7 @@ fn robot_type(
     let (base, pbase) = (&bases.standard, &bases.principal);
     let n = model.dof();
     let (n_lit, np_lit, nt_lit) = (emit::usize_lit(n), emit::usize_lit(10 * n), emit::usize_lit(4 * n));
+    let (nq_lit, nv_lit) = (emit::usize_lit(model.nq()), emit::usize_lit(model.nv()));
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     let parents: Vec<usize> = model.joints.iter().map(|j| j.parent).collect();
@@ -1139,20 +1178,21 @@ fn robot_type(
     ));
     let jbase = &bases.joints;
     let nbj = jbase.count();
-    let (nbj_lit, nj_lit) = (emit::usize_lit(nbj), emit::usize_lit(4 * n));
+    let nj = 4 * model.nv();
+    let (nbj_lit, nj_lit) = (emit::usize_lit(nbj), emit::usize_lit(nj));
     let jgroupings = &jbase.groupings;
     let jbase_index = jbase.independent.iter().map(|&c| emit::usize_lit(c));
     let jbase_k = sparse_rows(&jbase.k);
-    let nbjk = emit::usize_lit(nbj * 14 * n);
+    let nbjk = emit::usize_lit(nbj * (10 * n + nj));
     let nominal_joints = f64_array(&dyngen_model::joint_params::nominal_joint_params(model));
     let jbase_doc = doc_attrs(&format!(
         "The {nbj} base parameters of the standard and joint parameters together\n(`[params; joint_params]`, {} columns, Coulomb friction as `sign(v)`), found the same way:\n{}",
-        14 * n,
+        10 * n + nj,
         grouping_list(jbase)
     ));
     let jbase_k_doc = doc_attrs(&format!(
         "`K_j` ({nbj} × {}, row-major): `β_j = K_j · [params; joint_params]`.",
-        14 * n
+        10 * n + nj
     ));
     let base_k_doc = doc_attrs(&format!("`K` ({nb} × {}, row-major): `β = K · params`.", 10 * n));
     let pbase_k_doc = doc_attrs(&format!("`K_θ` ({nbt} × {}, row-major): `β_θ = K_θ · theta`.", 4 * n));
@@ -1171,10 +1211,10 @@ fn robot_type(
 
         #[allow(clippy::all, clippy::pedantic, unused_variables, unused_parens, non_snake_case)]
         impl #ty {
-            /// Number of joint positions.
-            pub const NQ: usize = #n_lit;
-            /// Number of joint velocities.
-            pub const NV: usize = #n_lit;
+            /// Number of position coordinates (a unit quaternion per ball joint and free flyer).
+            pub const NQ: usize = #nq_lit;
+            /// Number of velocity coordinates (degrees of freedom).
+            pub const NV: usize = #nv_lit;
             /// Number of moving bodies.
             pub const NBODIES: usize = #n_lit;
             /// Number of standard inertial parameters (10 per body).
@@ -1185,7 +1225,7 @@ fn robot_type(
             pub const NBASE: usize = #nb_lit;
             /// Number of base parameters of the principal parameterisation.
             pub const NBASE_PRINCIPAL: usize = #nbt_lit;
-            /// Number of joint parameters (4 per joint: `Ia, Fv, Fc, F0`).
+            /// Number of joint parameters (4 per velocity coordinate: `Ia, Fv, Fc, F0`).
             pub const NJOINT_PARAMS: usize = #nj_lit;
             /// Number of base parameters of the standard and joint parameters together.
             pub const NBASE_JOINTS: usize = #nbj_lit;
@@ -1202,7 +1242,7 @@ fn robot_type(
             pub const NOMINAL_PARAMS: [f64; #np_lit] = #nominal;
             /// The description's principal parameters `theta = (m, J1, J2, J3)`, 4 per body.
             pub const NOMINAL_THETA: [f64; #nt_lit] = #theta;
-            /// The description's joint parameters, 4 per joint `[Ia, Fv, Fc, F0]`: viscous and
+            /// The description's joint parameters, 4 per velocity coordinate `[Ia, Fv, Fc, F0]`: viscous and
             /// Coulomb friction from URDF `<dynamics damping friction>`, rotor inertia and offset 0.
             pub const NOMINAL_JOINT_PARAMS: [f64; #nj_lit] = #nominal_joints;
             #base_doc
@@ -1237,8 +1277,8 @@ fn robot_type(
         #[allow(clippy::all)]
         impl ::dyngen::Robot for #ty {
             const NAME: &'static str = #robot_name;
-            const NQ: usize = #n_lit;
-            const NV: usize = #n_lit;
+            const NQ: usize = #nq_lit;
+            const NV: usize = #nv_lit;
             const NBODIES: usize = #n_lit;
             const NPARAMS: usize = #np_lit;
             const NTHETA: usize = #nt_lit;

@@ -35,9 +35,10 @@ fn doc(text: &str) -> TokenStream {
 
 /// The joint functions of the robot type and their `Robot` methods.
 pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statements: usize) -> JointFns {
-    let n = sizes.n;
-    let (np, nj, nb, nbj) = (10 * n, 4 * n, sizes.nb, sizes.nbj);
-    let [n_l, np_l, nj_l, nb_l, nbj_l, nw_l] = [n, np, nj, nb, nbj, np + nj].map(emit::usize_lit);
+    // Rows and joint parameters go by velocity coordinate; parameters by body.
+    let n = sizes.nv;
+    let (np, nj, nb, nbj) = (10 * sizes.n, 4 * n, sizes.nb, sizes.nbj);
+    let [n_l, nq_l, np_l, nj_l, nb_l, nbj_l, nw_l] = [n, sizes.nq, np, nj, nb, nbj, np + nj].map(emit::usize_lit);
     let s = quote!(<S as ::dyngen::Scalar>);
     let jp = quote!(::dyngen::__private::joint_at(joint_params, j));
     let coulomb_doc = "`coulomb`: `Coulomb::Sign` or `Coulomb::smooth(ε)`";
@@ -53,7 +54,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
             Arg {
                 id: ARG_Q,
                 name: "q",
-                len: n,
+                len: sizes.nq,
             },
             Arg {
                 id: ARG_V,
@@ -156,7 +157,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
                 #rnea_doc
                 #[inline]
                 pub fn rnea_joints<S: ::dyngen::Scalar>(
-                    q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], params: &[S; #np_l],
+                    q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], params: &[S; #np_l],
                     joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
                 ) -> [S; #n_l] {
                     let mut tau = Self::rnea(q, v, a, params);
@@ -173,7 +174,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
                 #crba_doc
                 #[inline]
                 pub fn crba_joints<S: ::dyngen::Scalar>(
-                    q: &[S; #n_l], params: &[S; #np_l], joint_params: &[S; #nj_l], out: &mut [[S; #n_l]; #n_l],
+                    q: &[S; #nq_l], params: &[S; #np_l], joint_params: &[S; #nj_l], out: &mut [[S; #n_l]; #n_l],
                 ) {
                     Self::crba(q, params, out);
                     for j in 0..#n_l {
@@ -188,7 +189,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
                 #aba_doc
                 #[inline]
                 pub fn aba_joints<S: ::dyngen::Scalar>(
-                    q: &[S; #n_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
+                    q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                     joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
                 ) -> [S; #n_l] {
                     let mut driving = *tau;
@@ -206,7 +207,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
                 #reg_doc
                 #[inline]
                 pub fn torque_regressor_joints<S: ::dyngen::Scalar>(
-                    q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], coulomb: ::dyngen::Coulomb<S>,
+                    q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], coulomb: ::dyngen::Coulomb<S>,
                     out: &mut [[S; #nw_l]; #n_l],
                 ) {
                     let mut y = [[#s::ZERO; #np_l]; #n_l];
@@ -226,7 +227,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
                 #base_reg_doc
                 #[inline]
                 pub fn base_regressor_joints<S: ::dyngen::Scalar>(
-                    q: &[S; #n_l], v: &[S; #n_l], a: &[S; #n_l], coulomb: ::dyngen::Coulomb<S>,
+                    q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], coulomb: ::dyngen::Coulomb<S>,
                     out: &mut [[S; #nbj_l]; #n_l],
                 ) {
                     #base_reg_body

@@ -11,6 +11,32 @@ pub enum JointType {
     Continuous,
     /// Translation along the axis.
     Prismatic,
+    /// A ball joint: 4 positions (unit quaternion `[x, y, z, w]`), 3 velocities (the
+    /// angular velocity in the child frame).
+    Spherical,
+    /// The free flyer of a floating base (joint 1 only): 7 positions `[p; x, y, z, w]`,
+    /// 6 velocities `[v; ω]` in the body frame, as Pinocchio's `JointModelFreeFlyer`.
+    FreeFlyer,
+}
+
+impl JointType {
+    /// Number of position coordinates: 1, 4 or 7.
+    pub const fn nq(self) -> usize {
+        match self {
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
+            JointType::Spherical => 4,
+            JointType::FreeFlyer => 7,
+        }
+    }
+
+    /// Number of velocity coordinates: 1, 3 or 6.
+    pub const fn nv(self) -> usize {
+        match self {
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
+            JointType::Spherical => 3,
+            JointType::FreeFlyer => 6,
+        }
+    }
 }
 
 /// Joint position, velocity and effort limits (SI units).
@@ -33,7 +59,8 @@ pub struct JointModel {
     /// `x_parent = rotation · x_joint + translation`.
     pub rotation: [[f64; 3]; 3],
     pub translation: [f64; 3],
-    /// Unit axis in the joint (= child body) frame.
+    /// Unit axis in the joint (= child body) frame; zero for a ball joint and a free
+    /// flyer.
     pub axis: [f64; 3],
     pub limits: Option<JointLimits>,
     /// Nominal viscous friction `Fv` (URDF `<dynamics damping>`): `τ += Fv·q̇`.

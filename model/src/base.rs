@@ -66,14 +66,25 @@ impl Parameterisation {
         }
     }
 
-    /// The parameter names of an `n`-body model ([`crate::names`]).
+    /// The parameter names of a model of `n` bodies, each on a joint with one
+    /// degree of freedom ([`crate::names`]); [`Parameterisation::names_of`] for any.
     pub fn names(self, n: usize) -> Vec<String> {
+        self.names_with(n, n)
+    }
+
+    /// The parameter names of `model`: per body, then (joint parameters) per velocity
+    /// coordinate.
+    pub fn names_of(self, model: &Model) -> Vec<String> {
+        self.names_with(model.dof(), model.nv())
+    }
+
+    fn names_with(self, bodies: usize, dofs: usize) -> Vec<String> {
         match self {
-            Parameterisation::Standard => standard_param_names(n),
-            Parameterisation::Principal => principal_param_names(n),
+            Parameterisation::Standard => standard_param_names(bodies),
+            Parameterisation::Principal => principal_param_names(bodies),
             Parameterisation::StandardAndJoints => {
-                let mut names = standard_param_names(n);
-                names.extend(joint_param_names(n));
+                let mut names = standard_param_names(bodies);
+                names.extend(joint_param_names(dofs));
                 names
             }
         }
@@ -141,7 +152,7 @@ impl fmt::Display for BaseParams {
 /// `SEEDS[0]`, confirmed with `SEEDS[1]`, and the rank counted from the singular
 /// values of the same stacked matrix.
 pub fn analyse(model: &Model, parameterisation: Parameterisation) -> BaseParams {
-    let names = parameterisation.names(model.dof());
+    let names = parameterisation.names_of(model);
     let first = stacked(model, parameterisation, SEEDS[0]);
     let sv = singular_values(&first);
     let largest = sv.first().copied().unwrap_or(0.0);
@@ -158,7 +169,7 @@ pub fn analyse(model: &Model, parameterisation: Parameterisation) -> BaseParams 
 
 /// The regressor stacked over [`SAMPLES`] structure states drawn with `seed`.
 fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64) -> Vec<Vec<f64>> {
-    let mut rows = Vec::with_capacity(SAMPLES * model.dof());
+    let mut rows = Vec::with_capacity(SAMPLES * model.nv());
     for s in structure_states(model, SAMPLES, seed) {
         let y = torque_regressor(model, &s.q, &s.v, &s.a);
         match parameterisation {

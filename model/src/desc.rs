@@ -193,7 +193,64 @@ pub fn triangle_violation(moments: [f64; 3]) -> Option<usize> {
     (0..3).find(|&k| moments[k] > moments[(k + 1) % 3] + moments[(k + 2) % 3] + tol)
 }
 
+/// The fixed world link and the free-flyer joint [`Description::with_free_flyer`]
+/// adds, named as Pinocchio names them when it puts a `JointModelFreeFlyer` under a
+/// URDF's root link.
+pub const WORLD_LINK: &str = "universe";
+/// See [`WORLD_LINK`].
+pub const FREE_FLYER_JOINT: &str = "root_joint";
+
+/// Options every front end's loader takes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Refuse what would be accepted with a warning (CAD-rounded inertias).
+    pub strict: bool,
+    /// Put the description's root link on a free flyer ([`Description::with_free_flyer`]):
+    /// a floating base, as Pinocchio's `buildModel(urdf, JointModelFreeFlyer())`.
+    pub free_flyer: bool,
+}
+
 impl Description {
+    /// The same robot with its root link floating: a link [`WORLD_LINK`] (no
+    /// inertial) and a [`JointKind::FreeFlyer`] joint [`FREE_FLYER_JOINT`] from it to
+    /// the root link, whose inertial then counts. Unchanged when there is no single
+    /// root (the build reports that).
+    pub fn with_free_flyer(mut self) -> Description {
+        let children: std::collections::HashSet<&str> = self.joints.iter().map(|j| j.child.as_str()).collect();
+        let roots: Vec<&LinkDesc> = self
+            .links
+            .iter()
+            .filter(|l| !children.contains(l.name.as_str()))
+            .collect();
+        let [root] = roots.as_slice() else {
+            return self;
+        };
+        let (root, line) = (root.name.clone(), root.line);
+        self.links.insert(
+            0,
+            LinkDesc {
+                name: WORLD_LINK.into(),
+                inertial: None,
+                line: None,
+            },
+        );
+        self.joints.insert(
+            0,
+            JointDesc {
+                name: FREE_FLYER_JOINT.into(),
+                kind: DeclaredJointType::Moving(JointKind::FreeFlyer),
+                parent: WORLD_LINK.into(),
+                child: root,
+                origin: Placement::IDENTITY,
+                axis: [0.0; 3],
+                limits: None,
+                dynamics: JointDynamics::default(),
+                line,
+            },
+        );
+        self
+    }
+
     /// Checks the description and builds the model, collecting every error.
     pub fn build(&self) -> Result<Model, Vec<ModelError>> {
         self.build_with(SiblingOrder::Declaration)
@@ -248,8 +305,10 @@ impl Description {
             } else if let Err(kind) = check_value("origin", &j.origin.translation) {
                 errors.push(err(el(), j.line, kind));
             }
-            if let DeclaredJointType::Moving(_) = j.kind {
-                if let Err(kind) = check_value("axis", &j.axis) {
+            if let DeclaredJointType::Moving(kind) = j.kind {
+                if !kind.has_axis() {
+                    // A ball joint or a free flyer has no axis: whatever is given is unused.
+                } else if let Err(kind) = check_value("axis", &j.axis) {
                     errors.push(err(el(), j.line, kind));
                 } else if math::norm(&j.axis) < 1e-12 {
                     errors.push(err(el(), j.line, ErrorKind::ZeroAxis));
@@ -374,13 +433,25 @@ impl Description {
             let origin = placement.compose(&j.origin);
             let (body, placement) = match &j.kind {
                 DeclaredJointType::Moving(kind) => {
+                    if *kind == JointKind::FreeFlyer && (owner != 0 || !model.joints.is_empty()) {
+                        errors.push(err(
+                            Element::Joint(j.name.clone()),
+                            j.line,
+                            ErrorKind::FreeFlyerNotAtRoot,
+                        ));
+                    }
+                    let keeps_limits = matches!(kind, JointKind::Revolute | JointKind::Prismatic);
                     model.joints.push(Joint {
                         name: j.name.clone(),
                         kind: *kind,
                         parent: owner,
                         origin,
-                        axis: math::scale(1.0 / math::norm(&j.axis), &j.axis),
-                        limits: if *kind == JointKind::Continuous { None } else { j.limits },
+                        axis: if kind.has_axis() {
+                            math::scale(1.0 / math::norm(&j.axis), &j.axis)
+                        } else {
+                            [0.0; 3]
+                        },
+                        limits: if keeps_limits { j.limits } else { None },
                         dynamics: j.dynamics,
                     });
                     model.bodies.push(Body {

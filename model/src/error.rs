@@ -73,6 +73,9 @@ pub enum ErrorKind {
     /// The joint closes a loop (its child is one of its ancestors).
     Cycle,
     UnsupportedJointType(String),
+    /// A free flyer (URDF `floating`, MJCF `free`) that does not hang from the root
+    /// link, or a second one: a floating base is one free body on the world.
+    FreeFlyerNotAtRoot,
     ZeroAxis,
     NonFiniteValue(&'static str),
     /// A finite value beyond [`MAX_MAGNITUDE`](crate::desc::MAX_MAGNITUDE).
@@ -176,7 +179,11 @@ impl fmt::Display for ErrorKind {
             ErrorKind::Cycle => write!(f, "closes a kinematic loop; only trees are supported (every link reachable from the root exactly once)"),
             ErrorKind::UnsupportedJointType(t) => write!(
                 f,
-                "joint type `{t}` is not supported; use revolute, continuous, prismatic or fixed (the base is fixed)"
+                "joint type `{t}` is not supported; use revolute, continuous, prismatic, spherical, floating or fixed"
+            ),
+            ErrorKind::FreeFlyerNotAtRoot => write!(
+                f,
+                "a floating (free-flyer) joint must join the root link to the robot's first body, and only one may;                  make it the joint of the root link's only child, or leave the base fixed"
             ),
             ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
             ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),
@@ -208,7 +215,7 @@ impl fmt::Display for ErrorKind {
                 "<dynamics damping=\"{damping}\" friction=\"{friction}\"> is negative; friction only dissipates, \
                  give values ≥ 0"
             ),
-            ErrorKind::NoMovingJoint => write!(f, "has no revolute, continuous or prismatic joint; nothing moves"),
+            ErrorKind::NoMovingJoint => write!(f, "has no moving joint (revolute, continuous, prismatic, spherical or floating); nothing moves"),
             ErrorKind::NotSupported(m) | ErrorKind::InvalidMjcf(m) | ErrorKind::Ignored(m) => write!(f, "{m}"),
             ErrorKind::UnknownClass(c) => write!(
                 f,

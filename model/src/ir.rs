@@ -13,11 +13,44 @@ pub enum JointKind {
     Continuous,
     /// Translation along `axis`.
     Prismatic,
+    /// Free rotation about the joint-frame origin (a ball joint): 4 positions, the
+    /// unit quaternion `[x, y, z, w]` of the child in the joint frame; 3 velocities,
+    /// the angular velocity in the child frame. Pinocchio's `JointModelSpherical`.
+    Spherical,
+    /// The free flyer of a floating base, only as the joint of body 1 on the fixed
+    /// world: 7 positions `[p; x, y, z, w]` (position of the body in the world, unit
+    /// quaternion of its orientation), 6 velocities `[v; ω]`, the linear velocity of
+    /// the body-frame origin and the angular velocity, both in the body frame.
+    /// Pinocchio's `JointModelFreeFlyer`; its "torques" are the wrench on the base.
+    FreeFlyer,
 }
 
 impl JointKind {
     pub fn is_revolute(self) -> bool {
         matches!(self, JointKind::Revolute | JointKind::Continuous)
+    }
+
+    /// Number of position coordinates: 1, 4 (quaternion) or 7 (position, quaternion).
+    pub fn nq(self) -> usize {
+        match self {
+            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+            JointKind::Spherical => 4,
+            JointKind::FreeFlyer => 7,
+        }
+    }
+
+    /// Number of velocity coordinates (degrees of freedom): 1, 3 or 6.
+    pub fn nv(self) -> usize {
+        match self {
+            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+            JointKind::Spherical => 3,
+            JointKind::FreeFlyer => 6,
+        }
+    }
+
+    /// Whether the joint has an axis (one degree of freedom).
+    pub fn has_axis(self) -> bool {
+        self.nv() == 1
     }
 
     /// The URDF `type` attribute.
@@ -26,6 +59,8 @@ impl JointKind {
             JointKind::Revolute => "revolute",
             JointKind::Continuous => "continuous",
             JointKind::Prismatic => "prismatic",
+            JointKind::Spherical => "spherical",
+            JointKind::FreeFlyer => "floating",
         }
     }
 }
@@ -213,7 +248,8 @@ pub struct Joint {
     pub parent: usize,
     /// Joint frame at `q = 0` in the parent body's frame.
     pub origin: Placement,
-    /// Unit axis in the joint (= child body) frame.
+    /// Unit axis in the joint (= child body) frame; zero for a joint without one
+    /// ([`JointKind::has_axis`]).
     pub axis: Vec3,
     pub limits: Option<Limits>,
     pub dynamics: JointDynamics,
@@ -240,8 +276,11 @@ pub struct Frame {
     pub placement: Placement,
 }
 
-/// A checked fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
-/// `bodies[j - 1]` (body `j`), and `joints[j - 1].parent < j`.
+/// A checked kinematic tree in regular labelling: `joints[j - 1]` carries
+/// `bodies[j - 1]` (body `j`), and `joints[j - 1].parent < j`. Body 0 is fixed: the
+/// robot's base, or the world when joint 1 is a [`JointKind::FreeFlyer`] (a floating
+/// base). Coordinates are laid out joint after joint: joint `j`'s positions start at
+/// [`Model::q_offset`]`(j)` and its velocities at [`Model::v_offset`]`(j)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Model {
     pub name: String,
@@ -275,9 +314,57 @@ impl Model {
         model
     }
 
-    /// Number of moving bodies, joints and degrees of freedom (all equal).
+    /// Number of joints, which is the number of moving bodies; also the number of
+    /// degrees of freedom when every joint has one ([`Model::multi_dof_joint`]).
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// Number of position coordinates, `Σ nq` over the joints.
+    pub fn nq(&self) -> usize {
+        self.joints.iter().map(|j| j.kind.nq()).sum()
+    }
+
+    /// Number of velocity coordinates (degrees of freedom), `Σ nv` over the joints.
+    pub fn nv(&self) -> usize {
+        self.joints.iter().map(|j| j.kind.nv()).sum()
+    }
+
+    /// Index in `q` of joint `j`'s first position (1-based joint).
+    pub fn q_offset(&self, j: usize) -> usize {
+        self.joints[..j - 1].iter().map(|j| j.kind.nq()).sum()
+    }
+
+    /// Index in `v` of joint `j`'s first velocity (1-based joint).
+    pub fn v_offset(&self, j: usize) -> usize {
+        self.joints[..j - 1].iter().map(|j| j.kind.nv()).sum()
+    }
+
+    /// The joint (1-based) that owns velocity coordinate `d`.
+    pub fn joint_of_v(&self, d: usize) -> usize {
+        let mut start = 0;
+        for (k, joint) in self.joints.iter().enumerate() {
+            start += joint.kind.nv();
+            if d < start {
+                return k + 1;
+            }
+        }
+        panic!(
+            "velocity index {d} out of range: the model has {} velocities",
+            self.nv()
+        )
+    }
+
+    /// Whether the base floats: joint 1 is a free flyer.
+    pub fn is_floating(&self) -> bool {
+        self.joints.first().is_some_and(|j| j.kind == JointKind::FreeFlyer)
+    }
+
+    /// The first joint with more than one degree of freedom (a free flyer or a ball
+    /// joint), if any: what the runtime layers that assume one coordinate per joint
+    /// refuse by name.
+    pub fn multi_dof_joint(&self) -> Option<&Joint> {
+        self.joints.iter().find(|j| !j.kind.has_axis())
     }
 
     /// Parent body of body `i` (1-based), 0 for the base.

@@ -77,14 +77,16 @@ pub fn joint_torque(p: &[f64; PER_JOINT], v: f64, a: f64, coulomb: Coulomb) -> f
     r.iter().zip(p).map(|(y, p)| y * p).sum()
 }
 
-/// The description's nominal joint parameters, `4n`: rotor inertia and offset 0 (a
-/// URDF does not give them), viscous and Coulomb friction from `<dynamics damping
-/// friction>`.
+/// The description's nominal joint parameters, 4 per velocity coordinate (`4 nv`;
+/// one coordinate per joint with an axis, 3 per ball joint, 6 per free flyer): rotor
+/// inertia and offset 0 (a URDF does not give them), viscous and Coulomb friction
+/// from `<dynamics damping friction>`, the same on each coordinate of a joint.
 pub fn nominal_joint_params(model: &Model) -> Vec<f64> {
     model
         .joints
         .iter()
-        .flat_map(|j| [0.0, j.dynamics.damping, j.dynamics.friction, 0.0])
+        .flat_map(|j| std::iter::repeat_n([0.0, j.dynamics.damping, j.dynamics.friction, 0.0], j.kind.nv()))
+        .flatten()
         .collect()
 }
 

@@ -39,11 +39,14 @@ pub mod xml;
 pub use base::{BaseParams, Parameterisation};
 pub use desc::{
     check_inertial, check_physical, inertia_violation, nearest_physical_moments, DeclaredJointType, Description,
-    JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY, INERTIA_TOLERANCE,
+    JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY, FREE_FLYER_JOINT, INERTIA_TOLERANCE, WORLD_LINK,
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
-pub use mjcf::{load_mjcf, load_mjcf_with, load_robot, load_robot_with, parse_mjcf, parse_mjcf_with};
+pub use mjcf::{
+    load_mjcf, load_mjcf_options, load_mjcf_with, load_robot, load_robot_options, load_robot_with, parse_mjcf,
+    parse_mjcf_options, parse_mjcf_with,
+};
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
-pub use urdf::{load_urdf, load_urdf_with, parse_urdf, parse_urdf_with};
+pub use urdf::{load_urdf, load_urdf_options, load_urdf_with, parse_urdf, parse_urdf_options, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

@@ -27,7 +27,7 @@
 //!
 //! Siblings are numbered in declaration order, as MuJoCo numbers its bodies.
 
-use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
+use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math::{self, Mat3, Vec3};
@@ -53,7 +53,18 @@ pub fn parse_mjcf(text: &str) -> Result<Model, ModelErrors> {
 
 /// [`parse_mjcf`]; `strict` refuses the inertias it would accept with a warning.
 pub fn parse_mjcf_with(text: &str, strict: bool) -> Result<Model, ModelErrors> {
-    build(text, strict).map_err(|errors| ModelErrors { file: None, errors })
+    parse_mjcf_options(
+        text,
+        LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        },
+    )
+}
+
+/// [`parse_mjcf`] with every [`LoadOptions`] (a free flyer under the root link).
+pub fn parse_mjcf_options(text: &str, options: LoadOptions) -> Result<Model, ModelErrors> {
+    build(text, options).map_err(|errors| ModelErrors { file: None, errors })
 }
 
 /// Reads, parses and checks an MJCF file; errors are prefixed with its path.
@@ -63,12 +74,23 @@ pub fn load_mjcf(path: &Path) -> Result<Model, ModelErrors> {
 
 /// [`load_mjcf`]; `strict` as for [`parse_mjcf_with`].
 pub fn load_mjcf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
+    load_mjcf_options(
+        path,
+        LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        },
+    )
+}
+
+/// [`load_mjcf`] with every [`LoadOptions`] (a free flyer under the root link).
+pub fn load_mjcf_options(path: &Path, options: LoadOptions) -> Result<Model, ModelErrors> {
     let file = Some(path.display().to_string());
     let text = read_file(path).map_err(|errors| ModelErrors {
         file: file.clone(),
         errors,
     })?;
-    build(&text, strict).map_err(|errors| ModelErrors { file, errors })
+    build(&text, options).map_err(|errors| ModelErrors { file, errors })
 }
 
 /// Loads a robot by its file name: `.xml` or `.mjcf` as MJCF ([`load_mjcf`], siblings
@@ -80,10 +102,22 @@ pub fn load_robot(path: &Path) -> Result<Model, ModelErrors> {
 
 /// [`load_robot`]; `strict` refuses CAD-rounded inertias, as for URDF and MJCF.
 pub fn load_robot_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
+    load_robot_options(
+        path,
+        LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        },
+    )
+}
+
+/// [`load_robot`] with every [`LoadOptions`]: `free_flyer` puts the root link on a
+/// free flyer (a floating base).
+pub fn load_robot_options(path: &Path, options: LoadOptions) -> Result<Model, ModelErrors> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("xml" | "mjcf") => load_mjcf_with(path, strict),
-        _ => crate::load_urdf_with(path, strict),
+        Some("xml" | "mjcf") => load_mjcf_options(path, options),
+        _ => crate::urdf::load_urdf_options(path, options),
     }
 }
 
@@ -111,8 +145,12 @@ fn read_file(path: &Path) -> Result<String, Vec<ModelError>> {
     Ok(text)
 }
 
-fn build(text: &str, strict: bool) -> Result<Model, Vec<ModelError>> {
-    let read = read(text)?;
+fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
+    let strict = options.strict;
+    let mut read = read(text)?;
+    if options.free_flyer {
+        read.desc = read.desc.with_free_flyer();
+    }
     let built = read.desc.build_checked(SiblingOrder::Declaration, strict);
     if read.errors.is_empty() {
         match built {

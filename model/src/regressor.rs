@@ -40,8 +40,8 @@ pub const PRINCIPAL_PER_BODY: usize = 4;
 /// A state that does not fit the model.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum RegressorError {
-    /// `argument` (`"q"`, `"v"` or `"a"`) has `found` entries; the model has
-    /// `expected` joints.
+    /// `argument` (`"q"`, `"v"` or `"a"`) has `found` entries; the model needs
+    /// `expected` (`nq` positions for `q`, `nv` velocities for `v` and `a`).
     Length {
         argument: &'static str,
         expected: usize,
@@ -56,7 +56,14 @@ impl fmt::Display for RegressorError {
                 argument,
                 expected,
                 found,
-            } => write!(f, "`{argument}` has {found} entries; the model has {expected} joints"),
+            } => {
+                let what = if *argument == "q" {
+                    "position coordinates"
+                } else {
+                    "velocity coordinates"
+                };
+                write!(f, "`{argument}` has {found} entries; the model has {expected} {what}")
+            }
         }
     }
 }
@@ -83,8 +90,7 @@ pub fn principal_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Re
 }
 
 fn check_state(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<(), RegressorError> {
-    let expected = model.dof();
-    for (argument, x) in [("q", q), ("v", v), ("a", a)] {
+    for (argument, x, expected) in [("q", q, model.nq()), ("v", v, model.nv()), ("a", a, model.nv())] {
         if x.len() != expected {
             return Err(RegressorError::Length {
                 argument,
@@ -132,7 +138,56 @@ pub(crate) struct BodyMotion {
     pub accel: Vec3,
 }
 
-/// The forward pass of the module docs, body 1 first. Lengths are the caller's to check.
+/// Joint `j`'s placement at `q` (body frame → parent frame) and its relative
+/// motion in the body frame: angular and linear velocity, angular and linear
+/// acceleration, `(vq_w, vq_v, aq_w, aq_v)`.
+pub(crate) fn joint_state(model: &Model, j: usize, q: &[f64], v: &[f64], a: &[f64]) -> (Mat3, Vec3, [Vec3; 4]) {
+    let joint = &model.joints[j - 1];
+    let (qo, vo) = (model.q_offset(j), model.v_offset(j));
+    let origin = &joint.origin;
+    let z = joint.axis;
+    let v3 = |x: &[f64], o: usize| [x[o], x[o + 1], x[o + 2]];
+    let zero = [0.0; 3];
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => (
+            math::mat_mul(&origin.rotation, &axis_rotation(&z, q[qo])),
+            origin.translation,
+            [math::scale(v[vo], &z), zero, math::scale(a[vo], &z), zero],
+        ),
+        JointKind::Prismatic => {
+            let slide = math::mat_vec(&origin.rotation, &math::scale(q[qo], &z));
+            (
+                origin.rotation,
+                math::add(&origin.translation, &slide),
+                [zero, math::scale(v[vo], &z), zero, math::scale(a[vo], &z)],
+            )
+        }
+        JointKind::Spherical => (
+            math::mat_mul(&origin.rotation, &quaternion_xyzw(&q[qo..qo + 4])),
+            origin.translation,
+            [v3(v, vo), zero, v3(a, vo), zero],
+        ),
+        JointKind::FreeFlyer => {
+            let slide = math::mat_vec(&origin.rotation, &v3(q, qo));
+            (
+                math::mat_mul(&origin.rotation, &quaternion_xyzw(&q[qo + 3..qo + 7])),
+                math::add(&origin.translation, &slide),
+                [v3(v, vo + 3), v3(v, vo), v3(a, vo + 3), v3(a, vo)],
+            )
+        }
+    }
+}
+
+/// The rotation of a quaternion stored as Pinocchio stores it, `[x, y, z, w]`
+/// (not normalised: a configuration is expected to hold a unit quaternion).
+pub fn quaternion_xyzw(q: &[f64]) -> Mat3 {
+    math::quaternion_to_matrix([q[3], q[0], q[1], q[2]])
+}
+
+/// The forward pass of the module docs, body 1 first, for any joint: with the
+/// joint's relative velocity `(ω_q, v_q)` and acceleration `(ω̇_q, a_q)` in body axes,
+/// `ω = ω_in + ω_q`, `ω̇ = ω̇_in + ω̇_q + ω_in × ω_q`, and the origin's acceleration
+/// `a = a_in + a_q + 2 ω_in × v_q + ω_q × v_q`. Lengths are the caller's to check.
 pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<BodyMotion> {
     let mut out: Vec<BodyMotion> = Vec::with_capacity(model.dof());
     for (k, joint) in model.joints.iter().enumerate() {
@@ -140,49 +195,35 @@ pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Bod
             0 => ([0.0; 3], [0.0; 3], math::scale(-1.0, &model.gravity)),
             p => (out[p - 1].omega, out[p - 1].omega_dot, out[p - 1].accel),
         };
-        let z = joint.axis;
-        let origin = &joint.origin;
-        let (rotation, translation) = if joint.kind.is_revolute() {
-            (
-                math::mat_mul(&origin.rotation, &axis_rotation(&z, q[k])),
-                origin.translation,
-            )
-        } else {
-            let slide = math::mat_vec(&origin.rotation, &math::scale(q[k], &z));
-            (origin.rotation, math::add(&origin.translation, &slide))
-        };
+        let (rotation, translation, [vq_w, vq_v, aq_w, aq_v]) = joint_state(model, k + 1, q, v, a);
         let rt = math::transpose(&rotation);
         let p = translation;
         let carried = math::add(&math::add(&a_p, &cross(&wd_p, &p)), &cross(&w_p, &cross(&w_p, &p)));
         let w_in = math::mat_vec(&rt, &w_p);
         let wd_in = math::mat_vec(&rt, &wd_p);
         let accel_in = math::mat_vec(&rt, &carried);
-        let motion = match joint.kind {
-            JointKind::Revolute | JointKind::Continuous => {
-                let zv = math::scale(v[k], &z);
-                BodyMotion {
-                    rotation,
-                    translation,
-                    omega: math::add(&w_in, &zv),
-                    omega_dot: math::add(&math::add(&wd_in, &cross(&w_in, &zv)), &math::scale(a[k], &z)),
-                    accel: accel_in,
-                }
-            }
-            JointKind::Prismatic => {
-                let zv = math::scale(v[k], &z);
-                let coriolis = math::scale(2.0, &cross(&w_in, &zv));
-                BodyMotion {
-                    rotation,
-                    translation,
-                    omega: w_in,
-                    omega_dot: wd_in,
-                    accel: math::add(&math::add(&accel_in, &coriolis), &math::scale(a[k], &z)),
-                }
-            }
-        };
-        out.push(motion);
+        let coriolis = math::add(&math::scale(2.0, &cross(&w_in, &vq_v)), &cross(&vq_w, &vq_v));
+        out.push(BodyMotion {
+            rotation,
+            translation,
+            omega: math::add(&w_in, &vq_w),
+            omega_dot: math::add(&math::add(&wd_in, &cross(&w_in, &vq_w)), &aq_w),
+            accel: math::add(&math::add(&accel_in, &coriolis), &aq_v),
+        });
     }
     out
+}
+
+/// Joint `j`'s rows of `τ = Sᵀ [f; n]` for the wrench `(f, n)` in its body frame:
+/// one for a joint with an axis, `n` for a ball joint, `[f; n]` for a free flyer.
+pub(crate) fn joint_rows(model: &Model, j: usize, f: &Vec3, n: &Vec3) -> Vec<f64> {
+    let joint = &model.joints[j - 1];
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => vec![math::dot(&joint.axis, n)],
+        JointKind::Prismatic => vec![math::dot(&joint.axis, f)],
+        JointKind::Spherical => n.to_vec(),
+        JointKind::FreeFlyer => f.iter().chain(n).copied().collect(),
+    }
 }
 
 /// The net wrench `(f, n)` on a body about its origin for standard parameters `pi`
@@ -207,7 +248,7 @@ fn body_wrench(m: &BodyMotion, pi: &[f64; 10]) -> (Vec3, Vec3) {
 pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Vec<f64>> {
     let n = model.dof();
     let motion = forward(model, q, v, a);
-    let mut y = vec![vec![0.0; STANDARD_PER_BODY * n]; n];
+    let mut y = vec![vec![0.0; STANDARD_PER_BODY * n]; model.nv()];
     for i in 1..=n {
         for k in 0..STANDARD_PER_BODY {
             let mut unit = [0.0; 10];
@@ -215,13 +256,13 @@ pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -
             let (mut f, mut m) = body_wrench(&motion[i - 1], &unit);
             let mut j = i;
             while j != 0 {
-                let joint = &model.joints[j - 1];
-                let moved = if joint.kind.is_revolute() { &m } else { &f };
-                y[j - 1][STANDARD_PER_BODY * (i - 1) + k] = math::dot(&joint.axis, moved);
+                for (r, x) in joint_rows(model, j, &f, &m).into_iter().enumerate() {
+                    y[model.v_offset(j) + r][STANDARD_PER_BODY * (i - 1) + k] = x;
+                }
                 let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
                 f = math::mat_vec(r, &f);
                 m = math::add(&math::mat_vec(r, &m), &cross(p, &f));
-                j = joint.parent;
+                j = model.joints[j - 1].parent;
             }
         }
     }
@@ -368,7 +409,7 @@ mod tests {
             })
         );
         let e = principal_regressor(&model, &ok, &ok, &[0.0; 7]).unwrap_err();
-        assert_eq!(e.to_string(), "`a` has 7 entries; the model has 6 joints");
+        assert_eq!(e.to_string(), "`a` has 7 entries; the model has 6 velocity coordinates");
     }
 
     /// Pinocchio's `tau` and `Y` for each fixture sample, with the fixture's gravity.

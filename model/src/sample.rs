@@ -41,7 +41,8 @@ impl SplitMix64 {
     }
 }
 
-/// One joint-space state: positions, velocities and accelerations, `n` each.
+/// One joint-space state: `nq` positions (a unit quaternion per ball joint and free
+/// flyer), `nv` velocities and `nv` accelerations.
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     pub q: Vec<f64>,
@@ -79,24 +80,44 @@ fn draw(model: &Model, count: usize, seed: u64, within_limits: bool) -> Vec<Stat
     let mut rng = SplitMix64::new(seed);
     (0..count)
         .map(|_| {
-            let q = model
-                .joints
-                .iter()
-                .map(|j| {
-                    // One turn, or ±0.5 m, within the limits when asked and there are
-                    // any (a model written without limits carries wide placeholders).
-                    let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
-                    match j.limits {
-                        Some(l) if within_limits => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
-                        _ => rng.uniform(-reach, reach),
+            let mut q = Vec::with_capacity(model.nq());
+            for j in &model.joints {
+                match j.kind {
+                    JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => {
+                        // One turn, or ±0.5 m, within the limits when asked and there
+                        // are any (a model written without limits carries wide
+                        // placeholders).
+                        let reach = if j.kind == JointKind::Prismatic { 0.5 } else { PI };
+                        q.push(match j.limits {
+                            Some(l) if within_limits => rng.uniform(l.lower.max(-reach), l.upper.min(reach)),
+                            _ => rng.uniform(-reach, reach),
+                        });
                     }
-                })
-                .collect();
-            let v = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
-            let a = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
+                    JointKind::Spherical => q.extend(unit_quaternion(&mut rng)),
+                    JointKind::FreeFlyer => {
+                        q.extend((0..3).map(|_| rng.uniform(-1.0, 1.0)));
+                        q.extend(unit_quaternion(&mut rng));
+                    }
+                }
+            }
+            let v = (0..model.nv()).map(|_| rng.uniform(-2.0, 2.0)).collect();
+            let a = (0..model.nv()).map(|_| rng.uniform(-2.0, 2.0)).collect();
             State { q, v, a }
         })
         .collect()
+}
+
+/// A unit quaternion `[x, y, z, w]`, uniform over rotations: four draws uniform in
+/// `[−1, 1]` kept when their norm is in `[0.1, 1]` (rejection from the unit ball),
+/// then normalised.
+fn unit_quaternion(rng: &mut SplitMix64) -> [f64; 4] {
+    loop {
+        let x = [0; 4].map(|_| rng.uniform(-1.0, 1.0));
+        let n = x.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if (0.1..=1.0).contains(&n) {
+            return x.map(|c| c / n);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! text supplies line numbers, spots unexpanded xacro, and tells which optional
 //! elements (`<inertial>`, `<limit>`) were actually written.
 
-use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, SiblingOrder, DEFAULT_GRAVITY};
+use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
@@ -25,7 +25,18 @@ pub fn parse_urdf(text: &str) -> Result<Model, ModelErrors> {
 
 /// [`parse_urdf`]; `strict` refuses what it would accept with a warning.
 pub fn parse_urdf_with(text: &str, strict: bool) -> Result<Model, ModelErrors> {
-    build(text, strict).map_err(|errors| ModelErrors { file: None, errors })
+    parse_urdf_options(
+        text,
+        LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        },
+    )
+}
+
+/// [`parse_urdf`] with every [`LoadOptions`] (a free flyer under the root link).
+pub fn parse_urdf_options(text: &str, options: LoadOptions) -> Result<Model, ModelErrors> {
+    build(text, options).map_err(|errors| ModelErrors { file: None, errors })
 }
 
 /// Reads, parses and checks a URDF file; errors are prefixed with its path.
@@ -36,6 +47,17 @@ pub fn load_urdf(path: &Path) -> Result<Model, ModelErrors> {
 
 /// [`load_urdf`]; `strict` refuses what it would accept with a warning.
 pub fn load_urdf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
+    load_urdf_options(
+        path,
+        LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        },
+    )
+}
+
+/// [`load_urdf`] with every [`LoadOptions`] (a free flyer under the root link).
+pub fn load_urdf_options(path: &Path, options: LoadOptions) -> Result<Model, ModelErrors> {
     let file = Some(path.display().to_string());
     let fail = |kind: ErrorKind| ModelErrors {
         file: file.clone(),
@@ -51,7 +73,7 @@ pub fn load_urdf_with(path: &Path, strict: bool) -> Result<Model, ModelErrors> {
         let bytes = std::fs::metadata(path).map_or(text.len() as u64, |m| m.len());
         return Err(fail(ErrorKind::TooLarge { bytes }));
     }
-    build(&text, strict).map_err(|errors| ModelErrors { file, errors })
+    build(&text, options).map_err(|errors| ModelErrors { file, errors })
 }
 
 /// The unchecked description of URDF text, before [`Description::build`]: for
@@ -65,8 +87,12 @@ pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
     Ok(desc)
 }
 
-fn build(text: &str, strict: bool) -> Result<Model, Vec<ModelError>> {
-    let (desc, robot_line, unsupported) = read(text)?;
+fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
+    let strict = options.strict;
+    let (mut desc, robot_line, unsupported) = read(text)?;
+    if options.free_flyer {
+        desc = desc.with_free_flyer();
+    }
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
     let mut errors = match desc.build_checked(SiblingOrder::Name, strict) {
         Ok(model) if unsupported.is_empty() => return Ok(model),
@@ -340,9 +366,9 @@ fn convert_type(t: &urdf_rs::JointType) -> DeclaredJointType {
         T::Continuous => DeclaredJointType::Moving(JointKind::Continuous),
         T::Prismatic => DeclaredJointType::Moving(JointKind::Prismatic),
         T::Fixed => DeclaredJointType::Fixed,
-        T::Floating => DeclaredJointType::Unsupported("floating".into()),
+        T::Floating => DeclaredJointType::Moving(JointKind::FreeFlyer),
         T::Planar => DeclaredJointType::Unsupported("planar".into()),
-        T::Spherical => DeclaredJointType::Unsupported("spherical".into()),
+        T::Spherical => DeclaredJointType::Moving(JointKind::Spherical),
     }
 }
 

@@ -242,7 +242,7 @@ fn zero_axis() {
 
 #[test]
 fn unsupported_joint_types() {
-    for kind in ["floating", "planar", "spherical"] {
+    for kind in ["planar"] {
         let text = robot(&[r#"<link name="base"/>"#, &link("a"), &joint("j", kind, "base", "a", "")]);
         let e = single(&text, Element::Joint("j".into()), 4);
         assert_eq!(e.kind, ErrorKind::UnsupportedJointType(kind.into()));
@@ -251,6 +251,95 @@ fn unsupported_joint_types() {
             "{e}"
         );
     }
+}
+
+#[test]
+fn floating_and_spherical_joints_have_their_coordinates() {
+    let text = robot(&[
+        r#"<link name="world"/>"#,
+        &link("trunk"),
+        &link("arm"),
+        &link("hand"),
+        &joint("free", "floating", "world", "trunk", ""),
+        &joint("shoulder", "spherical", "trunk", "arm", r#"<origin xyz="0 0.2 0"/>"#),
+        &joint(
+            "wrist",
+            "revolute",
+            "arm",
+            "hand",
+            r#"<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        ),
+    ]);
+    let model = parse_urdf(&text).unwrap();
+    let kinds: Vec<JointKind> = model.joints.iter().map(|j| j.kind).collect();
+    assert_eq!(kinds, [JointKind::FreeFlyer, JointKind::Spherical, JointKind::Revolute]);
+    assert!(model.is_floating());
+    assert_eq!((model.dof(), model.nq(), model.nv()), (3, 12, 10));
+    assert_eq!(
+        (
+            model.q_offset(2),
+            model.v_offset(2),
+            model.q_offset(3),
+            model.v_offset(3)
+        ),
+        (7, 6, 11, 9)
+    );
+    assert_eq!(
+        (model.joint_of_v(5), model.joint_of_v(6), model.joint_of_v(9)),
+        (1, 2, 3)
+    );
+    assert_eq!(model.joints[0].axis, [0.0; 3]);
+    assert_eq!(model.multi_dof_joint().map(|j| j.name.as_str()), Some("free"));
+}
+
+#[test]
+fn a_floating_joint_must_hang_from_the_root() {
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint(
+            "j",
+            "revolute",
+            "base",
+            "a",
+            r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        ),
+        &joint("free", "floating", "a", "b", ""),
+    ]);
+    let e = single(&text, Element::Joint("free".into()), 6);
+    assert_eq!(e.kind, ErrorKind::FreeFlyerNotAtRoot);
+    assert!(e.to_string().contains("must join the root link"), "{e}");
+}
+
+#[test]
+fn the_free_flyer_option_floats_the_root_link_as_pinocchio_does() {
+    let text = robot(&[
+        &link("base"),
+        &link("a"),
+        &joint(
+            "j",
+            "revolute",
+            "base",
+            "a",
+            r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        ),
+    ]);
+    let fixed = parse_urdf(&text).unwrap();
+    let options = dyngen_model::LoadOptions {
+        free_flyer: true,
+        ..Default::default()
+    };
+    let floating = dyngen_model::parse_urdf_options(&text, options).unwrap();
+    assert_eq!(fixed.dof(), 1);
+    assert_eq!((floating.dof(), floating.nq(), floating.nv()), (2, 8, 7));
+    assert_eq!(floating.base, dyngen_model::WORLD_LINK);
+    assert_eq!(floating.joints[0].name, dyngen_model::FREE_FLYER_JOINT);
+    assert_eq!(floating.joints[0].kind, JointKind::FreeFlyer);
+    // The root link's inertial now counts: it is body 1.
+    assert_eq!(floating.bodies[0].name, "base");
+    assert_eq!(floating.bodies[0].inertial.mass, 1.0);
+    assert_eq!(floating.joints[1].parent, 1);
 }
 
 #[test]
@@ -692,7 +781,7 @@ fn all_errors_of_a_file_are_reported_together() {
         &link("c"),
         &joint("ja", "continuous", "bsae", "a", ""),
         &joint("jb", "continuous", "base", "b", r#"<axis xyz="0 0 0"/>"#),
-        &joint("jc", "floating", "base", "c", ""),
+        &joint("jc", "planar", "base", "c", ""),
     ]);
     let e = parse_urdf(&text).unwrap_err();
     let kinds: Vec<(&Element, Option<usize>, &ErrorKind)> =
@@ -709,7 +798,7 @@ fn all_errors_of_a_file_are_reported_together() {
             (
                 &Element::Joint("jc".into()),
                 Some(8),
-                &ErrorKind::UnsupportedJointType("floating".into())
+                &ErrorKind::UnsupportedJointType("planar".into())
             ),
         ]
     );

@@ -21,6 +21,8 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     JointType::Revolute => JointKind::Revolute,
                     JointType::Continuous => JointKind::Continuous,
                     JointType::Prismatic => JointKind::Prismatic,
+                    JointType::Spherical => JointKind::Spherical,
+                    JointType::FreeFlyer => JointKind::FreeFlyer,
                 },
                 parent: j.parent,
                 origin: Placement {

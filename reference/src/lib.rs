@@ -115,6 +115,10 @@ impl Reference {
         Reference::new(&model_from_static(&R::MODEL))
     }
 
+    /// # Panics
+    /// If a joint has more than one degree of freedom (a free flyer or a ball joint,
+    /// [`Model::multi_dof_joint`]): the reference implementation is for trees of
+    /// one-coordinate joints; the generated code handles the others.
     pub fn new(model: &Model) -> Reference {
         let joints = model
             .joints
@@ -124,6 +128,12 @@ impl Reference {
                 let subspace = match j.kind {
                     JointKind::Revolute | JointKind::Continuous => stack(&Vector3::zeros(), &axis),
                     JointKind::Prismatic => stack(&axis, &Vector3::zeros()),
+                    JointKind::Spherical | JointKind::FreeFlyer => panic!(
+                        "joint `{}` is a {} joint: the reference implementation takes joints with one degree \
+                         of freedom (check `Model::multi_dof_joint` first)",
+                        j.name,
+                        j.kind.urdf_name()
+                    ),
                 };
                 JointData {
                     kind: j.kind,
@@ -170,6 +180,7 @@ impl Reference {
                 rotation: nalgebra::Matrix3::identity(),
                 translation: j.axis * q,
             },
+            JointKind::Spherical | JointKind::FreeFlyer => unreachable!("refused by `Reference::new`"),
         };
         j.origin.compose(&motion)
     }

@@ -26,6 +26,8 @@ fn check<R: Robot>(want: &Model) {
             JointKind::Revolute => JointType::Revolute,
             JointKind::Continuous => JointType::Continuous,
             JointKind::Prismatic => JointType::Prismatic,
+            JointKind::Spherical => JointType::Spherical,
+            JointKind::FreeFlyer => JointType::FreeFlyer,
         };
         assert_eq!(g.kind, kind, "{who}: {j} kind");
         assert_eq!(g.parent, w.parent, "{who}: {j} parent");

@@ -60,6 +60,7 @@ pub struct Config {
     file_name: Option<String>,
     gravity: Option<[f64; 3]>,
     strict: bool,
+    free_flyer: bool,
     options: Options,
 }
 
@@ -95,6 +96,14 @@ impl Config {
         self
     }
 
+    /// Put the description's root link on a free flyer: a floating base, as
+    /// Pinocchio's `buildModel(urdf, JointModelFreeFlyer())` (joint 1 `root_joint`,
+    /// `q = [p; x, y, z, w; joints]`, `v = [v; ω; joints]` in the base frame).
+    pub fn free_flyer(&mut self, free_flyer: bool) -> &mut Config {
+        self.free_flyer = free_flyer;
+        self
+    }
+
     /// Statements per generated function before it is split into parts (default 1200).
     pub fn max_statements(&mut self, n: usize) -> &mut Config {
         self.options.max_statements = n.max(1);
@@ -109,7 +118,11 @@ impl Config {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
         }
-        let model = dyngen_model::load_robot_with(&urdf, self.strict).map_err(Error::Model)?;
+        let options = dyngen_model::LoadOptions {
+            strict: self.strict,
+            free_flyer: self.free_flyer,
+        };
+        let model = dyngen_model::load_robot_options(&urdf, options).map_err(Error::Model)?;
         for w in &model.warnings {
             println!("cargo:warning={}: {}", urdf.display(), w.warning_message());
         }

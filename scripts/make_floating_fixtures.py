@@ -16,7 +16,9 @@ mirrored), `ddq = aba(q, v, tau_rand)` for a random `tau_rand`, the joint torque
 regressor `Y`, every body's placement `oMi`, every BODY frame's placement and
 LOCAL_WORLD_ALIGNED Jacobian, the centre of mass and its Jacobian, the centroidal
 map `Ag`, `dAg v` (computeCentroidalMapTimeVariation) and the centroidal momentum
-`Ag v`. Matrices are lists of rows; spatial vectors linear first.
+`Ag v`, the derivatives of rnea (`dtau_dq`, `dtau_dv` at `q, v, a`) and of aba
+(`ddq_dq`, `ddq_dv`, `Minv` at `q, v, tau_rand`), with respect to the tangent of the
+configuration (Pinocchio's convention: `q ⊕ δ`). Matrices are lists of rows; spatial vectors linear first.
 
 Before writing, the script checks Pinocchio's values against identities (`Y π = τ`,
 `M ddq + nle = τ`, the linear rows of `Ag` against `m J_com`, `Ag v` against the
@@ -130,7 +132,13 @@ def make(name, urdf, samples, seed):
         ag_m = pin.computeCentroidalMap(model, data, pin.integrate(model, q, -h * v)).copy()
         fd = (ag_p - ag_m) @ v / (2 * h)
         checks["dAg_fd"] = max(checks["dAg_fd"], float(np.abs(fd - dag_v).max()) / max(1.0, float(np.abs(dag_v).max())))
+        # Copies: both return views of data's buffers, which the next call overwrites.
+        dtau_dq, dtau_dv = (x.copy() for x in pin.computeRNEADerivatives(model, data, q, v, a)[:2])
+        ddq_dq, ddq_dv, minv = (x.copy() for x in pin.computeABADerivatives(model, data, q, v, tau_rand))
+        minv = np.triu(minv) + np.triu(minv, 1).T
         out_samples.append({
+            "dtau_dq": rows(dtau_dq), "dtau_dv": rows(dtau_dv), "ddq_dq": rows(ddq_dq), "ddq_dv": rows(ddq_dv),
+            "Minv": rows(minv),
             "q": flat(ours), "v": flat(v), "a": flat(a), "tau": flat(tau), "nle": flat(nle),
             "gravity": flat(grav), "M": rows(m), "tau_rand": flat(tau_rand), "ddq": flat(ddq), "Y": rows(y),
             "oMi": omi, "frames": frames, "com": flat(com), "Jcom": rows(jcom), "Ag": rows(ag),

@@ -88,7 +88,7 @@ pub enum Ddq {
 /// parameters from [`algo::ARG_Q`], [`algo::ARG_V`], [`algo::ARG_A`] and
 /// [`algo::ARG_PARAMS`], as [`algo::rnea`] with [`Inputs::Full`].
 pub fn rnea_derivatives<'g>(g: &'g Graph, model: &Model) -> RneaDerivatives<'g> {
-    let n = model.dof();
+    let n = model.nv();
     let k = algo::kinematics(g, model, Inputs::Full);
     let r = algo::rnea(g, model, Inputs::Full);
     let qd: Vec<Expr<'g>> = (0..n).map(|i| g.input(ARG_V, i as u32)).collect();
@@ -107,7 +107,7 @@ pub fn aba_derivatives<'g>(g: &'g Graph, model: &Model) -> AbaDerivatives<'g> {
 /// The inverse-dynamics derivatives are taken at `a = q̈`, given as expressions: what
 /// `q̈` itself depends on is not differentiated again.
 pub fn aba_derivatives_with<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaDerivatives<'g> {
-    let n = model.dof();
+    let n = model.nv();
     let AbaParts {
         ddq,
         dtau_dq: dq,
@@ -161,7 +161,7 @@ pub fn aba_joints_derivative_parts<'g>(g: &'g Graph, model: &Model) -> AbaParts<
 }
 
 fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<'g> {
-    let n = model.dof();
+    let n = model.nv();
     let mass_matrix = || {
         let mut m = algo::crba(g, model);
         if armature {
@@ -202,15 +202,6 @@ fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<
         dtau_dv: dv,
         minv,
     }
-}
-
-/// Joint `j`'s motion subspace, one column: the derivatives are built for models
-/// whose joints all have one degree of freedom ([`Model::multi_dof_joint`] is
-/// `None`; the generator does not emit them otherwise).
-fn one_dof<'g>(g: &'g Graph, model: &Model, j: usize) -> Motion<'g> {
-    let s = algo::subspace(g, model, j);
-    assert_eq!(s.len(), 1, "derivatives need joints with one degree of freedom");
-    s[0]
 }
 
 fn dot<'g>(a: &[Expr<'g>], b: &[Expr<'g>]) -> Expr<'g> {
@@ -300,13 +291,17 @@ pub fn rnea_partials<'g>(
     wrenches: &[Force<'g>],
 ) -> (Vec<Vec<Expr<'g>>>, Vec<Vec<Expr<'g>>>) {
     let n = model.dof();
-    assert_eq!(qd.len(), n, "one joint velocity per joint");
+    assert_eq!(qd.len(), model.nv(), "one velocity per velocity coordinate");
     let x = &k.x;
     g.mark("derivatives: spatial velocities and accelerations");
     let v = velocities(g, model, x, qd);
     // The spatial acceleration, gravity included: the classical acceleration of the
-    // frame origin minus ω × u.
+    // frame origin minus ω × u (the base at rest, accelerating at −g).
     let mut a = vec![Motion::zero(g); n + 1];
+    a[0] = Motion {
+        v: k.motion[0].acc,
+        w: V3::zero(g),
+    };
     for i in 1..=n {
         let m = &k.motion[i];
         a[i] = Motion {
@@ -336,9 +331,13 @@ fn spatial_partials<'g>(
     }];
     let mut f: Vec<Force<'g>> = Vec::with_capacity(n);
     for i in 1..=n {
-        let s = one_dof(g, model, i);
-        let bias = v[i].cross_motion(s.scale(qd[i - 1]));
-        let ai = x[i - 1].motion_to_child(a[model.parent(i)]) + bias + s.scale(qdd[i - 1]);
+        let dofs = algo::dofs(model, i);
+        let (vj, aj) = (
+            algo::subspace_times(g, model, i, &qd[dofs.clone()]),
+            algo::subspace_times(g, model, i, &qdd[dofs]),
+        );
+        let bias = v[i].cross_motion(vj);
+        let ai = x[i - 1].motion_to_child(a[model.parent(i)]) + bias + aj;
         let body = BodyParams::input(g, i);
         f.push(inertia_times(&body, ai) + v[i].cross_force(inertia_times(&body, v[i])));
         a.push(ai);
@@ -358,7 +357,8 @@ fn velocities<'g>(g: &'g Graph, model: &Model, x: &[JointTransform<'g>], qd: &[E
     let n = model.dof();
     let mut v = vec![Motion::zero(g); n + 1];
     for i in 1..=n {
-        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + one_dof(g, model, i).scale(qd[i - 1]);
+        let vj = algo::subspace_times(g, model, i, &qd[algo::dofs(model, i)]);
+        v[i] = x[i - 1].motion_to_child(v[model.parent(i)]) + vj;
     }
     v
 }
@@ -373,8 +373,10 @@ fn partials<'g>(
     a: &[Motion<'g>],
     wrenches: &[Force<'g>],
 ) -> (Vec<Vec<Expr<'g>>>, Vec<Vec<Expr<'g>>>) {
-    let n = model.dof();
-    let s: Vec<Motion<'g>> = (1..=n).map(|j| one_dof(g, model, j)).collect();
+    let (n, nv) = (model.dof(), model.nv());
+    // Per velocity coordinate d: its body, its motion S_d in that body's frame.
+    let body: Vec<usize> = (0..nv).map(|d| model.joint_of_v(d)).collect();
+    let s: Vec<Motion<'g>> = (1..=n).flat_map(|j| algo::subspace(g, model, j)).collect();
     g.mark("derivatives: composite inertias, inertia rates and momenta");
     let own: Vec<BodyParams<'g>> = (1..=n).map(|j| BodyParams::input(g, j)).collect();
     let ic = composites(model, x, own.clone());
@@ -387,22 +389,64 @@ fn partials<'g>(
         }
     }
     let two = g.constant(2.0);
-    let beta: Vec<Motion<'g>> = (1..=n).map(|j| v[j].cross_motion(s[j - 1])).collect();
-    let alpha: Vec<Motion<'g>> = (1..=n)
-        .map(|j| a[j].cross_motion(s[j - 1]) + v[j].cross_motion(beta[j - 1]))
+    // Changing a coordinate of joint k turns what comes in from the parent: β and α
+    // are taken at the motion coming in to body k. For a joint with one degree of
+    // freedom that is the body's own motion (S × S = 0 makes the two equal); a ball
+    // joint or a free flyer takes the parent's motion seen in frame k.
+    let incoming: Vec<(Motion<'g>, Motion<'g>)> = (1..=n)
+        .map(|j| {
+            if model.joints[j - 1].kind.has_axis() {
+                (v[j], a[j])
+            } else {
+                let p = model.parent(j);
+                (x[j - 1].motion_to_child(v[p]), x[j - 1].motion_to_child(a[p]))
+            }
+        })
         .collect();
-    let ccs: Vec<Force<'g>> = (1..=n).map(|j| inertia_times(&cc[j - 1], s[j - 1])).collect();
-    let mut dq = vec![vec![g.zero(); n]; n];
-    let mut dv = vec![vec![g.zero(); n]; n];
-    // Row j, columns k on the path from j to the root (j included).
-    for j in 1..=n {
-        g.mark(format!("derivatives: row {j}, joints from {j} to the root"));
-        let mut rho = inertia_times(&ic[j - 1], s[j - 1]);
-        let mut sigma = force_sub(ccs[j - 1], s[j - 1].cross_force(hc[j - 1]));
+    let beta: Vec<Motion<'g>> = (0..nv).map(|d| incoming[body[d] - 1].0.cross_motion(s[d])).collect();
+    let alpha: Vec<Motion<'g>> = (0..nv)
+        .map(|d| {
+            let (vi, ai) = incoming[body[d] - 1];
+            ai.cross_motion(s[d]) + vi.cross_motion(beta[d])
+        })
+        .collect();
+    // Changing a velocity moves the subtree by S_e: its own bias acceleration changes by
+    // β (the incoming motion's) and the joints below add the turn of S_e at the body's
+    // own velocity; for one degree of freedom both are β, hence 2β.
+    let beta_v: Vec<Motion<'g>> = (0..nv)
+        .map(|d| {
+            let b = body[d];
+            if model.joints[b - 1].kind.has_axis() {
+                let two = g.constant(2.0);
+                Motion {
+                    v: beta[d].v.scale(two),
+                    w: beta[d].w.scale(two),
+                }
+            } else {
+                beta[d] + v[b].cross_motion(s[d])
+            }
+        })
+        .collect();
+    let ccs: Vec<Force<'g>> = (0..nv).map(|d| inertia_times(&cc[body[d] - 1], s[d])).collect();
+    let mut dq = vec![vec![g.zero(); nv]; nv];
+    let mut dv = vec![vec![g.zero(); nv]; nv];
+    // Row d, columns of the joints on the path from d's joint to the root (its own
+    // joint included).
+    for d in 0..nv {
+        let j = body[d];
+        g.mark(format!("derivatives: row {}, joints from {j} to the root", d + 1));
+        let mut rho = inertia_times(&ic[j - 1], s[d]);
+        let mut sigma = force_sub(ccs[d], s[d].cross_force(hc[j - 1]));
         let mut c = j;
         loop {
-            dq[j - 1][c - 1] = rho.dot(alpha[c - 1]) + sigma.dot(beta[c - 1]);
-            dv[j - 1][c - 1] = two * rho.dot(beta[c - 1]) + sigma.dot(s[c - 1]);
+            for e in algo::dofs(model, c) {
+                dq[d][e] = rho.dot(alpha[e]) + sigma.dot(beta[e]);
+                dv[d][e] = if model.joints[c - 1].kind.has_axis() {
+                    two * rho.dot(beta[e]) + sigma.dot(s[e])
+                } else {
+                    rho.dot(beta_v[e]) + sigma.dot(s[e])
+                };
+            }
             let p = model.parent(c);
             if p == 0 {
                 break;
@@ -412,25 +456,32 @@ fn partials<'g>(
             c = p;
         }
     }
-    // Column c, rows strictly above it.
-    for c in 1..=n {
+    // Column e, rows of the joints strictly above e's joint.
+    for e in 0..nv {
+        let c = body[e];
         if model.parent(c) == 0 {
             continue;
         }
-        g.mark(format!("derivatives: column {c}, joints above {c}"));
-        let (h, sc, be) = (hc[c - 1], s[c - 1], beta[c - 1]);
-        let mut gq = inertia_times(&ic[c - 1], alpha[c - 1])
+        g.mark(format!("derivatives: column {}, joints above {c}", e + 1));
+        let (h, sc, be) = (hc[c - 1], s[e], beta[e]);
+        let mut gq = inertia_times(&ic[c - 1], alpha[e])
             + inertia_times(&cc[c - 1], be)
             + be.cross_force(h)
             + sc.cross_force(wrenches[c - 1]);
-        let mut gv = force_scale(inertia_times(&ic[c - 1], be), two) + ccs[c - 1] + sc.cross_force(h);
+        let mut gv = if model.joints[c - 1].kind.has_axis() {
+            force_scale(inertia_times(&ic[c - 1], be), two) + ccs[e] + sc.cross_force(h)
+        } else {
+            inertia_times(&ic[c - 1], beta_v[e]) + ccs[e] + sc.cross_force(h)
+        };
         let mut j = c;
         while model.parent(j) != 0 {
             gq = x[j - 1].force_to_parent(gq);
             gv = x[j - 1].force_to_parent(gv);
             j = model.parent(j);
-            dq[j - 1][c - 1] = gq.dot(s[j - 1]);
-            dv[j - 1][c - 1] = gv.dot(s[j - 1]);
+            for (d, sd) in algo::dofs(model, j).zip(algo::subspace(g, model, j)) {
+                dq[d][e] = gq.dot(sd);
+                dv[d][e] = gv.dot(sd);
+            }
         }
     }
     (dq, dv)
@@ -440,10 +491,27 @@ fn partials<'g>(
 /// `LᵀDL` factorisation of a tree (Featherstone, RBDA §6.5): `M = Lᵀ D L` with `L`
 /// unit lower triangular and nonzero only where a joint supports another, so no
 /// fill-in; `M⁻¹ = L⁻¹ D⁻¹ L⁻ᵀ`, where `L⁻¹` has the same sparsity. One division per
-/// joint. Symmetric: the upper triangle is built and mirrored.
+/// velocity coordinate. Symmetric: the upper triangle is built and mirrored.
 pub fn inverse_inertia<'g>(g: &'g Graph, model: &Model, m: &[Vec<Expr<'g>>]) -> Vec<Vec<Expr<'g>>> {
-    let n = model.dof();
-    let parent = |i: usize| model.parent(i);
+    let n = model.nv();
+    // The tree of velocity coordinates (1-based, 0 the base): a ball joint's or a free
+    // flyer's coordinates form a chain, the first one hanging from the last
+    // coordinate of the parent joint (Featherstone's expanded tree), so `M` still
+    // factors without fill-in.
+    let parents: Vec<usize> = (0..n)
+        .map(|d| {
+            let j = model.joint_of_v(d);
+            if d > model.v_offset(j) {
+                d
+            } else {
+                match model.parent(j) {
+                    0 => 0,
+                    p => model.v_offset(p) + model.joints[p - 1].kind.nv(),
+                }
+            }
+        })
+        .collect();
+    let parent = |i: usize| parents[i - 1];
     g.mark("inverse of M: LᵀDL factorisation");
     // In place: the diagonal becomes D, the entries below it (joint k, ancestor i) L.
     let mut h: Vec<Vec<Expr<'g>>> = m.to_vec();

@@ -729,17 +729,10 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     functions.extend(joints.reports);
     items.extend(joints.items);
     methods.extend(joints.methods);
-    // The derivatives (closed form over one-coordinate joints) are generated when
-    // every joint has one degree of freedom; the type then implements
-    // `dyngen::RobotDerivatives`.
-    let derivatives = if model.multi_dof_joint().is_none() {
-        let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
-        functions.extend(derivative_reports);
-        items.extend(derivative_items);
-        Some(derivative_methods(sizes.n))
-    } else {
-        None
-    };
+    let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
+    functions.extend(derivative_reports);
+    items.extend(derivative_items);
+    let derivatives = Some(derivative_methods(sizes.nv));
     let ty = format_ident!("{}", name);
     let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
     functions.extend(frames.reports);
@@ -779,16 +772,15 @@ fn derivative_items(
     // 772 ns, but the UR5's and rnea_derivatives got slower); rnea_derivatives was
     // unchanged within 2 %. rustc schedules large straight-line functions poorly.
     let max_statements = max_statements.min(DERIVATIVE_MAX_STATEMENTS);
-    // Only models whose joints all have one degree of freedom get these, so
-    // n = nq = nv.
-    let n = sizes.n;
-    let (n_l, np_l) = (emit::usize_lit(n), emit::usize_lit(10 * n));
+    // Rows and columns go by velocity coordinate.
+    let n = sizes.nv;
+    let (n_l, nq_l, np_l) = (emit::usize_lit(n), emit::usize_lit(sizes.nq), emit::usize_lit(10 * sizes.n));
     let arg = |id, name, len| Arg { id, name, len };
     let (q, v, a, params) = (
-        arg(ARG_Q, "q", n),
+        arg(ARG_Q, "q", sizes.nq),
         arg(ARG_V, "v", n),
         arg(ARG_A, "a", n),
-        arg(ARG_PARAMS, "params", 10 * n),
+        arg(ARG_PARAMS, "params", 10 * sizes.n),
     );
     // Output `k` of a list of n × n matrices (and leading vectors) stored in the
     // fields `fields` of `out`.
@@ -849,13 +841,13 @@ fn derivative_items(
     outputs.extend(ids(&d.dtau_dv));
     outputs.extend(ids(&d.minv));
     let (q, v, tau, params) = (
-        arg(ARG_Q, "q", n),
+        arg(ARG_Q, "q", sizes.nq),
         arg(ARG_V, "v", n),
         arg(ARG_TAU, "tau", n),
-        arg(ARG_PARAMS, "params", 10 * n),
+        arg(ARG_PARAMS, "params", 10 * sizes.n),
     );
     let aba_doc = doc_attrs(&format!(
-        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per joint); the two products with it run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per velocity coordinate); the two products with it run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
         sizes.params()
     ));
     let spec = FnSpec {
@@ -878,7 +870,7 @@ fn derivative_items(
             #aba_doc
             #[inline]
             pub fn aba_derivatives<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
+                q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
                 Self::__aba_derivative_parts(q, v, tau, params, out);
@@ -908,10 +900,10 @@ fn derivative_items(
         public: false,
         doc: "The generated part of [`Self::aba_joints_derivatives`].".to_string(),
         args: vec![
-            arg(ARG_Q, "q", n),
+            arg(ARG_Q, "q", sizes.nq),
             arg(ARG_V, "v", n),
             arg(ARG_TAU, "tau", n),
-            arg(ARG_PARAMS, "params", 10 * n),
+            arg(ARG_PARAMS, "params", 10 * sizes.n),
             arg(ARG_JOINT_PARAMS, "joint_params", 4 * n),
         ],
         ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
@@ -934,7 +926,7 @@ fn derivative_items(
             #joints_doc
             #[inline]
             pub fn aba_joints_derivatives<S: ::dyngen::Scalar>(
-                q: &[S; #n_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
+                q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                 joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
@@ -963,7 +955,7 @@ fn derivative_items(
             "`M(q)⁻¹` ({n} × {n}, symmetric; Pinocchio's `computeMinverse`) from the tree's `LᵀDL`\nfactorisation of [`Self::crba`]'s matrix, written to `out`. {}.",
             sizes.params()
         ),
-        args: vec![arg(ARG_Q, "q", n), arg(ARG_PARAMS, "params", 10 * n)],
+        args: vec![arg(ARG_Q, "q", sizes.nq), arg(ARG_PARAMS, "params", 10 * sizes.n)],
         ret: quote!([[S; #n_l]; #n_l]),
         output: emit::matrix_output(n),
         outputs: ids(&minv),

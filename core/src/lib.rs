@@ -6,8 +6,10 @@
 //! [`FrameMotion`], [`Motion`] in a [`ReferenceFrame`], [`RneaDerivatives`],
 //! [`AbaDerivatives`] and the [`Linearization`] of a time step, [`log3`]), the model a
 //! generated robot carries ([`RobotModel`]), the joint models beyond rigid bodies
-//! ([`JointParams`], [`Coulomb`]), and the [`robot!`] macro. `no_std`: maths come from the standard library (feature `std`, the default)
-//! or from `libm` (feature `libm`).
+//! ([`JointParams`], [`Coulomb`]), the operations on configurations with a floating
+//! base or ball joints ([`configuration`]: integrate, difference, neutral, normalize,
+//! as Pinocchio's), and the [`robot!`] macro. `no_std`: maths come from the standard
+//! library (feature `std`, the default) or from `libm` (feature `libm`).
 //!
 //! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a
 //! URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
@@ -23,6 +25,7 @@ extern crate std;
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos, sqrt and tanh");
 
+pub mod configuration;
 mod derivatives;
 mod frames;
 mod joints;

@@ -259,40 +259,6 @@ fn only_error(text: &str, element: Element, line: usize, says: &str) -> ErrorKin
 }
 
 #[test]
-fn ball_joint_is_refused() {
-    let text = mjcf(&[
-        "<body name=\"a\">",
-        INERTIAL,
-        "<joint name=\"j\" type=\"ball\"/>",
-        "</body>",
-    ]);
-    only_error(
-        &text,
-        Element::Joint("j".into()),
-        5,
-        "joint type `ball` is not supported yet",
-    );
-}
-
-#[test]
-fn free_joints_are_refused() {
-    let text = mjcf(&[
-        "<body name=\"a\">",
-        INERTIAL,
-        "<joint name=\"f\" type=\"free\"/>",
-        "</body>",
-    ]);
-    only_error(
-        &text,
-        Element::Joint("f".into()),
-        5,
-        "joint type `free` is not supported yet",
-    );
-    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<freejoint name=\"f\"/>", "</body>"]);
-    only_error(&text, Element::Joint("f".into()), 5, "<freejoint> is not supported yet");
-}
-
-#[test]
 fn two_joints_in_one_body_are_refused() {
     let text = mjcf(&[
         "<body name=\"a\">",
@@ -411,7 +377,7 @@ fn errors_are_all_collected_with_the_file_name() {
     let path = dir.join("bad.xml");
     let text = mjcf(&[
         "<body name=\"a\">",
-        "<joint name=\"b\" type=\"ball\"/>",
+        "<joint name=\"b\" ref=\"0.5\"/>",
         INERTIAL,
         "<body name=\"c\"><joint name=\"d\"/></body>",
         "</body>",
@@ -422,7 +388,10 @@ fn errors_are_all_collected_with_the_file_name() {
     let message = e.to_string();
     let lines: Vec<&str> = message.lines().collect();
     assert_eq!(lines.len(), 2, "{message}");
-    assert!(lines[0].ends_with("bad.xml:4: joint `b`: joint type `ball` is not supported yet; only hinge and slide joints are (a ball joint is three hinges about orthogonal axes through one point, in a chain of bodies)"), "{message}");
+    assert!(
+        lines[0].ends_with("bad.xml:4: joint `b`: a joint `ref` (0.5) is not supported yet: it moves the joint's zero; rotate or move the body to the reference position instead"),
+        "{message}"
+    );
     assert!(
         lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"),
         "{message}"
@@ -560,4 +529,233 @@ fn orientations_are_mujocos() {
         let d = max_abs_diff(&flat3(&model.joints[0].origin.rotation), &expected);
         assert!(d < 1e-15, "{seq} {attr}: {d:e}");
     }
+}
+
+// ---------------------------------------------------------------------------------
+// Ball and free joints.
+
+/// A torso on the free joint `free` (a `<joint type="free">` or a `<freejoint>`),
+/// with `body_attrs`, and an arm on a hinge below it.
+fn free_body(free: &str, body_attrs: &str) -> String {
+    mjcf(&[
+        &format!("<body name=\"torso\" {body_attrs}>"),
+        free,
+        INERTIAL,
+        "<body name=\"arm\" pos=\"0 0 0.5\">",
+        "<joint name=\"j\" axis=\"1 0 0\"/>",
+        INERTIAL,
+        "</body>",
+        "</body>",
+    ])
+}
+
+#[test]
+fn a_free_joint_is_a_free_flyer_from_the_world() {
+    let short = parse_mjcf(&free_body("<freejoint name=\"f\"/>", "")).unwrap();
+    assert_eq!(short.joints[0].kind, JointKind::FreeFlyer);
+    assert_eq!((short.nq(), short.nv()), (8, 7));
+    assert!(short.is_floating());
+    // `<joint type="free">` is the same joint; MuJoCo ignores its pos and axis.
+    let long = parse_mjcf(&free_body(
+        "<joint name=\"f\" type=\"free\" pos=\"1 2 3\" axis=\"1 0 0\"/>",
+        "",
+    ))
+    .unwrap();
+    assert_eq!(long, short);
+    // The body's placement is MuJoCo's qpos0 alone: the model does not change.
+    let moved = parse_mjcf(&free_body(
+        "<freejoint name=\"f\"/>",
+        "pos=\"1 2 3\" euler=\"10 20 30\"",
+    ))
+    .unwrap();
+    assert_eq!(moved, short);
+    // Damping and friction of a `free` joint are kept; `<freejoint>` has none.
+    let damped = parse_mjcf(&free_body(
+        "<joint name=\"f\" type=\"free\" damping=\"2\" frictionloss=\"0.5\"/>",
+        "",
+    ))
+    .unwrap();
+    assert_eq!(
+        (damped.joints[0].dynamics.damping, damped.joints[0].dynamics.friction),
+        (2.0, 0.5)
+    );
+    // A class may make a joint free.
+    let text = format!(
+        "<mujoco><default><default class=\"float\"><joint type=\"free\"/></default></default><worldbody>\
+         <body name=\"torso\"><joint name=\"f\" class=\"float\"/>{INERTIAL}</body></worldbody></mujoco>"
+    );
+    assert_eq!(parse_mjcf(&text).unwrap().joints[0].kind, JointKind::FreeFlyer);
+}
+
+#[test]
+fn a_ball_joint_is_spherical_about_its_pos() {
+    let ball = |attrs: &str| {
+        mjcf(&[
+            "<body name=\"a\" pos=\"0 0 1\" euler=\"0 0 90\">",
+            &format!("<joint name=\"b\" type=\"ball\" pos=\"0.1 0 0\" {attrs}/>"),
+            INERTIAL,
+            "</body>",
+        ])
+    };
+    let model = parse_mjcf(&ball("axis=\"1 0 0\" limited=\"false\" range=\"0 60\"")).unwrap();
+    let joint = &model.joints[0];
+    assert_eq!(
+        (joint.kind, joint.axis, joint.limits),
+        (JointKind::Spherical, [0.0; 3], None)
+    );
+    assert_eq!((model.nq(), model.nv()), (4, 3));
+    // Rz(90°) takes the pos 0.1 0 0 to 0 0.1 0.
+    assert!(max_abs_diff(&joint.origin.translation, &[0.0, 0.1, 1.0]) < 1e-15);
+    // The body's inertial sits in the joint frame: its centre moves by -pos.
+    assert!(max_abs_diff(&model.bodies[0].inertial.com, &[-0.1, 0.0, 0.0]) < 1e-15);
+    assert!(model.warnings.is_empty());
+    // A range in effect (autolimits, or limited="true", even without a range as
+    // MuJoCo allows for a ball) is left out with a warning; no range, no warning.
+    for attrs in ["range=\"0 60\"", "limited=\"true\" range=\"0 60\"", "limited=\"true\""] {
+        let model = parse_mjcf(&ball(attrs)).unwrap();
+        assert_eq!(model.warnings.len(), 1, "{attrs}");
+        let w = model.warnings[0].warning_message();
+        assert!(w.starts_with("line 4: joint `b`: the limit of this ball joint"), "{w}");
+    }
+    assert!(parse_mjcf(&ball("")).unwrap().warnings.is_empty());
+}
+
+#[test]
+fn a_free_joint_below_the_top_level_is_refused() {
+    // Under a moving body (the description's own check would catch this too).
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "<body name=\"b\" pos=\"0 0 1\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "</body>",
+        "</body>",
+    ]);
+    let kind = only_error(&text, Element::Joint("f".into()), 8, "must join the root link");
+    assert_eq!(kind, ErrorKind::FreeFlyerNotAtRoot);
+    // Under a jointless body: MuJoCo refuses it ("free joint can only be used on top
+    // level") though the body is fixed to the world.
+    let text = mjcf(&[
+        "<body name=\"stand\">",
+        "<body name=\"b\">",
+        "<joint name=\"f\" type=\"free\"/>",
+        INERTIAL,
+        "</body>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("f".into()),
+        5,
+        "(in MJCF: a free joint only in a body directly in <worldbody>, before any other moving joint)",
+    );
+    // With the file name and line, as for URDF.
+    let dir = std::env::temp_dir().join(format!("dyngen-mjcf-free-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("nested.xml");
+    std::fs::write(&path, &text).unwrap();
+    let e = load_mjcf(&path).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let message = e.to_string();
+    assert_eq!(message.lines().count(), 1, "{message}");
+    assert!(
+        message.ends_with(
+            "nested.xml:5: joint `f`: a floating (free-flyer) joint must join the root link to the robot's first \
+             body, and only one may (in MJCF: a free joint only in a body directly in <worldbody>, before any \
+             other moving joint); make it the joint of the root link's child, or leave the base fixed"
+        ),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_free_body_after_a_moving_one_is_refused() {
+    // Top level, as MuJoCo allows, but not the first moving joint: the model floats
+    // one base at most, on joint 1.
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "</body>",
+        "<body name=\"b\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "</body>",
+    ]);
+    let kind = only_error(&text, Element::Joint("f".into()), 9, "must join the root link");
+    assert_eq!(kind, ErrorKind::FreeFlyerNotAtRoot);
+    // Nor with the free flyer of `LoadOptions::free_flyer` on top.
+    let options = dyngen_model::LoadOptions {
+        free_flyer: true,
+        ..Default::default()
+    };
+    let e = dyngen_model::parse_mjcf_options(&free_body("<freejoint name=\"f\"/>", ""), options).unwrap_err();
+    assert_eq!(e.errors.len(), 1, "{e}");
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Joint("f".into()), Some(4))
+    );
+    assert!(
+        e.to_string()
+            .contains("line 4: joint `f`: body `torso` already floats on this free joint; the free-flyer load option"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_free_body_aligned_with_its_inertia_is_refused() {
+    let alone = |compiler: &str, free: &str| {
+        format!(
+            "<mujoco>\n{compiler}\n<worldbody>\n<body name=\"a\">\n{free}\n{INERTIAL}\n</body>\n</worldbody>\n</mujoco>\n"
+        )
+    };
+    let says = "body `a` would be aligned with its principal axes of inertia";
+    only_error(
+        &alone("", "<freejoint name=\"f\" align=\"true\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    let aligned = "<compiler alignfree=\"true\"/>";
+    only_error(
+        &alone(aligned, "<freejoint name=\"f\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    only_error(
+        &alone(aligned, "<joint name=\"f\" type=\"free\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    only_error(
+        &alone("", "<freejoint name=\"f\" align=\"maybe\"/>"),
+        Element::Joint("f".into()),
+        5,
+        "<freejoint align=\"maybe\"> is not `true`, `false` or `auto`",
+    );
+    // align="false" keeps the frame; MuJoCo does not align a body with children.
+    assert!(parse_mjcf(&alone(aligned, "<freejoint name=\"f\" align=\"false\"/>")).is_ok());
+    let with_child = free_body("<freejoint name=\"f\" align=\"true\"/>", "");
+    assert!(parse_mjcf(&with_child).unwrap().is_floating());
+}
+
+#[test]
+fn a_free_joint_with_another_joint_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "<joint name=\"j\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("j".into()),
+        6,
+        "body `a` already has a joint; several joints in one body are not supported yet",
+    );
 }

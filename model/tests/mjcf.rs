@@ -2,8 +2,10 @@
 //! URDF's model (to MuJoCo's printed rounding), the mass matrix and bias forces of the
 //! models read from MJCF equal MuJoCo's (`tests/fixtures/mjcf/*.json`, written by
 //! `scripts/make_mjcf_fixtures.py`), the hand-written `small.xml` gives its documented
-//! numbers, and one test per refused construct checks the message names the element
-//! and its line.
+//! numbers, the hand-written `floating.xml` (a free flyer and a ball joint) gives its
+//! documented model and MuJoCo's mass matrix and bias forces in dyngen's coordinates,
+//! and one test per refused construct checks the message names the element and its
+//! line.
 
 use dyngen_model::regressor::joint_torque_regressor;
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
@@ -533,6 +535,171 @@ fn orientations_are_mujocos() {
 
 // ---------------------------------------------------------------------------------
 // Ball and free joints.
+
+/// The 1-based number of the first line of `text` holding `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).expect(needle) + 1
+}
+
+fn rotation_xyz(a: f64, b: f64, c: f64) -> [[f64; 3]; 3] {
+    use dyngen_model::math::mat_mul;
+    let (sa, ca) = a.sin_cos();
+    let (sb, cb) = b.sin_cos();
+    let (sc, cc) = c.sin_cos();
+    let rx = [[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]];
+    let ry = [[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]];
+    let rz = [[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]];
+    mat_mul(&mat_mul(&rx, &ry), &rz)
+}
+
+#[test]
+fn floating_gives_its_documented_model() {
+    use dyngen_model::math::{mat_vec, IDENTITY};
+    let text = std::fs::read_to_string(fixture("floating.xml")).unwrap();
+    let model = load_mjcf(&fixture("floating.xml")).unwrap();
+    assert_eq!((model.name.as_str(), model.base.as_str()), ("floating", "world"));
+    assert!(model.is_floating());
+    let kinds: Vec<(&str, JointKind, usize)> = model
+        .joints
+        .iter()
+        .map(|j| (j.name.as_str(), j.kind, j.parent))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            ("root", JointKind::FreeFlyer, 0),
+            ("shoulder", JointKind::Spherical, 1),
+            ("elbow", JointKind::Revolute, 2),
+            ("wrist", JointKind::Prismatic, 3),
+        ]
+    );
+    assert_eq!((model.nq(), model.nv(), model.dof()), (13, 11, 4));
+    let q_offsets: Vec<usize> = (1..=4).map(|j| model.q_offset(j)).collect();
+    let v_offsets: Vec<usize> = (1..=4).map(|j| model.v_offset(j)).collect();
+    assert_eq!((q_offsets, v_offsets), (vec![0, 7, 11, 12], vec![0, 6, 9, 10]));
+    let close = |a: &[f64], b: &[f64]| max_abs_diff(a, b) < 1e-15;
+
+    // The free flyer: from the world's origin whatever the torso's pos and quat.
+    let [root, shoulder, elbow, wrist] = [0, 1, 2, 3].map(|k| &model.joints[k]);
+    assert_eq!(root.origin, dyngen_model::Placement::IDENTITY);
+    assert_eq!((root.axis, root.limits), ([0.0; 3], None));
+    // The ball joint: the upper arm's placement moved to the joint pos; no axis, no
+    // limits (its range left out with a warning), its damping kept.
+    let r = rotation_xyz(0.3, -0.2, 0.1);
+    assert!(close(&flat3(&shoulder.origin.rotation), &flat3(&r)));
+    let at = mat_vec(&r, &[0.0, 0.03, 0.02]);
+    assert!(close(
+        &shoulder.origin.translation,
+        &[0.05 + at[0], 0.2 + at[1], 0.18 + at[2]]
+    ));
+    assert_eq!((shoulder.axis, shoulder.limits), ([0.0; 3], None));
+    assert_eq!(shoulder.dynamics.damping, 0.2);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let w = &model.warnings[0];
+    let shoulder_line = line_of(&text, "name=\"shoulder\"");
+    assert_eq!(
+        (&w.element, w.line),
+        (&Element::Joint("shoulder".into()), Some(shoulder_line))
+    );
+    assert!(matches!(w.kind, ErrorKind::Ignored(_)));
+    assert!(
+        w.warning_message().ends_with(
+            "the limit of this ball joint (range 0 1.5) is left out: the model has no limits for ball joints"
+        ),
+        "{}",
+        w.warning_message()
+    );
+    // The elbow: the forearm's placement (below the shoulder's pos) moved to its pos.
+    assert!(close(&flat3(&elbow.origin.rotation), &flat3(&IDENTITY)));
+    assert!(close(&elbow.origin.translation, &[0.0, -0.02, -0.305]));
+    assert_eq!(elbow.axis, [0.0, 1.0, 0.0]);
+    let l = elbow.limits.unwrap();
+    assert_eq!((l.lower, l.upper), (-2.5, 0.1));
+    // The wrist: a slide along (0.2 0 1), normalised, below the elbow's pos.
+    assert!(close(&wrist.origin.translation, &[0.0, 0.0, -0.275]));
+    let n = 1.04f64.sqrt();
+    assert!(close(&wrist.axis, &[0.2 / n, 0.0, 1.0 / n]));
+    assert_eq!(wrist.limits.map(|l| (l.lower, l.upper)), Some((-0.05, 0.05)));
+
+    // The fullinertia of the forearm, as written, its centre in the elbow's frame.
+    let forearm = &model.bodies[2].inertial;
+    assert_eq!(forearm.mass, 0.9);
+    assert!(close(&forearm.com, &[0.01, 0.0, -0.135]));
+    assert!(close(
+        &flat3(&forearm.inertia),
+        &[0.009, 0.0002, -0.0004, 0.0002, 0.0095, 0.0001, -0.0004, 0.0001, 0.0012]
+    ));
+    assert_eq!(model.bodies[0].merged, ["head"]);
+    assert!((model.bodies[0].inertial.mass - 7.6).abs() < 1e-15);
+    let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["world", "torso", "head", "upper_arm", "forearm", "hand"]);
+}
+
+/// The largest magnitude in `x`.
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0f64, |m, y| m.max(y.abs()))
+}
+
+/// Mass matrix (columns `τ(q, 0, e_k)` without gravity) and bias `τ(q, v, 0)` with
+/// it, for any model (`nq` positions, `nv` velocities).
+fn floating_dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let nv = model.nv();
+    let mut weightless = model.clone();
+    weightless.gravity = [0.0; 3];
+    let zero = vec![0.0; nv];
+    let mut m = vec![vec![0.0; nv]; nv];
+    for k in 0..nv {
+        let mut e = zero.clone();
+        e[k] = 1.0;
+        for (r, x) in torque(&weightless, q, &zero, &e).into_iter().enumerate() {
+            m[r][k] = x;
+        }
+    }
+    (m, torque(model, q, v, &zero))
+}
+
+/// MuJoCo's mass matrix and bias forces of `floating.xml`, converted to dyngen's
+/// coordinates by the script (quaternions `x y z w`, the free joint's linear velocity
+/// in the body frame, `M = T⁻ᵀ M_mj T⁻¹`, `b = T⁻ᵀ b_mj + M [ω × v; 0]`), equal the
+/// regressor's on the model read from the same file.
+#[test]
+fn floating_mass_matrix_and_bias_equal_mujocos() {
+    let model = load_mjcf(&fixture("floating.xml")).unwrap();
+    let text = std::fs::read_to_string(fixture("floating.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let joints: Vec<&str> = reference["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
+    let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(ours, joints);
+    assert_eq!(
+        (model.nq() as u64, model.nv() as u64),
+        (reference["nq"].as_u64().unwrap(), reference["nv"].as_u64().unwrap())
+    );
+    assert_eq!(model.gravity.to_vec(), numbers(&reference["gravity"]));
+    let (mut dm, mut db) = (0.0f64, 0.0f64);
+    let samples = reference["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 3);
+    for s in samples {
+        let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        // Unit quaternions, stored x y z w.
+        for qa in [3, 7] {
+            let norm: f64 = q[qa..qa + 4].iter().map(|x| x * x).sum();
+            assert!((norm - 1.0).abs() < 1e-15);
+        }
+        let (m, bias) = floating_dynamics(&model, &q, &v);
+        let m: Vec<f64> = m.into_iter().flatten().collect();
+        let (m_ref, bias_ref) = (numbers(&s["M"]), numbers(&s["bias"]));
+        dm = dm.max(max_abs_diff(&m, &m_ref) / max_abs(&m_ref));
+        db = db.max(max_abs_diff(&bias, &bias_ref) / max_abs(&bias_ref));
+    }
+    eprintln!("floating: |M - M_mujoco| / |M_mujoco| <= {dm:.2e}, |b - b_mujoco| / |b_mujoco| <= {db:.2e}");
+    // MuJoCo reads the hand-written numbers exactly: only rounding is left.
+    assert!(dm <= 1e-12 && db <= 1e-12, "M {dm:e}, bias {db:e}");
+}
 
 /// A torso on the free joint `free` (a `<joint type="free">` or a `<freejoint>`),
 /// with `body_attrs`, and an arm on a hinge below it.

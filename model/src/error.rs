@@ -97,15 +97,16 @@ pub enum ErrorKind {
         friction: f64,
     },
     NoMovingJoint,
-    /// An MJCF construct the MJCF front end does not read yet (ball and free joints,
-    /// several joints in one body, `<include>`, `<frame>`): what it is and what to do.
+    /// An MJCF construct the MJCF front end does not read yet (several joints in one
+    /// body, `<include>`, `<frame>`, a free body aligned with its inertia): what it is
+    /// and what to do.
     NotSupported(String),
     /// An MJCF `class` or `childclass` naming no `<default class>`.
     UnknownClass(String),
     /// An MJCF element or attribute that is not valid MJCF: what is wrong.
     InvalidMjcf(String),
     /// Something the description says that the model cannot hold and leaves out
-    /// (an MJCF joint's `armature`): only ever a warning.
+    /// (an MJCF joint's `armature`, a ball joint's `range`): only ever a warning.
     Ignored(String),
 }
 
@@ -183,7 +184,9 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::FreeFlyerNotAtRoot => write!(
                 f,
-                "a floating (free-flyer) joint must join the root link to the robot's first body, and only one may;                  make it the joint of the root link's only child, or leave the base fixed"
+                "a floating (free-flyer) joint must join the root link to the robot's first body, and only one may \
+                 (in MJCF: a free joint only in a body directly in <worldbody>, before any other moving joint); make \
+                 it the joint of the root link's child, or leave the base fixed"
             ),
             ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
             ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),

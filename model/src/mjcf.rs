@@ -3,27 +3,66 @@
 //! [`Description`] as the URDF front end, so checking, merging and numbering are
 //! shared.
 //!
-//! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits>` (MuJoCo's default
-//! angle unit is the degree), `<option gravity>`, `<default>` classes (nested, `class`
-//! on joints, `childclass` on bodies) for joint attributes, `<worldbody>` with nested
-//! `<body name pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass
+//! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree>` (MuJoCo's
+//! default angle unit is the degree), `<option gravity>`, `<default>` classes (nested,
+//! `class` on joints, `childclass` on bodies) for joint attributes, `<worldbody>` with
+//! nested `<body name pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass
 //! diaginertia (with an orientation) | fullinertia>` and at most one `<joint
-//! type="hinge|slide" pos axis range limited damping frictionloss armature
-//! actuatorfrcrange>` per body. A body without a joint is a fixed link, merged as a
-//! URDF fixed joint. MuJoCo's worldbody is the base, the link `world`.
+//! type="hinge|slide|ball|free" pos axis range limited damping frictionloss armature
+//! actuatorfrcrange>` or `<freejoint name align>` per body. A body without a joint is
+//! a fixed link, merged as a URDF fixed joint. MuJoCo's worldbody is the base, the
+//! link `world`.
 //!
 //! A joint's `pos` (a point on its axis, in the body frame) moves the link frame onto
 //! the joint, as URDF has it: the joint origin is the body placement followed by a
 //! translation by `pos`, and the body's inertial and its children's placements are
 //! re-expressed in that frame (`pos` subtracted).
 //!
-//! Refused, each naming the element and its line: `ball` and `free` joints,
-//! `<freejoint>`, several joints in one body, a nonzero joint `ref`, `<include>`,
-//! `<frame>`, `<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, unknown classes.
-//! A moving body without `<inertial>` is an error (MuJoCo would infer the inertia from
-//! its geoms; dyngen does not). Geometry, sites, cameras, lights, assets, actuators,
-//! sensors and the rest are skipped. A nonzero `armature` or `stiffness` has no place
-//! in the model and is left out with a warning.
+//! # Joints and their coordinates
+//!
+//! - `hinge`: [`JointKind::Revolute`] (limited) or [`JointKind::Continuous`]; `slide`:
+//!   [`JointKind::Prismatic`]. One coordinate each, MuJoCo's own.
+//! - `ball`: [`JointKind::Spherical`], rotating about `pos` (its frame is the body
+//!   frame with its origin moved to `pos`, as a hinge's). `axis` is ignored, as MuJoCo
+//!   ignores it. The model has no limits for a ball joint: a `range` in effect
+//!   (`limited="true"`, or `auto` with `autolimits`; MuJoCo bounds the rotation angle)
+//!   is left out with an [`ErrorKind::Ignored`] warning. Positions: MuJoCo's `qpos`
+//!   holds the quaternion as `w x y z`, the model's `q` as Pinocchio's `[x, y, z, w]`
+//!   (the same rotation, of the body in the joint frame). Velocities are the same in
+//!   both: the angular velocity in the body frame.
+//! - `free` and `<freejoint>`: [`JointKind::FreeFlyer`], only in a body directly in
+//!   `<worldbody>` (MuJoCo refuses a free joint deeper down; a floating base is also
+//!   the first moving joint, see [`ErrorKind::FreeFlyerNotAtRoot`]). MuJoCo ignores a
+//!   free joint's `pos`, `axis` and `range`, and so does this reader; `<freejoint>`
+//!   has no damping or friction. The free flyer's origin is the world frame: the
+//!   body's own `pos` and orientation are only MuJoCo's initial `qpos0`, and `q` is
+//!   the body's pose in the world, as in MuJoCo. The coordinates differ, with `R` the
+//!   body's orientation in the world:
+//!
+//!   ```text
+//!   MuJoCo  qpos = [p; w x y z]    qvel = [ṗ (world axes); ω (body axes)]
+//!   dyngen  q    = [p; x y z w]    v    = [Rᵀ ṗ; ω]   (both in body axes)
+//!   ```
+//!
+//!   So `v = T v_mj` with `T = blkdiag(Rᵀ, E, …, E)`, and by power (`τᵀv = τ_mjᵀv_mj`)
+//!   the generalised forces are `τ = T⁻ᵀ τ_mj` (the base force `Rᵀ f`, the torques
+//!   unchanged), the mass matrix `M = T⁻ᵀ M_mj T⁻¹`. `T` moves with the body, so the
+//!   accelerations differ by more than `T`: `v̇ = T v̇_mj + Ṫ v_mj` with
+//!   `Ṫ v_mj = [−ω × Rᵀṗ; 0]`, and MuJoCo's bias forces `qfrc_bias` become
+//!   `b = T⁻ᵀ b_mj + M [ω × Rᵀṗ; 0]`.
+//!
+//!   MuJoCo moves the frame of a free body without child bodies onto its principal
+//!   axes of inertia when asked (`<freejoint align="true">`, or `<compiler
+//!   alignfree="true">` without `align="false"`), which changes its coordinates: that
+//!   is refused.
+//!
+//! Refused, each naming the element and its line: a free joint not directly in
+//! `<worldbody>`, several joints in one body, a nonzero `ref` on a hinge or slide
+//! joint, `<include>`, `<frame>`, `<replicate>`, `<attach>`, `<composite>`,
+//! `<flexcomp>`, unknown classes. A moving body without `<inertial>` is an error
+//! (MuJoCo would infer the inertia from its geoms; dyngen does not). Geometry, sites,
+//! cameras, lights, assets, actuators, sensors and the rest are skipped. A nonzero
+//! `armature` or `stiffness` has no place in the model and is left out with a warning.
 //!
 //! Siblings are numbered in declaration order, as MuJoCo numbers its bodies.
 
@@ -149,7 +188,21 @@ fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
     let strict = options.strict;
     let mut read = read(text)?;
     if options.free_flyer {
-        read.desc = read.desc.with_free_flyer();
+        let free = DeclaredJointType::Moving(JointKind::FreeFlyer);
+        match read.desc.joints.iter().find(|j| j.kind == free) {
+            // Floating the world under the file's own floating base would leave a
+            // second free flyer and a world without mass: say what is wrong instead.
+            Some(j) => read.errors.push(ModelError {
+                element: Element::Joint(j.name.clone()),
+                line: j.line,
+                kind: ErrorKind::NotSupported(format!(
+                    "body `{}` already floats on this free joint; the free-flyer load option would put the \
+                     world on a second one: load this file without it",
+                    j.child
+                )),
+            }),
+            None => read.desc = read.desc.with_free_flyer(),
+        }
     }
     let built = read.desc.build_checked(SiblingOrder::Declaration, strict);
     if read.errors.is_empty() {
@@ -244,6 +297,7 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
         children,
         radian: false,
         autolimits: true,
+        alignfree: false,
         eulerseq: *b"xyz",
         classes: HashMap::new(),
         errors: Vec::new(),
@@ -278,11 +332,33 @@ struct Class {
 /// Elements that build or move bodies in ways this front end does not follow.
 const TREE_ELEMENTS: [&str; 5] = ["frame", "replicate", "attach", "composite", "flexcomp"];
 
+/// The body a joint belongs to, as [`Reader::read_joint`] needs it.
+struct Owner<'a> {
+    /// Name of the parent link (`world` for a body directly in `<worldbody>`).
+    parent: &'a str,
+    body: &'a str,
+    /// The body's placement in its parent link's frame.
+    placement: &'a Placement,
+    /// Whether the body has no child bodies (MuJoCo aligns only those).
+    childless: bool,
+}
+
+/// MJCF joint types.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum MjcfJoint {
+    Hinge,
+    Slide,
+    Ball,
+    Free,
+}
+
 struct Reader<'t> {
     tags: &'t [Tag],
     children: Vec<Vec<usize>>,
     radian: bool,
     autolimits: bool,
+    /// `<compiler alignfree>`: free bodies without children aligned with their inertia.
+    alignfree: bool,
     eulerseq: [u8; 3],
     classes: HashMap<String, Class>,
     errors: Vec<ModelError>,
@@ -395,17 +471,18 @@ impl<'t> Reader<'t> {
                 );
             }
         }
-        if let Some(v) = t.attr("autolimits") {
-            match v {
-                "true" => self.autolimits = true,
-                "false" => self.autolimits = false,
-                other => self.error(
-                    Element::Robot,
-                    t.line,
-                    ErrorKind::InvalidMjcf(format!(
-                        "<compiler autolimits=\"{other}\"> is neither `true` nor `false`"
+        for (attr, flag) in [("autolimits", &mut self.autolimits), ("alignfree", &mut self.alignfree)] {
+            match t.attr(attr) {
+                None => {}
+                Some("true") => *flag = true,
+                Some("false") => *flag = false,
+                Some(other) => self.errors.push(ModelError {
+                    element: Element::Robot,
+                    line: Some(t.line),
+                    kind: ErrorKind::InvalidMjcf(format!(
+                        "<compiler {attr}=\"{other}\"> is neither `true` nor `false`"
                     )),
-                ),
+                }),
             }
         }
     }
@@ -645,12 +722,20 @@ impl<'t> Reader<'t> {
                 );
                 continue;
             }
+            let owner = Owner {
+                parent,
+                body: &name,
+                placement: &placement,
+                childless: self.children_named(k, "body").is_empty(),
+            };
             if jt.name == "freejoint" {
-                self.error(jel, jt.line, free_not_supported("<freejoint>"));
+                // MuJoCo's shorthand for a free joint without damping, friction,
+                // armature or stiffness; it takes no class.
+                joint = self.free_joint(jt, jname, &owner, JointDynamics::default());
                 continue;
             }
             let class = self.class_of(jt, "class", &childclass, &jel);
-            if let Some(desc) = self.read_joint(jt, &class, jname, parent, &name, &placement) {
+            if let Some(desc) = self.read_joint(jt, &class, jname, &owner) {
                 joint = Some(desc);
             }
         }
@@ -705,17 +790,9 @@ impl<'t> Reader<'t> {
         );
     }
 
-    /// One `<joint>`, with the body's placement: the description's joint and its
+    /// One `<joint>` of the body `owner` describes: the description's joint and its
     /// `pos` (where the link frame sits in the body frame).
-    fn read_joint(
-        &mut self,
-        t: &'t Tag,
-        class: &str,
-        name: String,
-        parent: &str,
-        body: &str,
-        placement: &Placement,
-    ) -> Option<(JointDesc, Vec3)> {
+    fn read_joint(&mut self, t: &'t Tag, class: &str, name: String, owner: &Owner) -> Option<(JointDesc, Vec3)> {
         let el = Element::Joint(name.clone());
         let attr = |this: &Self, a: &str| this.joint_attr(t, class, a);
         let number = |this: &mut Self, a: &str, count: usize| -> Option<Vec<f64>> {
@@ -723,25 +800,11 @@ impl<'t> Reader<'t> {
             this.parse_numbers(t, a, &v, count, &el)
         };
         let kind = attr(self, "type").unwrap_or_else(|| "hinge".into());
-        let slide = match kind.as_str() {
-            "hinge" => false,
-            "slide" => true,
-            "ball" => {
-                self.error(
-                    el,
-                    t.line,
-                    ErrorKind::NotSupported(
-                        "joint type `ball` is not supported yet; only hinge and slide joints are (a ball joint \
-                         is three hinges about orthogonal axes through one point, in a chain of bodies)"
-                            .into(),
-                    ),
-                );
-                return None;
-            }
-            "free" => {
-                self.error(el, t.line, free_not_supported("joint type `free`"));
-                return None;
-            }
+        let kind = match kind.as_str() {
+            "hinge" => MjcfJoint::Hinge,
+            "slide" => MjcfJoint::Slide,
+            "ball" => MjcfJoint::Ball,
+            "free" => MjcfJoint::Free,
             other => {
                 self.error(
                     el,
@@ -753,8 +816,29 @@ impl<'t> Reader<'t> {
                 return None;
             }
         };
+        let scalar = |this: &mut Self, a: &str| number(this, a, 1).map_or(0.0, |v| v[0]);
+        let dynamics = JointDynamics {
+            damping: scalar(self, "damping"),
+            friction: scalar(self, "frictionloss"),
+        };
+        for what in ["armature", "stiffness"] {
+            let x = scalar(self, what);
+            if x != 0.0 {
+                self.warnings.push(ModelError {
+                    element: el.clone(),
+                    line: Some(t.line),
+                    kind: ErrorKind::Ignored(format!(
+                        "{what} = {x} is left out: the model has no place for it (the dynamics are the rigid \
+                         body's alone)"
+                    )),
+                });
+            }
+        }
+        if kind == MjcfJoint::Free {
+            // MuJoCo ignores a free joint's pos, axis, range and ref.
+            return self.free_joint(t, name, owner, dynamics);
+        }
         let pos = number(self, "pos", 3).map_or([0.0; 3], |v| [v[0], v[1], v[2]]);
-        let axis = number(self, "axis", 3).map_or([0.0, 0.0, 1.0], |v| [v[0], v[1], v[2]]);
         let range = number(self, "range", 2);
         let limited = match attr(self, "limited").as_deref() {
             None | Some("auto") => self.autolimits && range.is_some(),
@@ -769,6 +853,38 @@ impl<'t> Reader<'t> {
                 false
             }
         };
+        let origin = Placement {
+            rotation: owner.placement.rotation,
+            translation: owner.placement.transform_point(&pos),
+        };
+        let desc = |kind: JointKind, axis: Vec3, limits: Option<Limits>| JointDesc {
+            name: name.clone(),
+            kind: DeclaredJointType::Moving(kind),
+            parent: owner.parent.to_string(),
+            child: owner.body.to_string(),
+            origin,
+            axis,
+            limits,
+            dynamics,
+            line: Some(t.line),
+        };
+        if kind == MjcfJoint::Ball {
+            // MuJoCo ignores a ball joint's axis and ref; its range bounds the angle of
+            // rotation, which the model has no limit for.
+            if limited {
+                let range = range.map_or_else(String::new, |r| format!(" (range {} {})", r[0], r[1]));
+                self.warnings.push(ModelError {
+                    element: el.clone(),
+                    line: Some(t.line),
+                    kind: ErrorKind::Ignored(format!(
+                        "the limit of this ball joint{range} is left out: the model has no limits for ball joints"
+                    )),
+                });
+            }
+            return Some((desc(JointKind::Spherical, [0.0; 3], None), pos));
+        }
+        let slide = kind == MjcfJoint::Slide;
+        let axis = number(self, "axis", 3).map_or([0.0, 0.0, 1.0], |v| [v[0], v[1], v[2]]);
         if limited && range.is_none() {
             self.error(
                 el.clone(),
@@ -776,9 +892,6 @@ impl<'t> Reader<'t> {
                 ErrorKind::InvalidMjcf("limited=\"true\" without a `range`; give range=\"lower upper\"".into()),
             );
         }
-        let scalar = |this: &mut Self, a: &str| number(this, a, 1).map_or(0.0, |v| v[0]);
-        let damping = scalar(self, "damping");
-        let frictionloss = scalar(self, "frictionloss");
         let reference = scalar(self, "ref");
         if reference != 0.0 {
             self.error(
@@ -789,19 +902,6 @@ impl<'t> Reader<'t> {
                      move the body to the reference position instead"
                 )),
             );
-        }
-        for what in ["armature", "stiffness"] {
-            let x = scalar(self, what);
-            if x != 0.0 {
-                self.warnings.push(ModelError {
-                    element: el.clone(),
-                    line: Some(t.line),
-                    kind: ErrorKind::Ignored(format!(
-                        "{what} = {x} is left out: the model has no place for it (the dynamics are the rigid \
-                         body's alone)"
-                    )),
-                });
-            }
         }
         let effort = number(self, "actuatorfrcrange", 2).map_or(UNLIMITED, |v| v[0].abs().max(v[1].abs()));
         let limits = match (limited, range) {
@@ -825,25 +925,67 @@ impl<'t> Reader<'t> {
             (false, true) => JointKind::Revolute,
             (false, false) => JointKind::Continuous,
         };
-        let origin = Placement {
-            rotation: placement.rotation,
-            translation: placement.transform_point(&pos),
+        Some((desc(kind, axis, limits), pos))
+    }
+
+    /// A free joint (`<joint type="free">` or `<freejoint>`): a free flyer from the
+    /// world, whose origin is the world frame (the body's placement is only MuJoCo's
+    /// initial `qpos0`), or the error that refuses it.
+    fn free_joint(
+        &mut self,
+        t: &Tag,
+        name: String,
+        owner: &Owner,
+        dynamics: JointDynamics,
+    ) -> Option<(JointDesc, Vec3)> {
+        let el = Element::Joint(name.clone());
+        if owner.parent != WORLD {
+            // MuJoCo: "free joint can only be used on top level".
+            self.error(el, t.line, ErrorKind::FreeFlyerNotAtRoot);
+            return None;
+        }
+        // Only `<freejoint>` takes `align`; `<compiler alignfree>` is its default.
+        let align = match t.attr("align").filter(|_| t.name == "freejoint") {
+            None | Some("auto") => self.alignfree,
+            Some("true") => true,
+            Some("false") => false,
+            Some(other) => {
+                self.error(
+                    el,
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "<{} align=\"{other}\"> is not `true`, `false` or `auto`",
+                        t.name
+                    )),
+                );
+                return None;
+            }
         };
+        if align && owner.childless {
+            self.error(
+                el,
+                t.line,
+                ErrorKind::NotSupported(format!(
+                    "body `{}` would be aligned with its principal axes of inertia (align=\"true\", or <compiler \
+                     alignfree=\"true\">), which moves its frame and so its free-joint coordinates; this is not \
+                     supported: write align=\"false\"",
+                    owner.body
+                )),
+            );
+            return None;
+        }
         let desc = JointDesc {
             name,
-            kind: DeclaredJointType::Moving(kind),
-            parent: parent.to_string(),
-            child: body.to_string(),
-            origin,
-            axis,
-            limits,
-            dynamics: JointDynamics {
-                damping,
-                friction: frictionloss,
-            },
+            kind: DeclaredJointType::Moving(JointKind::FreeFlyer),
+            parent: owner.parent.to_string(),
+            child: owner.body.to_string(),
+            origin: Placement::IDENTITY,
+            axis: [0.0; 3],
+            limits: None,
+            dynamics,
             line: Some(t.line),
         };
-        Some((desc, pos))
+        Some((desc, [0.0; 3]))
     }
 
     /// An `<inertial>` in the link frame, which sits at `shift` in the body frame.
@@ -901,12 +1043,6 @@ impl<'t> Reader<'t> {
         }
         Some(inertial)
     }
-}
-
-fn free_not_supported(what: &str) -> ErrorKind {
-    ErrorKind::NotSupported(format!(
-        "{what} is not supported yet: dyngen models fixed-base trees; remove it to fix the body to its parent"
-    ))
 }
 
 fn cross(a: &Vec3, b: &Vec3) -> Vec3 {

@@ -2,8 +2,10 @@
 //! URDF's model (to MuJoCo's printed rounding), the mass matrix and bias forces of the
 //! models read from MJCF equal MuJoCo's (`tests/fixtures/mjcf/*.json`, written by
 //! `scripts/make_mjcf_fixtures.py`), the hand-written `small.xml` gives its documented
-//! numbers, and one test per refused construct checks the message names the element
-//! and its line.
+//! numbers, the hand-written `floating.xml` (a free flyer and a ball joint) gives its
+//! documented model and MuJoCo's mass matrix and bias forces in dyngen's coordinates,
+//! and one test per refused construct checks the message names the element and its
+//! line.
 
 use dyngen_model::regressor::joint_torque_regressor;
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
@@ -259,40 +261,6 @@ fn only_error(text: &str, element: Element, line: usize, says: &str) -> ErrorKin
 }
 
 #[test]
-fn ball_joint_is_refused() {
-    let text = mjcf(&[
-        "<body name=\"a\">",
-        INERTIAL,
-        "<joint name=\"j\" type=\"ball\"/>",
-        "</body>",
-    ]);
-    only_error(
-        &text,
-        Element::Joint("j".into()),
-        5,
-        "joint type `ball` is not supported yet",
-    );
-}
-
-#[test]
-fn free_joints_are_refused() {
-    let text = mjcf(&[
-        "<body name=\"a\">",
-        INERTIAL,
-        "<joint name=\"f\" type=\"free\"/>",
-        "</body>",
-    ]);
-    only_error(
-        &text,
-        Element::Joint("f".into()),
-        5,
-        "joint type `free` is not supported yet",
-    );
-    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<freejoint name=\"f\"/>", "</body>"]);
-    only_error(&text, Element::Joint("f".into()), 5, "<freejoint> is not supported yet");
-}
-
-#[test]
 fn two_joints_in_one_body_are_refused() {
     let text = mjcf(&[
         "<body name=\"a\">",
@@ -411,7 +379,7 @@ fn errors_are_all_collected_with_the_file_name() {
     let path = dir.join("bad.xml");
     let text = mjcf(&[
         "<body name=\"a\">",
-        "<joint name=\"b\" type=\"ball\"/>",
+        "<joint name=\"b\" ref=\"0.5\"/>",
         INERTIAL,
         "<body name=\"c\"><joint name=\"d\"/></body>",
         "</body>",
@@ -422,7 +390,10 @@ fn errors_are_all_collected_with_the_file_name() {
     let message = e.to_string();
     let lines: Vec<&str> = message.lines().collect();
     assert_eq!(lines.len(), 2, "{message}");
-    assert!(lines[0].ends_with("bad.xml:4: joint `b`: joint type `ball` is not supported yet; only hinge and slide joints are (a ball joint is three hinges about orthogonal axes through one point, in a chain of bodies)"), "{message}");
+    assert!(
+        lines[0].ends_with("bad.xml:4: joint `b`: a joint `ref` (0.5) is not supported yet: it moves the joint's zero; rotate or move the body to the reference position instead"),
+        "{message}"
+    );
     assert!(
         lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"),
         "{message}"
@@ -560,4 +531,398 @@ fn orientations_are_mujocos() {
         let d = max_abs_diff(&flat3(&model.joints[0].origin.rotation), &expected);
         assert!(d < 1e-15, "{seq} {attr}: {d:e}");
     }
+}
+
+// ---------------------------------------------------------------------------------
+// Ball and free joints.
+
+/// The 1-based number of the first line of `text` holding `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).expect(needle) + 1
+}
+
+fn rotation_xyz(a: f64, b: f64, c: f64) -> [[f64; 3]; 3] {
+    use dyngen_model::math::mat_mul;
+    let (sa, ca) = a.sin_cos();
+    let (sb, cb) = b.sin_cos();
+    let (sc, cc) = c.sin_cos();
+    let rx = [[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]];
+    let ry = [[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]];
+    let rz = [[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]];
+    mat_mul(&mat_mul(&rx, &ry), &rz)
+}
+
+#[test]
+fn floating_gives_its_documented_model() {
+    use dyngen_model::math::{mat_vec, IDENTITY};
+    let text = std::fs::read_to_string(fixture("floating.xml")).unwrap();
+    let model = load_mjcf(&fixture("floating.xml")).unwrap();
+    assert_eq!((model.name.as_str(), model.base.as_str()), ("floating", "world"));
+    assert!(model.is_floating());
+    let kinds: Vec<(&str, JointKind, usize)> = model
+        .joints
+        .iter()
+        .map(|j| (j.name.as_str(), j.kind, j.parent))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            ("root", JointKind::FreeFlyer, 0),
+            ("shoulder", JointKind::Spherical, 1),
+            ("elbow", JointKind::Revolute, 2),
+            ("wrist", JointKind::Prismatic, 3),
+        ]
+    );
+    assert_eq!((model.nq(), model.nv(), model.dof()), (13, 11, 4));
+    let q_offsets: Vec<usize> = (1..=4).map(|j| model.q_offset(j)).collect();
+    let v_offsets: Vec<usize> = (1..=4).map(|j| model.v_offset(j)).collect();
+    assert_eq!((q_offsets, v_offsets), (vec![0, 7, 11, 12], vec![0, 6, 9, 10]));
+    let close = |a: &[f64], b: &[f64]| max_abs_diff(a, b) < 1e-15;
+
+    // The free flyer: from the world's origin whatever the torso's pos and quat.
+    let [root, shoulder, elbow, wrist] = [0, 1, 2, 3].map(|k| &model.joints[k]);
+    assert_eq!(root.origin, dyngen_model::Placement::IDENTITY);
+    assert_eq!((root.axis, root.limits), ([0.0; 3], None));
+    // The ball joint: the upper arm's placement moved to the joint pos; no axis, no
+    // limits (its range left out with a warning), its damping kept.
+    let r = rotation_xyz(0.3, -0.2, 0.1);
+    assert!(close(&flat3(&shoulder.origin.rotation), &flat3(&r)));
+    let at = mat_vec(&r, &[0.0, 0.03, 0.02]);
+    assert!(close(
+        &shoulder.origin.translation,
+        &[0.05 + at[0], 0.2 + at[1], 0.18 + at[2]]
+    ));
+    assert_eq!((shoulder.axis, shoulder.limits), ([0.0; 3], None));
+    assert_eq!(shoulder.dynamics.damping, 0.2);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let w = &model.warnings[0];
+    let shoulder_line = line_of(&text, "name=\"shoulder\"");
+    assert_eq!(
+        (&w.element, w.line),
+        (&Element::Joint("shoulder".into()), Some(shoulder_line))
+    );
+    assert!(matches!(w.kind, ErrorKind::Ignored(_)));
+    assert!(
+        w.warning_message().ends_with(
+            "the limit of this ball joint (range 0 1.5) is left out: the model has no limits for ball joints"
+        ),
+        "{}",
+        w.warning_message()
+    );
+    // The elbow: the forearm's placement (below the shoulder's pos) moved to its pos.
+    assert!(close(&flat3(&elbow.origin.rotation), &flat3(&IDENTITY)));
+    assert!(close(&elbow.origin.translation, &[0.0, -0.02, -0.305]));
+    assert_eq!(elbow.axis, [0.0, 1.0, 0.0]);
+    let l = elbow.limits.unwrap();
+    assert_eq!((l.lower, l.upper), (-2.5, 0.1));
+    // The wrist: a slide along (0.2 0 1), normalised, below the elbow's pos.
+    assert!(close(&wrist.origin.translation, &[0.0, 0.0, -0.275]));
+    let n = 1.04f64.sqrt();
+    assert!(close(&wrist.axis, &[0.2 / n, 0.0, 1.0 / n]));
+    assert_eq!(wrist.limits.map(|l| (l.lower, l.upper)), Some((-0.05, 0.05)));
+
+    // The fullinertia of the forearm, as written, its centre in the elbow's frame.
+    let forearm = &model.bodies[2].inertial;
+    assert_eq!(forearm.mass, 0.9);
+    assert!(close(&forearm.com, &[0.01, 0.0, -0.135]));
+    assert!(close(
+        &flat3(&forearm.inertia),
+        &[0.009, 0.0002, -0.0004, 0.0002, 0.0095, 0.0001, -0.0004, 0.0001, 0.0012]
+    ));
+    assert_eq!(model.bodies[0].merged, ["head"]);
+    assert!((model.bodies[0].inertial.mass - 7.6).abs() < 1e-15);
+    let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["world", "torso", "head", "upper_arm", "forearm", "hand"]);
+}
+
+/// The largest magnitude in `x`.
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0f64, |m, y| m.max(y.abs()))
+}
+
+/// Mass matrix (columns `τ(q, 0, e_k)` without gravity) and bias `τ(q, v, 0)` with
+/// it, for any model (`nq` positions, `nv` velocities).
+fn floating_dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let nv = model.nv();
+    let mut weightless = model.clone();
+    weightless.gravity = [0.0; 3];
+    let zero = vec![0.0; nv];
+    let mut m = vec![vec![0.0; nv]; nv];
+    for k in 0..nv {
+        let mut e = zero.clone();
+        e[k] = 1.0;
+        for (r, x) in torque(&weightless, q, &zero, &e).into_iter().enumerate() {
+            m[r][k] = x;
+        }
+    }
+    (m, torque(model, q, v, &zero))
+}
+
+/// MuJoCo's mass matrix and bias forces of `floating.xml`, converted to dyngen's
+/// coordinates by the script (quaternions `x y z w`, the free joint's linear velocity
+/// in the body frame, `M = T⁻ᵀ M_mj T⁻¹`, `b = T⁻ᵀ b_mj + M [ω × v; 0]`), equal the
+/// regressor's on the model read from the same file.
+#[test]
+fn floating_mass_matrix_and_bias_equal_mujocos() {
+    let model = load_mjcf(&fixture("floating.xml")).unwrap();
+    let text = std::fs::read_to_string(fixture("floating.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let joints: Vec<&str> = reference["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
+    let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(ours, joints);
+    assert_eq!(
+        (model.nq() as u64, model.nv() as u64),
+        (reference["nq"].as_u64().unwrap(), reference["nv"].as_u64().unwrap())
+    );
+    assert_eq!(model.gravity.to_vec(), numbers(&reference["gravity"]));
+    let (mut dm, mut db) = (0.0f64, 0.0f64);
+    let samples = reference["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 3);
+    for s in samples {
+        let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        // Unit quaternions, stored x y z w.
+        for qa in [3, 7] {
+            let norm: f64 = q[qa..qa + 4].iter().map(|x| x * x).sum();
+            assert!((norm - 1.0).abs() < 1e-15);
+        }
+        let (m, bias) = floating_dynamics(&model, &q, &v);
+        let m: Vec<f64> = m.into_iter().flatten().collect();
+        let (m_ref, bias_ref) = (numbers(&s["M"]), numbers(&s["bias"]));
+        dm = dm.max(max_abs_diff(&m, &m_ref) / max_abs(&m_ref));
+        db = db.max(max_abs_diff(&bias, &bias_ref) / max_abs(&bias_ref));
+    }
+    eprintln!("floating: |M - M_mujoco| / |M_mujoco| <= {dm:.2e}, |b - b_mujoco| / |b_mujoco| <= {db:.2e}");
+    // MuJoCo reads the hand-written numbers exactly: only rounding is left.
+    assert!(dm <= 1e-12 && db <= 1e-12, "M {dm:e}, bias {db:e}");
+}
+
+/// A torso on the free joint `free` (a `<joint type="free">` or a `<freejoint>`),
+/// with `body_attrs`, and an arm on a hinge below it.
+fn free_body(free: &str, body_attrs: &str) -> String {
+    mjcf(&[
+        &format!("<body name=\"torso\" {body_attrs}>"),
+        free,
+        INERTIAL,
+        "<body name=\"arm\" pos=\"0 0 0.5\">",
+        "<joint name=\"j\" axis=\"1 0 0\"/>",
+        INERTIAL,
+        "</body>",
+        "</body>",
+    ])
+}
+
+#[test]
+fn a_free_joint_is_a_free_flyer_from_the_world() {
+    let short = parse_mjcf(&free_body("<freejoint name=\"f\"/>", "")).unwrap();
+    assert_eq!(short.joints[0].kind, JointKind::FreeFlyer);
+    assert_eq!((short.nq(), short.nv()), (8, 7));
+    assert!(short.is_floating());
+    // `<joint type="free">` is the same joint; MuJoCo ignores its pos and axis.
+    let long = parse_mjcf(&free_body(
+        "<joint name=\"f\" type=\"free\" pos=\"1 2 3\" axis=\"1 0 0\"/>",
+        "",
+    ))
+    .unwrap();
+    assert_eq!(long, short);
+    // The body's placement is MuJoCo's qpos0 alone: the model does not change.
+    let moved = parse_mjcf(&free_body(
+        "<freejoint name=\"f\"/>",
+        "pos=\"1 2 3\" euler=\"10 20 30\"",
+    ))
+    .unwrap();
+    assert_eq!(moved, short);
+    // Damping and friction of a `free` joint are kept; `<freejoint>` has none.
+    let damped = parse_mjcf(&free_body(
+        "<joint name=\"f\" type=\"free\" damping=\"2\" frictionloss=\"0.5\"/>",
+        "",
+    ))
+    .unwrap();
+    assert_eq!(
+        (damped.joints[0].dynamics.damping, damped.joints[0].dynamics.friction),
+        (2.0, 0.5)
+    );
+    // A class may make a joint free.
+    let text = format!(
+        "<mujoco><default><default class=\"float\"><joint type=\"free\"/></default></default><worldbody>\
+         <body name=\"torso\"><joint name=\"f\" class=\"float\"/>{INERTIAL}</body></worldbody></mujoco>"
+    );
+    assert_eq!(parse_mjcf(&text).unwrap().joints[0].kind, JointKind::FreeFlyer);
+}
+
+#[test]
+fn a_ball_joint_is_spherical_about_its_pos() {
+    let ball = |attrs: &str| {
+        mjcf(&[
+            "<body name=\"a\" pos=\"0 0 1\" euler=\"0 0 90\">",
+            &format!("<joint name=\"b\" type=\"ball\" pos=\"0.1 0 0\" {attrs}/>"),
+            INERTIAL,
+            "</body>",
+        ])
+    };
+    let model = parse_mjcf(&ball("axis=\"1 0 0\" limited=\"false\" range=\"0 60\"")).unwrap();
+    let joint = &model.joints[0];
+    assert_eq!(
+        (joint.kind, joint.axis, joint.limits),
+        (JointKind::Spherical, [0.0; 3], None)
+    );
+    assert_eq!((model.nq(), model.nv()), (4, 3));
+    // Rz(90°) takes the pos 0.1 0 0 to 0 0.1 0.
+    assert!(max_abs_diff(&joint.origin.translation, &[0.0, 0.1, 1.0]) < 1e-15);
+    // The body's inertial sits in the joint frame: its centre moves by -pos.
+    assert!(max_abs_diff(&model.bodies[0].inertial.com, &[-0.1, 0.0, 0.0]) < 1e-15);
+    assert!(model.warnings.is_empty());
+    // A range in effect (autolimits, or limited="true", even without a range as
+    // MuJoCo allows for a ball) is left out with a warning; no range, no warning.
+    for attrs in ["range=\"0 60\"", "limited=\"true\" range=\"0 60\"", "limited=\"true\""] {
+        let model = parse_mjcf(&ball(attrs)).unwrap();
+        assert_eq!(model.warnings.len(), 1, "{attrs}");
+        let w = model.warnings[0].warning_message();
+        assert!(w.starts_with("line 4: joint `b`: the limit of this ball joint"), "{w}");
+    }
+    assert!(parse_mjcf(&ball("")).unwrap().warnings.is_empty());
+}
+
+#[test]
+fn a_free_joint_below_the_top_level_is_refused() {
+    // Under a moving body (the description's own check would catch this too).
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "<body name=\"b\" pos=\"0 0 1\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "</body>",
+        "</body>",
+    ]);
+    let kind = only_error(&text, Element::Joint("f".into()), 8, "must join the root link");
+    assert_eq!(kind, ErrorKind::FreeFlyerNotAtRoot);
+    // Under a jointless body: MuJoCo refuses it ("free joint can only be used on top
+    // level") though the body is fixed to the world.
+    let text = mjcf(&[
+        "<body name=\"stand\">",
+        "<body name=\"b\">",
+        "<joint name=\"f\" type=\"free\"/>",
+        INERTIAL,
+        "</body>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("f".into()),
+        5,
+        "(in MJCF: a free joint only in a body directly in <worldbody>, before any other moving joint)",
+    );
+    // With the file name and line, as for URDF.
+    let dir = std::env::temp_dir().join(format!("dyngen-mjcf-free-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("nested.xml");
+    std::fs::write(&path, &text).unwrap();
+    let e = load_mjcf(&path).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let message = e.to_string();
+    assert_eq!(message.lines().count(), 1, "{message}");
+    assert!(
+        message.ends_with(
+            "nested.xml:5: joint `f`: a floating (free-flyer) joint must join the root link to the robot's first \
+             body, and only one may (in MJCF: a free joint only in a body directly in <worldbody>, before any \
+             other moving joint); make it the joint of the root link's child, or leave the base fixed"
+        ),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_free_body_after_a_moving_one_is_refused() {
+    // Top level, as MuJoCo allows, but not the first moving joint: the model floats
+    // one base at most, on joint 1.
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "</body>",
+        "<body name=\"b\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "</body>",
+    ]);
+    let kind = only_error(&text, Element::Joint("f".into()), 9, "must join the root link");
+    assert_eq!(kind, ErrorKind::FreeFlyerNotAtRoot);
+    // Nor with the free flyer of `LoadOptions::free_flyer` on top.
+    let options = dyngen_model::LoadOptions {
+        free_flyer: true,
+        ..Default::default()
+    };
+    let e = dyngen_model::parse_mjcf_options(&free_body("<freejoint name=\"f\"/>", ""), options).unwrap_err();
+    assert_eq!(e.errors.len(), 1, "{e}");
+    assert_eq!(
+        (&e.errors[0].element, e.errors[0].line),
+        (&Element::Joint("f".into()), Some(4))
+    );
+    assert!(
+        e.to_string()
+            .contains("line 4: joint `f`: body `torso` already floats on this free joint; the free-flyer load option"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_free_body_aligned_with_its_inertia_is_refused() {
+    let alone = |compiler: &str, free: &str| {
+        format!(
+            "<mujoco>\n{compiler}\n<worldbody>\n<body name=\"a\">\n{free}\n{INERTIAL}\n</body>\n</worldbody>\n</mujoco>\n"
+        )
+    };
+    let says = "body `a` would be aligned with its principal axes of inertia";
+    only_error(
+        &alone("", "<freejoint name=\"f\" align=\"true\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    let aligned = "<compiler alignfree=\"true\"/>";
+    only_error(
+        &alone(aligned, "<freejoint name=\"f\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    only_error(
+        &alone(aligned, "<joint name=\"f\" type=\"free\"/>"),
+        Element::Joint("f".into()),
+        5,
+        says,
+    );
+    only_error(
+        &alone("", "<freejoint name=\"f\" align=\"maybe\"/>"),
+        Element::Joint("f".into()),
+        5,
+        "<freejoint align=\"maybe\"> is not `true`, `false` or `auto`",
+    );
+    // align="false" keeps the frame; MuJoCo does not align a body with children.
+    assert!(parse_mjcf(&alone(aligned, "<freejoint name=\"f\" align=\"false\"/>")).is_ok());
+    let with_child = free_body("<freejoint name=\"f\" align=\"true\"/>", "");
+    assert!(parse_mjcf(&with_child).unwrap().is_floating());
+}
+
+#[test]
+fn a_free_joint_with_another_joint_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<freejoint name=\"f\"/>",
+        "<joint name=\"j\"/>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Joint("j".into()),
+        6,
+        "body `a` already has a joint; several joints in one body are not supported yet",
+    );
 }

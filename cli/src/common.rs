@@ -21,6 +21,11 @@ pub struct ModelArgs {
     /// which are otherwise accepted as written with a warning.
     #[arg(long)]
     pub strict: bool,
+    /// Put the root link on a free flyer (a floating base, as Pinocchio's
+    /// `JointModelFreeFlyer` root joint): `q = [p; quaternion x y z w; joints]`,
+    /// `v = [v; ω; joints]` in the base frame.
+    #[arg(long)]
+    pub free_flyer: bool,
 }
 
 impl ModelArgs {
@@ -36,10 +41,16 @@ impl ModelArgs {
 }
 
 /// Reads, parses and checks the URDF or MJCF (`.xml`) at `path` (all errors as `file:line: message`),
-/// prints its warnings (`strict`: refuses them), then sets the gravity when given.
-pub fn load_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Result<Model> {
+/// as `args` says (`--strict`, `--free-flyer`), prints its warnings, then sets the
+/// gravity when given.
+pub fn load_model(path: &Path, args: &ModelArgs) -> Result<Model> {
+    let gravity = args.get()?;
+    let options = dyngen_model::LoadOptions {
+        strict: args.strict,
+        free_flyer: args.free_flyer,
+    };
     // The model's errors already read `file:line: message`.
-    let mut model = dyngen_model::load_robot_with(path, strict).map_err(|e| CliError::Input(e.to_string()))?;
+    let mut model = dyngen_model::load_robot_options(path, options).map_err(|e| CliError::Input(e.to_string()))?;
     for w in &model.warnings {
         let at = w.line.map(|l| format!(":{l}")).unwrap_or_default();
         let message = ModelError {
@@ -55,11 +66,28 @@ pub fn load_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Resul
     Ok(model)
 }
 
-/// Like [`load_model`], and refuses a model without moving joints.
-pub fn load_moving_model(path: &Path, gravity: Option<[f64; 3]>, strict: bool) -> Result<Model> {
-    let model = load_model(path, gravity, strict)?;
+/// Like [`load_model`], for the commands that run the dynamics at run time
+/// (identification, simulation, validation, NIM): refuses a model without moving
+/// joints, and one with a free flyer or a ball joint, which only the generated code
+/// handles so far.
+pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
+    let model = load_model(path, args)?;
     if model.dof() == 0 {
         return Err(CliError::input(path, "the robot has no moving joints"));
+    }
+    if let Some(j) = model.multi_dof_joint() {
+        return Err(CliError::input(
+            path,
+            format!(
+                "joint `{}` is a {} joint ({} positions, {} velocities); this command runs on robots whose joints \
+                 each have one degree of freedom. Floating bases and ball joints are handled by the generated \
+                 code (`dyngen generate`, `build.rs`), including the floating-base regressor for identification",
+                j.name,
+                j.kind.urdf_name(),
+                j.kind.nq(),
+                j.kind.nv()
+            ),
+        ));
     }
     Ok(model)
 }

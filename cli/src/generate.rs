@@ -43,7 +43,7 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
     if let Some(out) = &args.output {
         check_overwrite(out, args.force)?;
     }
-    let model = load_model(&args.urdf, None, args.gravity.strict)?;
+    let model = load_model(&args.urdf, &args.gravity)?;
     let mut config = Config::new();
     if let Some(g) = args.gravity.get()? {
         config.gravity(g);

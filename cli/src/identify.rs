@@ -419,7 +419,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     let options = args.options();
     options.check().map_err(|e| pipeline_error(&args.data, e))?;
     check_outputs(args)?;
-    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?, args.recording.gravity.strict)?;
+    let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
     let n = model.dof();
     let traj = args.recording.load(&args.data, n)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {

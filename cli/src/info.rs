@@ -28,7 +28,7 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
-    let model = load_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
+    let model = load_model(&args.urdf, &args.gravity)?;
     let mut out = topology(&model, &args.urdf);
     let n = model.dof();
     writeln!(out).ok();
@@ -106,6 +106,20 @@ fn topology(model: &Model, path: &std::path::Path) -> String {
         model.base, g[0], g[1], g[2]
     )
     .ok();
+    if model.multi_dof_joint().is_some() {
+        writeln!(
+            out,
+            "  {} position coordinates, {} velocity coordinates{}",
+            model.nq(),
+            model.nv(),
+            if model.is_floating() {
+                " (floating base: joint 1 is a free flyer)"
+            } else {
+                ""
+            }
+        )
+        .ok();
+    }
     writeln!(out).ok();
     writeln!(out, "Joints (joint j carries body j; parent 0 is the base)").ok();
     let width = model.joints.iter().map(|j| j.name.len()).max().unwrap_or(4).max(4);
@@ -116,7 +130,11 @@ fn topology(model: &Model, path: &std::path::Path) -> String {
     )
     .ok();
     for (k, j) in model.joints.iter().enumerate() {
-        let axis = format!("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2]);
+        let axis = if j.kind.has_axis() {
+            format!("[{}, {}, {}]", j.axis[0], j.axis[1], j.axis[2])
+        } else {
+            "—".to_string()
+        };
         let limits = match j.limits {
             Some(l) => format!("[{}, {}], v ≤ {}, effort ≤ {}", l.lower, l.upper, l.velocity, l.effort),
             None => "—".to_string(),

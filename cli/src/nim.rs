@@ -167,7 +167,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         }
         check_overwrite(svg, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
+    let model = load_moving_model(&args.urdf, &args.gravity)?;
     let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
     let motion = SampledMotion::from_data(&traj)
         .ok_or_else(|| CliError::input(&args.motion, "the motion has no velocities or accelerations"))?;
@@ -316,7 +316,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
     if let Some(path) = &args.params_json {
         check_overwrite(path, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
+    let model = load_moving_model(&args.urdf, &args.gravity)?;
     let nim = Nim::load(&args.nim).map_err(|e| nim_file_error(&args.nim, e, false))?;
     let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     if nim.body_names != body_names {

@@ -195,7 +195,7 @@ fn check_args(args: &SimulateArgs) -> Result<()> {
 pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     check_args(args)?;
     check_overwrite(&args.output, args.force)?;
-    let model = load_moving_model(&args.urdf, args.gravity.get()?, args.gravity.strict)?;
+    let model = load_moving_model(&args.urdf, &args.gravity)?;
     let robot = Reference::new(&model);
     let params = model.standard_params();
 

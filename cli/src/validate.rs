@@ -60,7 +60,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     if let Some(svg) = &args.svg {
         check_overwrite(svg, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, args.recording.gravity.get()?, args.recording.gravity.strict)?;
+    let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
     let text = std::fs::read_to_string(&args.params).map_err(|e| CliError::input(&args.params, e))?;
     let params = ParameterReport::from_json(&text).map_err(|e| CliError::input(&args.params, e))?;
     let prediction = params.prediction.as_ref().ok_or_else(|| {

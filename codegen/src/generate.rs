@@ -732,22 +732,13 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
     functions.extend(derivative_reports);
     items.extend(derivative_items);
-    let derivatives = Some(derivative_methods(sizes.nv));
+    methods.push(derivative_methods(sizes.nv));
     let ty = format_ident!("{}", name);
     let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
     functions.extend(frames.reports);
     items.extend(frames.items);
     methods.push(frames.methods);
     let mut tokens = robot_type(model, &ty, bases, &functions, &items, &methods);
-    if let Some(methods) = derivatives {
-        tokens.extend(quote! {
-            #[automatically_derived]
-            #[allow(clippy::all)]
-            impl ::dyngen::RobotDerivatives for #ty {
-                #methods
-            }
-        });
-    }
     tokens.extend(frames.enum_item);
     GeneratedCode {
         tokens,
@@ -774,7 +765,11 @@ fn derivative_items(
     let max_statements = max_statements.min(DERIVATIVE_MAX_STATEMENTS);
     // Rows and columns go by velocity coordinate.
     let n = sizes.nv;
-    let (n_l, nq_l, np_l) = (emit::usize_lit(n), emit::usize_lit(sizes.nq), emit::usize_lit(10 * sizes.n));
+    let (n_l, nq_l, np_l) = (
+        emit::usize_lit(n),
+        emit::usize_lit(sizes.nq),
+        emit::usize_lit(10 * sizes.n),
+    );
     let arg = |id, name, len| Arg { id, name, len };
     let (q, v, a, params) = (
         arg(ARG_Q, "q", sizes.nq),

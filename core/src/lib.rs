@@ -38,7 +38,7 @@ pub use dyngen_macros::robot;
 pub use frames::{log3, FrameJacobian, FrameJacobianTimeVariation, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
-pub use robot::{BodyRegressor, OpCount, Pose, Robot, RobotDerivatives, Wrench};
+pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
 pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
 pub use scalar::Scalar;
 

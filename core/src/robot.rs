@@ -247,11 +247,6 @@ pub trait Robot {
     /// `A_g` and its time derivative `Ȧ_g(q, v)` (each 6 × `NV`, row-major):
     /// `ḣ_g = A_g a + Ȧ_g v`.
     fn centroidal_map_time_variation<S: Scalar>(q: &[S], v: &[S], params: &[S], a_g: &mut [S], a_g_dot: &mut [S]);
-}
-
-/// The derivatives of the dynamics, over slices: implemented by every generated
-/// robot whose joints all have one degree of freedom (no free flyer, no ball joint).
-pub trait RobotDerivatives: Robot {
     /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`Robot::rnea`], each `NV × NV` row-major.
     fn rnea_derivatives<S: Scalar>(
         q: &[S],

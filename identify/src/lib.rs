@@ -29,6 +29,7 @@
 //! ```
 
 pub mod data;
+pub mod floating;
 pub mod friction;
 pub mod gains;
 pub mod mim;

@@ -167,19 +167,43 @@ pub fn analyse(model: &Model, parameterisation: Parameterisation) -> BaseParams 
     }
 }
 
+/// [`analyse`] on some rows of the dynamics only: `rows` lists the velocity
+/// coordinates whose equations are measured (e.g. `0..6`, the base wrench of a
+/// floating base from contact forces, or `6..nv`, the joint torques alone).
+pub fn analyse_rows(model: &Model, parameterisation: Parameterisation, rows: &[usize]) -> BaseParams {
+    let names = parameterisation.names_of(model);
+    let first = stacked_rows(model, parameterisation, SEEDS[0], Some(rows));
+    let sv = singular_values(&first);
+    let largest = sv.first().copied().unwrap_or(0.0);
+    let rank_check = sv.iter().filter(|&&s| s > RANK_TOLERANCE * largest && s > 0.0).count();
+    let mut base = from_stacked(first, &names);
+    let second = from_stacked(stacked_rows(model, parameterisation, SEEDS[1], Some(rows)), &names);
+    base.confirmed = second.independent == base.independent;
+    BaseParams {
+        parameterisation,
+        rank_check,
+        ..base
+    }
+}
+
 /// The regressor stacked over [`SAMPLES`] structure states drawn with `seed`.
 fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64) -> Vec<Vec<f64>> {
+    stacked_rows(model, parameterisation, seed, None)
+}
+
+/// [`stacked`] keeping only the rows `keep` of each state (all when `None`).
+fn stacked_rows(model: &Model, parameterisation: Parameterisation, seed: u64, keep: Option<&[usize]>) -> Vec<Vec<f64>> {
     let mut rows = Vec::with_capacity(SAMPLES * model.nv());
     for s in structure_states(model, SAMPLES, seed) {
-        let y = torque_regressor(model, &s.q, &s.v, &s.a);
+        let mut y = torque_regressor(model, &s.q, &s.v, &s.a);
         match parameterisation {
-            Parameterisation::Standard => rows.extend(y),
-            Parameterisation::Principal => rows.extend(principal_from_standard(model, &y)),
-            Parameterisation::StandardAndJoints => {
-                let mut y = y;
-                append_joint_columns(&mut y, &s.v, &s.a, Coulomb::Sign);
-                rows.extend(y);
-            }
+            Parameterisation::Standard => {}
+            Parameterisation::Principal => y = principal_from_standard(model, &y),
+            Parameterisation::StandardAndJoints => append_joint_columns(&mut y, &s.v, &s.a, Coulomb::Sign),
+        }
+        match keep {
+            None => rows.extend(y),
+            Some(k) => rows.extend(y.into_iter().enumerate().filter(|(d, _)| k.contains(d)).map(|(_, r)| r)),
         }
     }
     rows

@@ -5,7 +5,7 @@
 //! derivatives of inverse and forward dynamics and `M⁻¹`. Then the same functions
 //! against central finite differences of the generated code itself.
 
-use dyngen::{Pose, ReferenceFrame, RobotDerivatives};
+use dyngen::{Pose, ReferenceFrame, Robot};
 use dyngen_tests::tree12::Tree12;
 use dyngen_tests::{pose_vec, rel_err, workspace_root};
 use robot_gripper_arm::GripperArm;
@@ -62,7 +62,7 @@ impl Worst {
     }
 }
 
-fn check<R: RobotDerivatives>(fixture: &str) -> Worst {
+fn check<R: Robot>(fixture: &str) -> Worst {
     let fx = load(fixture);
     let who = R::NAME;
     let n = R::NV;
@@ -244,7 +244,7 @@ fn fd_err(got: &[f64], fd: &[Vec<f64>]) -> f64 {
 
 /// The generated Jacobians, drift and derivatives against central differences of the
 /// generated placements, velocities, rnea and aba, at random states (fixed seed).
-fn finite_differences<R: RobotDerivatives>() -> [f64; 6] {
+fn finite_differences<R: Robot>() -> [f64; 6] {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
     let n = R::NV;

@@ -4,7 +4,7 @@
 //! generated algorithm, the base rows included, frames and Jacobians, the centre of
 //! mass and the centroidal map. Then identities of the generated code itself.
 
-use dyngen::{ReferenceFrame, RobotDerivatives};
+use dyngen::{ReferenceFrame, Robot};
 use dyngen_tests::{pose_vec, rel_err, workspace_root};
 use robot_humanoid31::Humanoid31;
 use robot_quadruped12::Quadruped12;
@@ -58,7 +58,7 @@ impl Worst {
     }
 }
 
-fn check<R: RobotDerivatives>(fixture: &str) -> Worst {
+fn check<R: Robot>(fixture: &str) -> Worst {
     let fx = load(fixture);
     let who = R::NAME;
     let (nq, nv, nb) = (R::NQ, R::NV, R::NBODIES);
@@ -150,7 +150,16 @@ fn check<R: RobotDerivatives>(fixture: &str) -> Worst {
         worst.add("rnea_derivatives ∂τ/∂v", who, s, &dv, &nums(&x["dtau_dv"]));
         worst.add("rnea_derivatives ∂τ/∂a", who, s, &mm, &nums(&x["M"]));
         let mut minv = vec![0.0; nv * nv];
-        R::aba_derivatives(&q, &v, &nums(&x["tau_rand"]), params, &mut out, &mut dq, &mut dv, &mut minv);
+        R::aba_derivatives(
+            &q,
+            &v,
+            &nums(&x["tau_rand"]),
+            params,
+            &mut out,
+            &mut dq,
+            &mut dv,
+            &mut minv,
+        );
         worst.add("aba_derivatives q̈", who, s, &out, &nums(&x["ddq"]));
         worst.add("aba_derivatives ∂q̈/∂q", who, s, &dq, &nums(&x["ddq_dq"]));
         worst.add("aba_derivatives ∂q̈/∂v", who, s, &dv, &nums(&x["ddq_dv"]));
@@ -175,3 +184,130 @@ fn humanoid31_matches_pinocchio_free_flyer() {
     eprintln!("humanoid31: {w:?}");
 }
 
+/// Floating-base identification from the base rows (contact wrenches), the joint
+/// rows (joint torques) and both, on simulated samples of the quadruped with noise:
+/// which base parameters each gives, and that the estimate recovers them.
+#[test]
+fn quadruped12_identification_from_base_and_joint_rows() {
+    use dyngen_identify::floating::{Contact, FloatingBase, FloatingRows};
+    use dyngen_model::base::analyse_rows;
+    use dyngen_model::Parameterisation;
+    use rand::{Rng, SeedableRng};
+
+    type R = Quadruped12;
+    let nv = <R as Robot>::NV;
+    let model = dyngen_reference::model_from_static(&<R as Robot>::MODEL);
+    let base_rows: Vec<usize> = (0..6).collect();
+    let joint_rows: Vec<usize> = (6..nv).collect();
+    let all_rows: Vec<usize> = (0..nv).collect();
+    let from_base = analyse_rows(&model, Parameterisation::Standard, &base_rows);
+    let from_joints = analyse_rows(&model, Parameterisation::Standard, &joint_rows);
+    let from_all = analyse_rows(&model, Parameterisation::Standard, &all_rows);
+    eprintln!(
+        "quadruped12 base parameters: base rows {}, joint rows {}, all rows {} (of {})",
+        from_base.count(),
+        from_joints.count(),
+        from_all.count(),
+        <R as Robot>::NPARAMS
+    );
+    // The base rows alone determine every base parameter; the joint torques alone do
+    // not see the trunk (body 1) at all.
+    assert_eq!(from_base.count(), from_all.count());
+    assert!(from_joints.count() < from_all.count());
+    assert!(
+        from_joints.independent.iter().all(|&c| c >= 10),
+        "joint rows see no trunk parameter"
+    );
+    assert!(from_all.is_consistent() && from_base.is_consistent());
+
+    // Simulated recording: random states, generalized forces from rnea plus noise.
+    let truth = <R as Robot>::nominal_params();
+    let states = dyngen_model::sample::sample_states(&model, 400, 11);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let noise = 0.05;
+    let mut sets = Vec::new();
+    for rows in [FloatingRows::Base, FloatingRows::Joints, FloatingRows::All] {
+        let mut id = FloatingBase::<R>::new(rows).unwrap();
+        for s in &states {
+            let mut tau = vec![0.0; nv];
+            <R as Robot>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
+            for t in &mut tau {
+                *t += rng.gen_range(-noise..noise);
+            }
+            id.push(&s.q, &s.v, &s.a, &tau).unwrap();
+        }
+        sets.push((rows, id));
+    }
+    let opts = dyngen_identify::Options::default();
+    for ((rows, id), base) in sets.iter().zip([&from_base, &from_joints, &from_all]) {
+        let est = id.ols(&opts).unwrap();
+        assert_eq!(est.rank, base.count(), "{rows:?}: rank");
+        // Every base parameter of the analysis is recovered: β = K π.
+        for (k, row) in base.k.iter().enumerate() {
+            let value = est.value_of(row).expect("identifiable");
+            let want: f64 = row.iter().zip(truth).map(|(a, b)| a * b).sum();
+            let scale = row.iter().map(|x| x.abs()).sum::<f64>().max(1.0);
+            assert!(
+                (value - want).abs() < 0.02 * scale,
+                "{rows:?}: {}: {value} vs {want}",
+                base.groupings[k]
+            );
+        }
+        eprintln!(
+            "{rows:?}: rank {}, condition number {:.1e}, residual rms {:.3} (noise rms {:.3})",
+            est.rank,
+            est.condition_number,
+            est.residuals.rms,
+            noise / 3f64.sqrt()
+        );
+    }
+
+    // Contact wrenches instead of the base rows: a foot force on each foot frame,
+    // mapped through the frames' Jacobians, gives the same data.
+    let feet: Vec<usize> = (0..<R as Robot>::MODEL.frames.len())
+        .filter(|&f| <R as Robot>::MODEL.frames[f].name.ends_with("foot"))
+        .collect();
+    assert_eq!(feet.len(), 4, "four feet");
+    let s = &states[0];
+    let mut tau = vec![0.0; nv];
+    <R as Robot>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
+    // One contact at a foot: the base rows of Jᵀ F carry the whole generalized force
+    // on the base; choose F so that the dynamics hold, from the base rows.
+    let mut jac = vec![0.0; 6 * nv];
+    <R as Robot>::frame_jacobian(&s.q, feet[0], ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
+    // J[:, 0..6] is invertible (a rigid transform of the base twist): solve Jbᵀ w = τ_base.
+    let jb = nalgebra::Matrix6::from_fn(|r, c| jac[r * nv + c]);
+    let w = jb
+        .transpose()
+        .lu()
+        .solve(&nalgebra::Vector6::from_column_slice(&tau[..6]))
+        .unwrap();
+    let joint_torques: Vec<f64> = (6..nv)
+        .map(|d| tau[d] - (0..6).map(|r| jac[r * nv + d] * w[r]).sum::<f64>())
+        .collect();
+    let mut by_contact = FloatingBase::<R>::new(FloatingRows::All).unwrap();
+    let contact = Contact {
+        frame: feet[0],
+        force: [w[0], w[1], w[2]],
+        moment: [w[3], w[4], w[5]],
+    };
+    by_contact
+        .push_contacts(&s.q, &s.v, &s.a, &joint_torques, &[contact])
+        .unwrap();
+    let mut direct = FloatingBase::<R>::new(FloatingRows::All).unwrap();
+    direct.push(&s.q, &s.v, &s.a, &tau).unwrap();
+    let (a, b) = (by_contact.accumulator(), direct.accumulator());
+    assert_eq!(a.rows(), b.rows());
+    // The same equations: the nominal parameters fit both exactly.
+    let fit = |acc: &dyngen_identify::Accumulator| acc.ols(&opts).unwrap().residuals.rms;
+    assert!(fit(a) < 1e-9 && fit(b) < 1e-9);
+
+    // Errors: a fixed-base robot, a frame that does not exist, wrong lengths.
+    assert!(FloatingBase::<robot_panda::Panda>::new(FloatingRows::All).is_err());
+    let bad = Contact { frame: 999, ..contact };
+    let e = by_contact
+        .push_contacts(&s.q, &s.v, &s.a, &joint_torques, &[bad])
+        .unwrap_err();
+    assert!(e.to_string().contains("999"), "{e}");
+    assert!(direct.push(&s.q[..5], &s.v, &s.a, &tau).is_err());
+}

@@ -311,3 +311,52 @@ fn quadruped12_identification_from_base_and_joint_rows() {
     assert!(e.to_string().contains("999"), "{e}");
     assert!(direct.push(&s.q[..5], &s.v, &s.a, &tau).is_err());
 }
+
+dyngen::robot! {
+    name: Floater,
+    incidence: [
+        [-1,  0,  0],
+        [ 1, -1,  0],
+        [ 0,  1, -1],
+        [ 0,  0,  1],
+    ],
+    joints: [free(), spherical(rest: [0.0, 0.0, 0.5]), revolute(y)],
+    body_joint_vectors: {
+        (0, 1): [0.0, 0.0, 0.0],
+        (1, 1): [0.0, 0.0, 0.0], (1, 2): [0.2, 0.0, 0.0],
+        (2, 2): [-0.1, 0.0, 0.0], (2, 3): [0.1, 0.0, 0.0],
+        (3, 3): [-0.1, 0.0, 0.0],
+    },
+    bodies: {
+        1: principal(mass: 5.0, moments: [0.1, 0.2, 0.25]),
+        2: cylinder(mass: 1.0, radius: 0.03, length: 0.2, axis: x),
+        3: cylinder(mass: 0.5, radius: 0.02, length: 0.2, axis: x),
+    },
+}
+
+/// A floating base written in the `robot!` DSL (`free()`, `spherical()`): the base
+/// rows of `rnea` at rest carry the weight; `aba` inverts `rnea`; `M` is symmetric
+/// positive definite with the total mass in its linear block.
+#[test]
+fn dsl_floating_base_with_a_ball_joint() {
+    assert_eq!((Floater::NQ, Floater::NV), (12, 10));
+    let mut q = [0.0; 12];
+    q[6] = 1.0;
+    q[10] = 1.0;
+    let g = Floater::generalized_gravity(&q, &Floater::NOMINAL_PARAMS);
+    assert!((g[2] - 6.5 * 9.81).abs() < 1e-12, "{g:?}");
+    let mut states = dyngen_model::sample::sample_states(&dyngen_reference::model_from_static(&Floater::MODEL), 5, 3);
+    for s in states.drain(..) {
+        let q: [f64; 12] = s.q.try_into().unwrap();
+        let v: [f64; 10] = s.v.try_into().unwrap();
+        let a: [f64; 10] = s.a.try_into().unwrap();
+        let tau = Floater::rnea(&q, &v, &a, &Floater::NOMINAL_PARAMS);
+        let back = Floater::aba(&q, &v, &tau, &Floater::NOMINAL_PARAMS);
+        assert!(rel_err(&back, &a, 1.0) < 1e-12);
+        let mut m = [[0.0; 10]; 10];
+        Floater::crba(&q, &Floater::NOMINAL_PARAMS, &mut m);
+        for r in 0..3 {
+            assert!((m[r][r] - 6.5).abs() < 1e-12);
+        }
+    }
+}

@@ -27,10 +27,12 @@ pub fn check(cx: &Ctxt, robot: &Robot) -> Option<IncidenceTree> {
 
     if let Some(list) = &robot.joints.value {
         check_joint_count(cx, list, n);
-        for joint in list.joints.iter().flatten() {
+        for (a, joint) in list.joints.iter().enumerate() {
+            let Some(joint) = joint else { continue };
             check_axis_nonzero(cx, joint);
             check_limits_ordered(cx, joint);
             check_continuous_has_no_limits(cx, joint);
+            check_free_is_first(cx, joint, a);
         }
     }
 
@@ -323,9 +325,16 @@ fn check_limits_ordered(cx: &Ctxt, joint: &Joint) {
     }
 }
 
-/// A continuous joint is by definition a revolute joint without limits; limits on it
-/// would be silently dropped.
+/// A continuous joint is by definition a revolute joint without limits, and a ball
+/// joint or a free flyer has no single coordinate to limit; limits on them would be
+/// silently dropped.
 fn check_continuous_has_no_limits(cx: &Ctxt, joint: &Joint) {
+    if let (JointKind::Spherical | JointKind::FreeFlyer, Some(l)) = (joint.kind, &joint.limits) {
+        cx.error_spanned_by(
+            joint.kind_loc.to(l.key_loc),
+            "a `spherical` or `free` joint has no position limits (its coordinates are a quaternion); remove `limits`",
+        );
+    }
     if let (JointKind::Continuous, Some(l)) = (joint.kind, &joint.limits) {
         cx.error_spanned_by(
             joint.kind_loc.to(l.key_loc),
@@ -335,6 +344,21 @@ fn check_continuous_has_no_limits(cx: &Ctxt, joint: &Joint) {
                 symbol::CONTINUOUS,
                 symbol::REVOLUTE,
                 symbol::LIMITS
+            ),
+        );
+    }
+}
+
+/// A free flyer is the floating base: joint 1, between the base (body 0) and body 1.
+fn check_free_is_first(cx: &Ctxt, joint: &Joint, column: usize) {
+    if joint.kind == JointKind::FreeFlyer && column != 0 {
+        cx.error_spanned_by(
+            joint.kind_loc,
+            format!(
+                "a `{}` joint is the floating base: it must be joint 1 (the first column of the incidence \
+                 matrix), between the base (body 0) and body 1; this is joint {}",
+                symbol::FREE,
+                column + 1
             ),
         );
     }

@@ -51,7 +51,11 @@ pub fn lower(robot: &Robot, tree: &IncidenceTree) -> Option<Description> {
             parent: format!("body{p}"),
             child: format!("body{child}"),
             origin: Placement::from_xyz_rpy(translation, rest),
-            axis: joint.axis.as_ref()?.value,
+            axis: if joint.kind.has_axis() {
+                joint.axis.as_ref()?.value
+            } else {
+                [0.0; 3]
+            },
             limits: joint.limits.as_ref().map(|l| Limits {
                 lower: l.lower.value,
                 upper: l.upper.value,

@@ -201,6 +201,59 @@ mod tests {
     }
 
     #[test]
+    fn free_and_spherical_joints_lower_to_a_floating_model() {
+        let d = description(quote! {
+            name: Floater,
+            incidence: [
+                [-1,  0,  0],
+                [ 1, -1,  0],
+                [ 0,  1, -1],
+                [ 0,  0,  1],
+            ],
+            joints: [free(), spherical(rest: [0.0, 0.0, 0.5]), revolute(y)],
+            body_joint_vectors: {
+                (0, 1): [0.0, 0.0, 0.0],
+                (1, 1): [0.0, 0.0, 0.0], (1, 2): [0.2, 0.0, 0.0],
+                (2, 2): [-0.1, 0.0, 0.0], (2, 3): [0.1, 0.0, 0.0],
+                (3, 3): [-0.1, 0.0, 0.0],
+            },
+            bodies: {
+                1: principal(mass: 5.0, moments: [0.1, 0.2, 0.25]),
+                2: cylinder(mass: 1.0, radius: 0.03, length: 0.2, axis: x),
+                3: cylinder(mass: 0.5, radius: 0.02, length: 0.2, axis: x),
+            },
+        });
+        let model = d.build().unwrap();
+        let kinds: Vec<JointKind> = model.joints.iter().map(|j| j.kind).collect();
+        assert_eq!(kinds, [JointKind::FreeFlyer, JointKind::Spherical, JointKind::Revolute]);
+        assert!(model.is_floating());
+        assert_eq!((model.nq(), model.nv()), (12, 10));
+        assert_eq!(model.joints[1].axis, [0.0; 3]);
+    }
+
+    #[test]
+    fn free_and_spherical_joints_take_no_axis_and_no_limits() {
+        let robot = |joints: TokenStream| {
+            quote! {
+                name: Bad,
+                incidence: [[-1], [1]],
+                joints: #joints,
+                body_joint_vectors: { (0, 1): [0.0, 0.0, 0.0], (1, 1): [0.0, 0.0, 0.0] },
+                bodies: { 1: principal(mass: 1.0, moments: [0.1, 0.1, 0.1]) },
+            }
+        };
+        let m = messages(robot(quote!([spherical(z)])));
+        assert!(
+            m.iter()
+                .any(|e| e.contains("a `spherical` joint has no axis: write `spherical()`")),
+            "{m:?}"
+        );
+        let m = messages(robot(quote!([free(limits: [-1.0, 1.0])])));
+        assert!(m.iter().any(|e| e.contains("has no position limits")), "{m:?}");
+        assert!(messages(robot(quote!([free()]))).is_empty());
+    }
+
+    #[test]
     fn planar2_lowers_to_the_expected_description() {
         let d = description(planar2());
         assert_eq!(d.name, "Planar2");

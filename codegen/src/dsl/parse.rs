@@ -367,7 +367,7 @@ fn joints(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<JointList> {
 fn joint(cx: &Ctxt, tokens: TokenStream) -> Option<Joint> {
     let valid = || {
         format!(
-            "valid joint types are {}, each as `type(axis)`",
+            "valid joint types are {}, each as `type(axis)` (`spherical()` and `free()` take no axis)",
             symbol::one_of(symbol::JOINT_TYPES)
         )
     };
@@ -389,6 +389,8 @@ fn joint(cx: &Ctxt, tokens: TokenStream) -> Option<Joint> {
         Some(symbol::REVOLUTE) => JointKind::Revolute,
         Some(symbol::CONTINUOUS) => JointKind::Continuous,
         Some(symbol::PRISMATIC) => JointKind::Prismatic,
+        Some(symbol::SPHERICAL) => JointKind::Spherical,
+        Some(symbol::FREE) => JointKind::FreeFlyer,
         _ if kind_ident == symbol::FIXED => {
             cx.error_spanned_by(
                 &kind_ident,
@@ -413,21 +415,37 @@ fn joint(cx: &Ctxt, tokens: TokenStream) -> Option<Joint> {
         }
     };
     let args_loc = Loc::at(args.span());
-    let mut pieces = nonempty_pieces(cx, args.stream(), "an argument").into_iter();
-    let axis = match pieces.next() {
-        None => {
+    let mut pieces = nonempty_pieces(cx, args.stream(), "an argument").into_iter().peekable();
+    // `key: value`, as opposed to a positional axis.
+    let named = |p: &Piece| {
+        let mut t = p.tokens.clone().into_iter();
+        matches!((t.next(), t.next()), (Some(TokenTree::Ident(_)), Some(TokenTree::Punct(c))) if c.as_char() == ':')
+    };
+    let axis = if !kind.has_axis() {
+        // A ball joint or a free flyer turns (and moves) every way: no axis.
+        if let Some(piece) = pieces.next_if(|p| !named(p)) {
             cx.error_spanned_by(
-                args_loc,
-                format!(
-                    "expected the joint axis, as in `{kind_ident}(z)`: `x`, `y`, `z`, `-x`, `-y`, \
-                     `-z` or `[ax, ay, az]`"
-                ),
+                Loc::of(&piece.tokens, args.span()),
+                format!("a `{kind_ident}` joint has no axis: write `{kind_ident}()`"),
             );
-            None
         }
-        Some(piece) => {
-            let ploc = Loc::of(&piece.tokens, args.span());
-            report(cx, parse_all(piece.tokens, |i| axis(i, ploc)))
+        None
+    } else {
+        match pieces.next() {
+            None => {
+                cx.error_spanned_by(
+                    args_loc,
+                    format!(
+                        "expected the joint axis, as in `{kind_ident}(z)`: `x`, `y`, `z`, `-x`, `-y`, \
+                     `-z` or `[ax, ay, az]`"
+                    ),
+                );
+                None
+            }
+            Some(piece) => {
+                let ploc = Loc::of(&piece.tokens, args.span());
+                report(cx, parse_all(piece.tokens, |i| axis(i, ploc)))
+            }
         }
     };
     let mut rest = None;
@@ -945,7 +963,7 @@ mod tests {
             name: "Planar",
             colour: red,
             gravity: [0.0, 1.0],
-            joints: [revolute(w), spherical(z), revolute(z, rest: [0, 0, 0], rest: [0, 0, 0])],
+            joints: [revolute(w), helical(z), revolute(z, rest: [0, 0, 0], rest: [0, 0, 0])],
             bodies: { 1: cylinder(mass: 1.0, radius: 0.1, axis: x), 2: blob() },
         });
         assert_eq!(e.len(), 8, "{e:#?}");
@@ -953,7 +971,7 @@ mod tests {
         assert!(e[1].contains("unknown keyword `colour`"));
         assert!(e[2].contains("exactly 3 numbers"));
         assert!(e[3].contains("unknown axis `w`"));
-        assert!(e[4].contains("unknown joint type `spherical`"));
+        assert!(e[4].contains("unknown joint type `helical`"));
         assert!(e[5].contains("duplicate `rest`"));
         assert!(e[6].contains("missing `length`"), "{e:#?}");
         assert!(e[7].contains("unknown body kind `blob`"), "{e:#?}");

@@ -37,7 +37,12 @@ pub const INLINE_OPTIONAL: &[Symbol] = &[GRAVITY, FRAMES];
 pub const REVOLUTE: Symbol = Symbol("revolute");
 pub const CONTINUOUS: Symbol = Symbol("continuous");
 pub const PRISMATIC: Symbol = Symbol("prismatic");
-pub const JOINT_TYPES: &[Symbol] = &[REVOLUTE, CONTINUOUS, PRISMATIC];
+/// A ball joint, `spherical()`: no axis.
+pub const SPHERICAL: Symbol = Symbol("spherical");
+/// The free flyer of a floating base, `free()`: no axis; only between the base and
+/// body 1.
+pub const FREE: Symbol = Symbol("free");
+pub const JOINT_TYPES: &[Symbol] = &[REVOLUTE, CONTINUOUS, PRISMATIC, SPHERICAL, FREE];
 /// Not a joint type of the inline form; named only to explain why.
 pub const FIXED: Symbol = Symbol("fixed");
 

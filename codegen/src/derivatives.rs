@@ -413,18 +413,11 @@ fn partials<'g>(
     // Changing a velocity moves the subtree by S_e: its own bias acceleration changes by
     // β (the incoming motion's) and the joints below add the turn of S_e at the body's
     // own velocity; for one degree of freedom both are β, hence 2β.
-    let beta_v: Vec<Motion<'g>> = (0..nv)
+    // (Built for the coordinates of multi-coordinate joints only.)
+    let beta_v: Vec<Option<Motion<'g>>> = (0..nv)
         .map(|d| {
             let b = body[d];
-            if model.joints[b - 1].kind.has_axis() {
-                let two = g.constant(2.0);
-                Motion {
-                    v: beta[d].v.scale(two),
-                    w: beta[d].w.scale(two),
-                }
-            } else {
-                beta[d] + v[b].cross_motion(s[d])
-            }
+            (!model.joints[b - 1].kind.has_axis()).then(|| beta[d] + v[b].cross_motion(s[d]))
         })
         .collect();
     let ccs: Vec<Force<'g>> = (0..nv).map(|d| inertia_times(&cc[body[d] - 1], s[d])).collect();
@@ -441,10 +434,9 @@ fn partials<'g>(
         loop {
             for e in algo::dofs(model, c) {
                 dq[d][e] = rho.dot(alpha[e]) + sigma.dot(beta[e]);
-                dv[d][e] = if model.joints[c - 1].kind.has_axis() {
-                    two * rho.dot(beta[e]) + sigma.dot(s[e])
-                } else {
-                    rho.dot(beta_v[e]) + sigma.dot(s[e])
+                dv[d][e] = match beta_v[e] {
+                    None => two * rho.dot(beta[e]) + sigma.dot(s[e]),
+                    Some(bv) => rho.dot(bv) + sigma.dot(s[e]),
                 };
             }
             let p = model.parent(c);
@@ -468,10 +460,9 @@ fn partials<'g>(
             + inertia_times(&cc[c - 1], be)
             + be.cross_force(h)
             + sc.cross_force(wrenches[c - 1]);
-        let mut gv = if model.joints[c - 1].kind.has_axis() {
-            force_scale(inertia_times(&ic[c - 1], be), two) + ccs[e] + sc.cross_force(h)
-        } else {
-            inertia_times(&ic[c - 1], beta_v[e]) + ccs[e] + sc.cross_force(h)
+        let mut gv = match beta_v[e] {
+            None => force_scale(inertia_times(&ic[c - 1], be), two) + ccs[e] + sc.cross_force(h),
+            Some(bv) => inertia_times(&ic[c - 1], bv) + ccs[e] + sc.cross_force(h),
         };
         let mut j = c;
         while model.parent(j) != 0 {

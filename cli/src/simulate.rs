@@ -149,13 +149,20 @@ pub struct SimulateArgs {
     pub base_frequency: f64,
 
     /// Fourier: objective evaluations allowed to the optimiser (each one evaluates
-    /// the regressor at every sample; the default takes seconds for a 6-joint arm in a
-    /// release build, about 3 minutes for a 31-joint tree at 67 ms an evaluation, with
-    /// a progress bar). Too few for one Nelder–Mead run (0, say; a run needs more than
+    /// the regressor at every sample). Default: 3000 up to 12 joints, then 3000·(12/n)²,
+    /// so that it takes about as long on any robot: seconds for a 6-joint arm in a
+    /// release build, about 30 s (450 evaluations) for a 31-joint tree, with a
+    /// progress bar. Too few for one Nelder–Mead run (0, say; a run needs more than
     /// one evaluation per variable, 1 + 2·harmonics per joint) keep the random feasible
     /// start.
-    #[arg(long, default_value_t = 3000)]
-    pub evaluations: usize,
+    #[arg(long)]
+    pub evaluations: Option<usize>,
+
+    /// Fourier: stop optimising after this many seconds and keep the best excitation
+    /// so far (the result then depends on the machine's speed; `--evaluations` is the
+    /// reproducible bound).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub time_budget: Option<f64>,
 
     #[command(flatten)]
     pub gravity: ModelArgs,
@@ -171,6 +178,13 @@ fn check_args(args: &SimulateArgs) -> Result<()> {
     }
     if args.steps < 1 {
         return Err(CliError::usage("--steps must be at least 1"));
+    }
+    if let Some(t) = args.time_budget {
+        if !(t.is_finite() && t > 0.0 && t < 1e9) {
+            return Err(CliError::usage(format!(
+                "--time-budget must be a positive number of seconds, got {t}"
+            )));
+        }
     }
     if !(args.noise.is_finite() && args.noise >= 0.0) {
         return Err(CliError::usage(format!(
@@ -216,7 +230,10 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             design.base_frequency = args.base_frequency;
             design.duration = args.duration.unwrap_or(1.0 / args.base_frequency);
             design.samples = args.steps;
-            design.max_evaluations = args.evaluations;
+            if let Some(n) = args.evaluations {
+                design.max_evaluations = n;
+            }
+            design.time_budget = args.time_budget.map(std::time::Duration::from_secs_f64);
             design.seed = args.seed;
             // A bar with the evaluations spent and the time left: one evaluation stacks
             // the regressor at every sample, tens of milliseconds on a 30-joint tree.

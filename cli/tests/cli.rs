@@ -242,3 +242,28 @@ fn demo_prints_the_papers_tables() {
     let o = run!("demo", "--quiet", "--out", dir);
     assert_error(&o, "--force");
 }
+
+/// `--free-flyer` floats the root link: `info` shows the coordinates, `generate`
+/// writes the floating type, and the commands that run the dynamics at run time refuse
+/// it by name. `--time-budget` is checked.
+#[test]
+fn free_flyer_in_info_and_generate_and_refused_at_run_time() {
+    let o = run!("info", ur5(), "--free-flyer", "--no-ops");
+    assert_ok(&o);
+    let out = stdout(&o);
+    assert!(
+        out.contains("13 position coordinates, 12 velocity coordinates (floating base"),
+        "{out}"
+    );
+    assert!(out.contains("root_joint") && out.contains("floating"), "{out}");
+    let dir = temp_dir("dyngen-cli", "free-flyer");
+    let file = dir.join("floating.rs");
+    let o = run!("generate", ur5(), "--free-flyer", "--name", "FloatingUr5", "-o", &file);
+    assert_ok(&o);
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains("pub const NQ: usize = 13;") && text.contains("pub const NV: usize = 12;"));
+    let o = run!("simulate", ur5(), "--free-flyer", "-o", dir.join("x.csv"));
+    assert_error(&o, "joint `root_joint` is a floating joint (7 positions, 6 velocities)");
+    let o = run!("simulate", ur5(), "-o", dir.join("y.csv"), "--time-budget", "-1");
+    assert_error(&o, "--time-budget must be a positive number of seconds");
+}

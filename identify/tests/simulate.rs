@@ -790,3 +790,26 @@ fn a_recording_from_measurements_needs_velocities_accelerations_and_wrenches() {
          MIM from body measurements needs them"
     );
 }
+
+/// The default evaluation count scales with the robot so it takes about the same time
+/// on any tree; a time budget stops the search and keeps the best point so far.
+#[test]
+fn excitation_defaults_scale_and_a_time_budget_keeps_the_best_so_far() {
+    assert_eq!(ExcitationDesign::default_evaluations(6), 3000);
+    assert_eq!(ExcitationDesign::default_evaluations(12), 3000);
+    assert_eq!(ExcitationDesign::default_evaluations(31), 450);
+    let (m, r) = reference();
+    let mut design = ExcitationDesign::new(&m);
+    assert_eq!(design.max_evaluations, 3000);
+    assert_eq!(design.time_budget, None);
+    design.harmonics = 2;
+    design.samples = 12;
+    design.max_evaluations = 100_000;
+    design.time_budget = Some(std::time::Duration::from_millis(1));
+    let result = design.optimise(&r);
+    // Stopped by the budget long before 100,000 evaluations (no wall-clock bound is
+    // asserted; the count says it stopped).
+    assert!(result.evaluations < 100_000, "{}", result.evaluations);
+    assert!(result.value <= result.initial_value);
+    assert_limits(&result.excitation, &design.limits);
+}

@@ -137,7 +137,10 @@ impl<S: Scalar, const N: usize> AbaDerivatives<S, N> {
     /// ```
     ///
     /// (`q ⊕ dt·v` is `q + dt·v` here: every joint coordinate is an angle or a
-    /// displacement.)
+    /// displacement. With a free flyer or a ball joint `q` has more coordinates than
+    /// `v` and does not fit `[S; N]`: step the configuration with
+    /// [`crate::configuration::integrate`]; the derivatives are then with respect to
+    /// the tangent of the configuration, as Pinocchio's.)
     pub fn semi_implicit_euler(&self, q: &[S; N], v: &[S; N], dt: S) -> Linearization<S, N> {
         let mut l = Linearization::default();
         for i in 0..N {

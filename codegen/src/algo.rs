@@ -98,8 +98,13 @@ impl<'g> M3<'g> {
     /// `R · self · Rᵀ` for a symmetric `self`: the upper triangle is computed and
     /// mirrored, so both halves are the same nodes.
     pub fn rotate_sym(&self, r: &M3<'g>) -> M3<'g> {
-        let full = r.mul(self).mul(&r.transpose());
-        let mut m = full.0;
+        r.mul(self).mul(&r.transpose()).mirror_upper()
+    }
+
+    /// The symmetric matrix of the upper triangle: the lower entries replaced by the
+    /// upper ones (the same nodes), for results known to be symmetric.
+    pub fn mirror_upper(self) -> M3<'g> {
+        let mut m = self.0;
         for a in 0..3 {
             for b in 0..a {
                 m[a][b] = m[b][a];
@@ -815,16 +820,10 @@ pub fn composite_to_parent<'g>(x: &JointTransform<'g>, b: &BodyParams<'g>) -> Bo
     let rot = b.inertia.rotate_sym(&x.motion).rotate_sym(&x.origin);
     let (sp, srh) = (M3::skew(p), M3::skew(rh));
     let shift = sp.mul(&sp).scale(b.m).add(&sp.mul(&srh)).add(&srh.mul(&sp));
-    let mut inertia = rot.sub(&shift).0;
-    for a in 0..3 {
-        for c in 0..a {
-            inertia[a][c] = inertia[c][a];
-        }
-    }
     BodyParams {
         m: b.m,
         h: rh + p.scale(b.m),
-        inertia: M3(inertia),
+        inertia: rot.sub(&shift).mirror_upper(),
     }
 }
 
@@ -863,19 +862,10 @@ impl<'g> Inertia6<'g> {
     /// `self − U Uᵀ / D` with `inv_d = 1 / D`.
     fn minus_outer(&self, u: &Force<'g>, inv_d: Expr<'g>) -> Inertia6<'g> {
         let (u1, u2) = (u.f, u.n);
-        let sym = |m: M3<'g>| {
-            let mut a = m.0;
-            for r in 0..3 {
-                for c in 0..r {
-                    a[r][c] = a[c][r];
-                }
-            }
-            M3(a)
-        };
         Inertia6 {
-            m: sym(self.m.sub(&M3::outer(u1.scale(inv_d), u1))),
+            m: self.m.sub(&M3::outer(u1.scale(inv_d), u1)).mirror_upper(),
             h: self.h.sub(&M3::outer(u1.scale(inv_d), u2)),
-            j: sym(self.j.sub(&M3::outer(u2.scale(inv_d), u2))),
+            j: self.j.sub(&M3::outer(u2.scale(inv_d), u2)).mirror_upper(),
         }
     }
 
@@ -887,19 +877,10 @@ impl<'g> Inertia6<'g> {
             out.h = out.h.sub(&M3::outer(ua.f, wa.n));
             out.j = out.j.sub(&M3::outer(ua.n, wa.n));
         }
-        let sym = |m: M3<'g>| {
-            let mut a = m.0;
-            for r in 0..3 {
-                for c in 0..r {
-                    a[r][c] = a[c][r];
-                }
-            }
-            M3(a)
-        };
         Inertia6 {
-            m: sym(out.m),
+            m: out.m.mirror_upper(),
             h: out.h,
-            j: sym(out.j),
+            j: out.j.mirror_upper(),
         }
     }
 
@@ -920,13 +901,11 @@ impl<'g> Inertia6<'g> {
             .sub(&h.transpose().mul(&sp))
             .add(&sp.mul(&h))
             .sub(&sp.mul(&m).mul(&sp));
-        let mut ja = j2.0;
-        for a in 0..3 {
-            for c in 0..a {
-                ja[a][c] = ja[c][a];
-            }
+        Inertia6 {
+            m,
+            h: h2,
+            j: j2.mirror_upper(),
         }
-        Inertia6 { m, h: h2, j: M3(ja) }
     }
 }
 

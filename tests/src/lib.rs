@@ -158,6 +158,28 @@ pub fn workspace_root() -> PathBuf {
         .unwrap_or_default()
 }
 
+/// Reads `tests/fixtures/<path>` (a JSON file) as an untyped value.
+pub fn load_json(path: &str) -> serde_json::Value {
+    let path = workspace_root().join("tests/fixtures").join(path);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The numbers of a JSON value, nested lists flattened row-major; a placement
+/// `{"rotation", "translation"}` as its 12 numbers (as [`pose_vec`]).
+pub fn json_numbers(v: &serde_json::Value) -> Vec<f64> {
+    use serde_json::Value;
+    match v {
+        Value::Number(x) => vec![x.as_f64().expect("f64")],
+        Value::Array(xs) => xs.iter().flat_map(json_numbers).collect(),
+        Value::Object(o) if o.contains_key("rotation") => json_numbers(&o["rotation"])
+            .into_iter()
+            .chain(json_numbers(&o["translation"]))
+            .collect(),
+        _ => panic!("not a number, a list or a placement: {v}"),
+    }
+}
+
 /// Loads `tests/fixtures/<name>.json`.
 pub fn load_fixture(name: &str) -> Fixture {
     let path = workspace_root().join("tests/fixtures").join(format!("{name}.json"));

@@ -7,7 +7,7 @@
 
 use dyngen::{Pose, ReferenceFrame, Robot};
 use dyngen_tests::tree12::Tree12;
-use dyngen_tests::{pose_vec, rel_err, workspace_root};
+use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;
@@ -24,24 +24,7 @@ const REFS: [(ReferenceFrame, &str); 3] = [
 ];
 
 fn load(name: &str) -> Value {
-    let path = workspace_root().join(format!("tests/fixtures/control/{name}.json"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).expect("fixture JSON")
-}
-
-/// Numbers of a JSON value, nested lists flattened row-major.
-fn nums(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Number(x) => vec![x.as_f64().expect("f64")],
-        Value::Array(xs) => xs.iter().flat_map(nums).collect(),
-        _ => panic!("not a number or list: {v}"),
-    }
-}
-
-fn fixture_pose(v: &Value) -> Vec<f64> {
-    let mut p = nums(&v["rotation"]);
-    p.extend(nums(&v["translation"]));
-    p
+    load_json(&format!("control/{name}.json"))
 }
 
 /// Worst relative error of each quantity over the fixture, by name.
@@ -106,14 +89,7 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         let zero = vec![0.0; n];
         for (f, want) in index.iter().zip(sample["frames"].as_array().unwrap()) {
             let placement = R::frame_placement(&q, *f).unwrap();
-            worst.add(
-                "placement",
-                who,
-                s,
-                &pose_vec(&placement),
-                &fixture_pose(&want["oMf"]),
-                1.0,
-            );
+            worst.add("placement", who, s, &pose_vec(&placement), &nums(&want["oMf"]), 1.0);
             for (reference, key) in REFS {
                 let mut jac = vec![0.0; 6 * n];
                 let p = R::frame_jacobian(&q, *f, reference, &mut jac).unwrap();

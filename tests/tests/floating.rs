@@ -5,7 +5,7 @@
 //! mass and the centroidal map. Then identities of the generated code itself.
 
 use dyngen::{ReferenceFrame, Robot};
-use dyngen_tests::{pose_vec, rel_err, workspace_root};
+use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err};
 use robot_humanoid31::Humanoid31;
 use robot_quadruped12::Quadruped12;
 use serde_json::Value;
@@ -17,22 +17,7 @@ const TOL: f64 = 1e-12;
 const TOL_FORWARD_DERIVATIVES: f64 = 5e-12;
 
 fn load(name: &str) -> Value {
-    let path = workspace_root().join(format!("tests/fixtures/floating/{name}.json"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).expect("fixture JSON")
-}
-
-/// Numbers of a JSON value, nested lists flattened row-major.
-fn nums(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Number(x) => vec![x.as_f64().expect("f64")],
-        Value::Array(xs) => xs.iter().flat_map(nums).collect(),
-        Value::Object(o) => nums(&o["rotation"])
-            .into_iter()
-            .chain(nums(&o["translation"]))
-            .collect(),
-        _ => panic!("not a number or list: {v}"),
-    }
+    load_json(&format!("floating/{name}.json"))
 }
 
 /// Worst relative error of each quantity, by name.

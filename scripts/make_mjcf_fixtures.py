@@ -19,6 +19,11 @@ For each of `robots/ur5/ur5.urdf` and `robots/panda/panda.urdf`:
     bias forces `qfrc_bias` (gravity + Coriolis/centrifugal, dyngen's
     `nonlinear_effects`): `NAME.json`.
 
+For `robots/quadruped12/quadruped12.urdf`, (a) with the root link put on a URDF
+`floating` joint from a `world` link first: `quadruped12.xml`, with MuJoCo's free
+joint; `model/tests/mjcf.rs` reads it and checks it against the URDF loaded with a
+free flyer (the same robot in both formats).
+
 (c) For the hand-written `small.xml` (not written by this script), MuJoCo's values as
     in (b): `small.json`.
 (d) For the hand-written `floating.xml` (a free-floating torso and a ball joint),
@@ -41,13 +46,24 @@ import mujoco
 import numpy as np
 
 ROBOTS = {"ur5": "robots/ur5/ur5.urdf", "panda": "robots/panda/panda.urdf"}
+# Floating-base robots: the URDF's root link put on a `floating` joint from a `world`
+# link before the export, which MuJoCo turns into a free joint (`<freejoint>`).
+FLOATING = {"quadruped12": "robots/quadruped12/quadruped12.urdf"}
 COMPILER = ('<mujoco><compiler discardvisual="true" fusestatic="false" '
             'balanceinertia="false" angle="radian"/></mujoco>')
 
 
-def urdf_to_mjcf(urdf_path, out_path):
+def urdf_to_mjcf(urdf_path, out_path, floating=False):
     with open(urdf_path) as f:
         src = f.read()
+    if floating:
+        children = set(re.findall(r'<child\s+link="([^"]+)"', src))
+        links = re.findall(r'<link\s+name="([^"]+)"', src)
+        [root] = [l for l in links if l not in children]
+        world = ('<link name="world"/><joint name="root_joint" type="floating">'
+                 f'<parent link="world"/><child link="{root}"/></joint>')
+        src, n = re.subn(r"(<robot[^>]*>)", lambda m: m.group(1) + world, src, count=1)
+        assert n == 1, "no <robot> element"
     src, n = re.subn(r"(<robot[^>]*>)", lambda m: m.group(1) + COMPILER, src, count=1)
     assert n == 1, "no <robot> element"
     with tempfile.TemporaryDirectory() as tmp:
@@ -207,11 +223,17 @@ def floating_reference(xml_path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out-dir", default="tests/fixtures/mjcf")
-    ap.add_argument("--only", choices=[*ROBOTS, "small", "floating"],
+    ap.add_argument("--only", choices=[*ROBOTS, *FLOATING, "small", "floating"],
                     help="write this fixture alone")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
     wanted = lambda name: args.only in (None, name)
+    for name, urdf in FLOATING.items():
+        if not wanted(name):
+            continue
+        xml = os.path.join(args.out_dir, name + ".xml")
+        urdf_to_mjcf(urdf, xml, floating=True)
+        print(f"{name}: {xml} (floating; compared with the URDF on a free flyer by model/tests/mjcf.rs)")
     for name, urdf in ROBOTS.items():
         if not wanted(name):
             continue

@@ -86,6 +86,22 @@ macro_rules! bench_floating {
                 black_box(&ad);
             })
         });
+        let zero_joints = [0.0; 4 * NV];
+        group.bench_function("aba_joints_derivatives/generated", |b| {
+            b.iter(|| {
+                let (q, v, tau) = next();
+                <$robot>::aba_joints_derivatives(
+                    black_box(q),
+                    black_box(v),
+                    black_box(tau),
+                    &params,
+                    &zero_joints,
+                    dyngen::Coulomb::Sign,
+                    &mut ad,
+                );
+                black_box(&ad);
+            })
+        });
         group.finish();
     }};
 }

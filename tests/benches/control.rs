@@ -85,6 +85,22 @@ macro_rules! bench_control {
                 black_box(&ad);
             })
         });
+        let zero_joints = [0.0; 4 * N];
+        group.bench_function("aba_joints_derivatives/generated", |b| {
+            b.iter(|| {
+                let (q, v, a) = next();
+                <$robot>::aba_joints_derivatives(
+                    black_box(q),
+                    black_box(v),
+                    black_box(a),
+                    &params,
+                    &zero_joints,
+                    dyngen::Coulomb::Sign,
+                    &mut ad,
+                );
+                black_box(&ad);
+            })
+        });
         let mut minv = [[0.0; N]; N];
         group.bench_function("inverse_inertia/generated", |b| {
             b.iter(|| {

@@ -800,6 +800,7 @@ fn derivative_items(
         }
     };
     let ids = |m: &[Vec<Expr<'_>>]| m.iter().flatten().map(|x| x.id()).collect::<Vec<_>>();
+    let products = times_minus_minv(model);
     let clear = quote!(*out = ::core::default::Default::default(););
     let mut items = Vec::new();
     let mut reports = Vec::new();
@@ -869,7 +870,7 @@ fn derivative_items(
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
                 Self::__aba_derivative_parts(q, v, tau, params, out);
-                ::dyngen::__private::times_minus_minv(out);
+                #products
             }
             #parts
         },
@@ -933,7 +934,7 @@ fn derivative_items(
                 for j in 0..#n_l {
                     out.ddq_dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
                 }
-                ::dyngen::__private::times_minus_minv(out);
+                #products
             }
             #parts
         },
@@ -959,6 +960,32 @@ fn derivative_items(
     items.push(("inverse_inertia".to_string(), t));
     reports.push(r);
     (items, reports)
+}
+
+/// The products by `−M⁻¹` that finish the forward-dynamics derivatives: over the
+/// structurally nonzero rows of each column (coordinates of joints on one path) when
+/// the tree has branches, dense loops when every pair of coordinates shares a path.
+fn times_minus_minv(model: &Model) -> TokenStream {
+    let nv = model.nv();
+    let on_path = |a: usize, b: usize| {
+        let (ja, jb) = (model.joint_of_v(a), model.joint_of_v(b));
+        model.supports(ja, jb) || model.supports(jb, ja)
+    };
+    let support: Vec<Vec<usize>> = (0..nv).map(|c| (0..nv).filter(|&k| on_path(k, c)).collect()).collect();
+    if support.iter().all(|rows| rows.len() == nv) {
+        return quote!(::dyngen::__private::times_minus_minv(out););
+    }
+    let n_l = emit::usize_lit(nv);
+    let columns = support.iter().map(|rows| {
+        let rows = rows.iter().map(|&k| emit::usize_lit(k));
+        quote!(&[#(#rows),*])
+    });
+    quote! {
+        // Column c of ∂τ/∂q and ∂τ/∂v is zero outside the coordinates of the joints
+        // on one path with c's.
+        const SUPPORT: [&[usize]; #n_l] = [#(#columns),*];
+        ::dyngen::__private::times_minus_minv_sparse(out, &SUPPORT);
+    }
 }
 
 /// The `Robot` methods of [`derivative_items`].

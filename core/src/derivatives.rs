@@ -126,6 +126,32 @@ pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N
     }
 }
 
+/// Support for generated code: [`__times_minus_minv`] when column `c` of `∂τ/∂q` and
+/// `∂τ/∂v` can be nonzero only in the rows `support[c]` (the coordinates of joints on
+/// one path with `c`'s; the others are structural zeros of the tree): `Σ_c |support[c]|
+/// · N` multiply-adds per matrix instead of `N³`. `M⁻¹` is symmetric, so its row `k`
+/// serves as its column.
+#[doc(hidden)]
+#[inline]
+pub fn __times_minus_minv_sparse<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, support: &[&[usize]; N]) {
+    let (dq, dv) = (d.ddq_dq, d.ddq_dv);
+    for c in 0..N {
+        let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
+        for &k in support[c] {
+            let (x, y) = (dq[k][c], dv[k][c]);
+            let row = &d.minv[k];
+            for i in 0..N {
+                sq[i] += row[i] * x;
+                sv[i] += row[i] * y;
+            }
+        }
+        for i in 0..N {
+            d.ddq_dq[i][c] = -sq[i];
+            d.ddq_dv[i][c] = -sv[i];
+        }
+    }
+}
+
 impl<S: Scalar, const N: usize> AbaDerivatives<S, N> {
     /// The semi-implicit (symplectic) Euler step `v⁺ = v + dt·q̈(q, v, τ)`,
     /// `q⁺ = q + dt·v⁺` from the state `(q, v)` these derivatives were taken at,

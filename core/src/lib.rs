@@ -46,6 +46,7 @@ pub use scalar::Scalar;
 #[doc(hidden)]
 pub mod __private {
     pub use crate::derivatives::__times_minus_minv as times_minus_minv;
+    pub use crate::derivatives::__times_minus_minv_sparse as times_minus_minv_sparse;
     pub use crate::frames::__express_jacobian as express_jacobian;
     pub use crate::frames::__express_jacobian_time_variation as express_jacobian_time_variation;
 

@@ -158,6 +158,37 @@ pub fn workspace_root() -> PathBuf {
         .unwrap_or_default()
 }
 
+/// The worst relative error of each quantity compared with a fixture, by name, in the
+/// order first met; every comparison is asserted below `tolerance(what)`.
+#[derive(Debug)]
+pub struct Worst {
+    pub items: Vec<(&'static str, f64)>,
+    tolerance: fn(&str) -> f64,
+}
+
+impl Worst {
+    pub fn new(tolerance: fn(&str) -> f64) -> Worst {
+        Worst {
+            items: Vec::new(),
+            tolerance,
+        }
+    }
+
+    /// Compares `got` with `want` ([`rel_err`] with `floor`) for `who`'s `sample`.
+    pub fn add(&mut self, what: &'static str, who: &str, sample: usize, got: &[f64], want: &[f64], floor: f64) {
+        let e = rel_err(got, want, floor);
+        let tol = (self.tolerance)(what);
+        assert!(
+            e < tol,
+            "{who}: {what}, sample {sample}: relative error {e:e} (tolerance {tol:e})\n got {got:?}\nwant {want:?}"
+        );
+        match self.items.iter_mut().find(|(w, _)| *w == what) {
+            Some((_, x)) => *x = x.max(e),
+            None => self.items.push((what, e)),
+        }
+    }
+}
+
 /// Reads `tests/fixtures/<path>` (a JSON file) as an untyped value.
 pub fn load_json(path: &str) -> serde_json::Value {
     let path = workspace_root().join("tests/fixtures").join(path);

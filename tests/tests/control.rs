@@ -7,7 +7,7 @@
 
 use dyngen::{Pose, ReferenceFrame, Robot};
 use dyngen_tests::tree12::Tree12;
-use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err};
+use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err, Worst};
 use robot_gripper_arm::GripperArm;
 use robot_panda::Panda;
 use robot_paper6::Paper6;
@@ -25,24 +25,6 @@ const REFS: [(ReferenceFrame, &str); 3] = [
 
 fn load(name: &str) -> Value {
     load_json(&format!("control/{name}.json"))
-}
-
-/// Worst relative error of each quantity over the fixture, by name.
-#[derive(Default, Debug)]
-struct Worst(Vec<(&'static str, f64)>);
-
-impl Worst {
-    fn add(&mut self, what: &'static str, who: &str, sample: usize, got: &[f64], want: &[f64], floor: f64) {
-        let e = rel_err(got, want, floor);
-        assert!(
-            e < TOL,
-            "{who}: {what}, sample {sample}: relative error {e:e}\n got {got:?}\nwant {want:?}"
-        );
-        match self.0.iter_mut().find(|(w, _)| *w == what) {
-            Some((_, x)) => *x = x.max(e),
-            None => self.0.push((what, e)),
-        }
-    }
 }
 
 fn check<R: Robot>(fixture: &str) -> Worst {
@@ -78,7 +60,7 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         .collect();
 
     let params = R::nominal_params();
-    let mut worst = Worst::default();
+    let mut worst = Worst::new(|_| TOL);
     for (s, sample) in fx["samples"].as_array().unwrap().iter().enumerate() {
         let (q, v, a, tau) = (
             nums(&sample["q"]),
@@ -191,7 +173,7 @@ fn control_kernels_match_pinocchio() {
         ("tree12", check::<Tree12>("tree12")),
     ];
     for (name, w) in &all {
-        let line: Vec<String> = w.0.iter().map(|(k, e)| format!("{k} {e:.1e}")).collect();
+        let line: Vec<String> = w.items.iter().map(|(k, e)| format!("{k} {e:.1e}")).collect();
         println!("{name}: {}", line.join(", "));
     }
 }

@@ -333,3 +333,41 @@ fn dsl_floating_base_with_a_ball_joint() {
         }
     }
 }
+
+/// The joint models on a floating robot (parameters per velocity coordinate, the free
+/// flyer's six included): `aba_joints` inverts `rnea_joints` with rotor inertias and
+/// friction everywhere, `crba_joints` adds the rotor inertias to `M`'s diagonal, and
+/// the widened regressor reproduces `rnea_joints`.
+#[test]
+fn quadruped12_joint_models_invert_and_match_the_regressor() {
+    type R = Quadruped12;
+    let (nv, np) = (<R as Robot>::NV, <R as Robot>::NPARAMS);
+    let model = dyngen_reference::model_from_static(&<R as Robot>::MODEL);
+    let params = <R as Robot>::nominal_params();
+    let joint_params: Vec<f64> = (0..nv)
+        .flat_map(|d| [0.01 * (d + 1) as f64, 0.2, 0.3 + 0.01 * d as f64, -0.05])
+        .collect();
+    assert_eq!(joint_params.len(), <R as Robot>::NJOINT_PARAMS);
+    let coulomb = dyngen::Coulomb::smooth(0.05).unwrap();
+    for s in dyngen_model::sample::sample_states(&model, 4, 21) {
+        let mut tau = vec![0.0; nv];
+        <R as Robot>::rnea_joints(&s.q, &s.v, &s.a, params, &joint_params, coulomb, &mut tau);
+        let mut back = vec![0.0; nv];
+        <R as Robot>::aba_joints(&s.q, &s.v, &tau, params, &joint_params, coulomb, &mut back);
+        assert!(rel_err(&back, &s.a, 1.0) < 1e-12, "{back:?} vs {:?}", s.a);
+        let (mut m, mut mj) = (vec![0.0; nv * nv], vec![0.0; nv * nv]);
+        <R as Robot>::crba(&s.q, params, &mut m);
+        <R as Robot>::crba_joints(&s.q, params, &joint_params, &mut mj);
+        for d in 0..nv {
+            m[d * nv + d] += joint_params[4 * d];
+        }
+        assert!(rel_err(&mj, &m, 1.0) < 1e-14);
+        let mut y = vec![0.0; nv * (np + 4 * nv)];
+        <R as Robot>::torque_regressor_joints(&s.q, &s.v, &s.a, coulomb, &mut y);
+        let x: Vec<f64> = params.iter().chain(&joint_params).copied().collect();
+        let from_y: Vec<f64> = (0..nv)
+            .map(|r| (0..x.len()).map(|c| y[r * x.len() + c] * x[c]).sum())
+            .collect();
+        assert!(rel_err(&from_y, &tau, 1.0) < 1e-12);
+    }
+}

@@ -579,10 +579,8 @@ pub fn kinematics_with<'g>(
         let joint = &model.joints[j - 1];
         let p = joint.parent;
         let xj = &x[j - 1];
-        let axis = V3::constant(g, joint.axis);
         let qds: Vec<Expr<'g>> = dofs(model, j).map(&qd).collect();
         let qdds: Vec<Expr<'g>> = dofs(model, j).map(&qdd).collect();
-        let (qd, qdd) = (qds[0], qdds[0]);
         let t = xj.translation;
         let mp = motion[p];
         // Acceleration of the joint-frame origin, still in parent axes.
@@ -590,35 +588,16 @@ pub fn kinematics_with<'g>(
         let w_in = xj.to_child(mp.w);
         let wd_in = xj.to_child(mp.wd);
         let a_in = xj.to_child(a_origin);
-        let m = match joint.kind {
-            JointKind::Revolute | JointKind::Continuous => {
-                let wq = axis.scale(qd);
-                BodyMotion {
-                    w: w_in + wq,
-                    wd: wd_in + axis.scale(qdd) + w_in.cross(wq),
-                    acc: a_in,
-                }
-            }
-            JointKind::Prismatic => {
-                let vq = axis.scale(qd);
-                let two_w_vq = w_in.cross(vq).scale(g.constant(2.0));
-                BodyMotion {
-                    w: w_in,
-                    wd: wd_in,
-                    acc: a_in + two_w_vq + axis.scale(qdd),
-                }
-            }
-            JointKind::Spherical | JointKind::FreeFlyer => {
-                // The joint's velocity (ω_q, v_q) and acceleration (ω̇_q, a_q) in body
-                // axes: ω̇ = ω̇_in + ω̇_q + ω_in × ω_q, a = a_in + a_q + 2 ω_in × v_q + ω_q × v_q.
-                let (vq, aq) = (subspace_times(g, model, j, &qds), subspace_times(g, model, j, &qdds));
-                let two_w_vq = w_in.cross(vq.v).scale(g.constant(2.0));
-                BodyMotion {
-                    w: w_in + vq.w,
-                    wd: wd_in + aq.w + w_in.cross(vq.w),
-                    acc: a_in + aq.v + two_w_vq + vq.w.cross(vq.v),
-                }
-            }
+        // The joint's velocity (ω_q, v_q) and acceleration (ω̇_q, a_q) in body axes
+        // (terms a joint does not have fold away): ω = ω_in + ω_q,
+        // ω̇ = ω̇_in + ω̇_q + ω_in × ω_q, a = a_in + 2 ω_in × v_q + a_q + ω_q × v_q.
+        let vq = subspace_times(g, model, j, &qds);
+        let two_w_vq = w_in.cross(vq.v).scale(g.constant(2.0));
+        let aq = subspace_times(g, model, j, &qdds);
+        let m = BodyMotion {
+            w: w_in + vq.w,
+            wd: wd_in + aq.w + w_in.cross(vq.w),
+            acc: a_in + two_w_vq + aq.v + vq.w.cross(vq.v),
         };
         motion.push(m);
     }
@@ -859,23 +838,14 @@ impl<'g> Inertia6<'g> {
         }
     }
 
-    /// `self − U Uᵀ / D` with `inv_d = 1 / D`.
-    fn minus_outer(&self, u: &Force<'g>, inv_d: Expr<'g>) -> Inertia6<'g> {
-        let (u1, u2) = (u.f, u.n);
-        Inertia6 {
-            m: self.m.sub(&M3::outer(u1.scale(inv_d), u1)).mirror_upper(),
-            h: self.h.sub(&M3::outer(u1.scale(inv_d), u2)),
-            j: self.j.sub(&M3::outer(u2.scale(inv_d), u2)).mirror_upper(),
-        }
-    }
-
-    /// `self − Σ_a U_a W_aᵀ` for `W = U D⁻¹` with `D` symmetric (so the result is).
+    /// `self − Σ_a W_a U_aᵀ` for `W = U D⁻¹` with `D` symmetric, so `U D⁻¹ Uᵀ` (the
+    /// result is symmetric; for one coordinate, `self − U Uᵀ / D`).
     fn minus_products(&self, u: &[Force<'g>], w: &[Force<'g>]) -> Inertia6<'g> {
         let mut out = *self;
         for (ua, wa) in u.iter().zip(w) {
-            out.m = out.m.sub(&M3::outer(ua.f, wa.f));
-            out.h = out.h.sub(&M3::outer(ua.f, wa.n));
-            out.j = out.j.sub(&M3::outer(ua.n, wa.n));
+            out.m = out.m.sub(&M3::outer(wa.f, ua.f));
+            out.h = out.h.sub(&M3::outer(wa.f, ua.n));
+            out.j = out.j.sub(&M3::outer(wa.n, ua.n));
         }
         Inertia6 {
             m: out.m.mirror_upper(),
@@ -975,12 +945,8 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
     for i in 1..=n {
         mark_body(g, model, i, "velocity and bias force");
         let p = model.parent(i);
-        let vj = if s[i - 1].len() == 1 {
-            s[i - 1][0].scale(g.input(ARG_V, model.v_offset(i) as u32))
-        } else {
-            let qd: Vec<Expr<'g>> = dofs(model, i).map(|d| g.input(ARG_V, d as u32)).collect();
-            subspace_times(g, model, i, &qd)
-        };
+        let qd: Vec<Expr<'g>> = dofs(model, i).map(|d| g.input(ARG_V, d as u32)).collect();
+        let vj = subspace_times(g, model, i, &qd);
         let vi = x[i - 1].motion_to_child(v[p]) + vj;
         let inertia = Inertia6::rigid(g, &BodyParams::input(g, i));
         pa.push(vi.cross_force(inertia.apply(vi)));
@@ -997,52 +963,41 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
         mark_body(g, model, i, "articulated inertia");
         let ui: Vec<Force<'g>> = s[i - 1].iter().map(|sk| ia[i].apply(*sk)).collect();
         let rotor = |d: usize| g.input(ARG_JOINT_PARAMS, (4 * d) as u32);
-        let id: Vec<Vec<Expr<'g>>> = if ui.len() == 1 {
-            let d = match armature {
-                Armature::None => ui[0].dot(s[i - 1][0]),
-                Armature::Input => ui[0].dot(s[i - 1][0]) + rotor(model.v_offset(i)),
-            };
-            vec![vec![g.one() / d]]
-        } else {
-            let d: Vec<Vec<Expr<'g>>> = dofs(model, i)
-                .zip(&ui)
-                .map(|(a, ua)| {
-                    dofs(model, i)
-                        .zip(&s[i - 1])
-                        .map(|(b, sb)| match armature {
-                            Armature::Input if a == b => ua.dot(*sb) + rotor(a),
-                            _ => ua.dot(*sb),
-                        })
-                        .collect()
-                })
-                .collect();
-            spd_inverse(g, &d)
-        };
+        // D = Sᵀ Iᴬ S (+ the rotor inertias): one division for one coordinate.
+        let d: Vec<Vec<Expr<'g>>> = dofs(model, i)
+            .zip(&ui)
+            .map(|(a, ua)| {
+                dofs(model, i)
+                    .zip(&s[i - 1])
+                    .map(|(b, sb)| match armature {
+                        Armature::Input if a == b => ua.dot(*sb) + rotor(a),
+                        _ => ua.dot(*sb),
+                    })
+                    .collect()
+            })
+            .collect();
+        let id = spd_inverse(g, &d);
         let ui_scalar: Vec<Expr<'g>> = dofs(model, i)
             .zip(&s[i - 1])
             .map(|(d, sk)| g.input(ARG_TAU, d as u32) - pa[i].dot(*sk))
             .collect();
         let p = model.parent(i);
         if p > 0 {
-            let (a_ia, gain) = if ui.len() == 1 {
-                (ia[i].minus_outer(&ui[0], id[0][0]), vec![ui_scalar[0] * id[0][0]])
-            } else {
-                // W = U D⁻¹: Iᴬ − U D⁻¹ Uᵀ = Iᴬ − Σ_a U_a W_aᵀ, and D⁻¹ u.
-                let w: Vec<Force<'g>> = (0..ui.len())
-                    .map(|a| {
-                        (0..ui.len()).fold(Force::zero(g), |acc, b| {
-                            acc + Force {
-                                f: ui[b].f.scale(id[a][b]),
-                                n: ui[b].n.scale(id[a][b]),
-                            }
-                        })
+            // W = U D⁻¹: Iᴬ − U D⁻¹ Uᵀ = Iᴬ − Σ_a W_a U_aᵀ, and D⁻¹ u.
+            let w: Vec<Force<'g>> = (0..ui.len())
+                .map(|a| {
+                    (0..ui.len()).fold(Force::zero(g), |acc, b| {
+                        acc + Force {
+                            f: ui[b].f.scale(id[a][b]),
+                            n: ui[b].n.scale(id[a][b]),
+                        }
                     })
-                    .collect();
-                let gain = (0..ui.len())
-                    .map(|a| (0..ui.len()).fold(g.zero(), |acc, b| acc + id[a][b] * ui_scalar[b]))
-                    .collect();
-                (ia[i].minus_products(&ui, &w), gain)
-            };
+                })
+                .collect();
+            let gain: Vec<Expr<'g>> = (0..ui.len())
+                .map(|a| (0..ui.len()).fold(g.zero(), |acc, b| acc + id[a][b] * ui_scalar[b]))
+                .collect();
+            let a_ia = ia[i].minus_products(&ui, &w);
             let a_pa = ui.iter().zip(&gain).fold(pa[i] + a_ia.apply(c[i]), |acc, (uk, gk)| {
                 acc + Force {
                     f: uk.f.scale(*gk),
@@ -1066,18 +1021,12 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
         mark_body(g, model, i, "acceleration");
         let p = model.parent(i);
         let a_prime = x[i - 1].motion_to_child(acc[p]) + c[i];
-        if s[i - 1].len() == 1 {
-            let qi = (u[i][0] - u_vec[i][0].dot(a_prime)) * inv_d[i][0][0];
-            acc.push(a_prime + s[i - 1][0].scale(qi));
-            qdd.push(qi);
-        } else {
-            let r: Vec<Expr<'g>> = (0..u[i].len()).map(|k| u[i][k] - u_vec[i][k].dot(a_prime)).collect();
-            let qi: Vec<Expr<'g>> = (0..r.len())
-                .map(|a| (0..r.len()).fold(g.zero(), |acc, b| acc + inv_d[i][a][b] * r[b]))
-                .collect();
-            acc.push(a_prime + subspace_times(g, model, i, &qi));
-            qdd.extend(qi);
-        }
+        let r: Vec<Expr<'g>> = (0..u[i].len()).map(|k| u[i][k] - u_vec[i][k].dot(a_prime)).collect();
+        let qi: Vec<Expr<'g>> = (0..r.len())
+            .map(|a| (0..r.len()).fold(g.zero(), |acc, b| acc + inv_d[i][a][b] * r[b]))
+            .collect();
+        acc.push(a_prime + subspace_times(g, model, i, &qi));
+        qdd.extend(qi);
     }
     qdd
 }

@@ -148,49 +148,27 @@ fn walk<'g>(
             // The parent's velocity and acceleration carried to the joint origin.
             let v = p.v + p.w.cross(d);
             let acc = p.acc + p.wd.cross(d) + p.w.cross(p.w.cross(d));
-            let rates: Vec<(WorldDof<'g>, Expr<'g>, Expr<'g>)> = wj
-                .dofs()
-                .iter()
-                .zip(crate::algo::dofs(model, k))
-                .map(|(dof, i)| (*dof, g.input(ARG_V, i as u32), g.input(ARG_A, i as u32)))
-                .collect();
-            match rates.as_slice() {
-                [(WorldDof::Rotation(z), qd, qdd)] => {
-                    let zqd = z.scale(*qd);
-                    b.w = p.w + zqd;
-                    b.wd = p.wd + z.scale(*qdd) + p.w.cross(zqd);
-                    b.v = v;
-                    b.acc = acc;
-                }
-                [(WorldDof::Translation(z), qd, qdd)] => {
-                    let zqd = z.scale(*qd);
-                    b.w = p.w;
-                    b.wd = p.wd;
-                    b.v = v + zqd;
-                    b.acc = acc + z.scale(*qdd) + p.w.cross(zqd).scale(g.constant(2.0));
-                }
-                _ => {
-                    // ω = ω_p + ω_q, ω̇ = ω̇_p + ω̇_q + ω_p × ω_q, v = v_p + v_q,
-                    // a = a_p + a_q + 2 ω_p × v_q + ω_q × v_q (world axes, at the origin).
-                    let (mut wq, mut wdq, mut vq, mut aq) = (zero, zero, zero, zero);
-                    for (dof, qd, qdd) in &rates {
-                        match dof {
-                            WorldDof::Rotation(z) => {
-                                wq = wq + z.scale(*qd);
-                                wdq = wdq + z.scale(*qdd);
-                            }
-                            WorldDof::Translation(z) => {
-                                vq = vq + z.scale(*qd);
-                                aq = aq + z.scale(*qdd);
-                            }
-                        }
+            // ω = ω_p + ω_q, ω̇ = ω̇_p + ω̇_q + ω_p × ω_q, v = v_p + v_q,
+            // a = a_p + a_q + 2 ω_p × v_q + ω_q × v_q (world axes, at the origin; the
+            // terms a joint does not have fold away).
+            let (mut wq, mut wdq, mut vq, mut aq) = (zero, zero, zero, zero);
+            for (dof, i) in wj.dofs().iter().zip(crate::algo::dofs(model, k)) {
+                let (qd, qdd) = (g.input(ARG_V, i as u32), g.input(ARG_A, i as u32));
+                match dof {
+                    WorldDof::Rotation(z) => {
+                        wq = wq + z.scale(qd);
+                        wdq = wdq + z.scale(qdd);
                     }
-                    b.w = p.w + wq;
-                    b.wd = p.wd + wdq + p.w.cross(wq);
-                    b.v = v + vq;
-                    b.acc = acc + aq + p.w.cross(vq).scale(g.constant(2.0)) + wq.cross(vq);
+                    WorldDof::Translation(z) => {
+                        vq = vq + z.scale(qd);
+                        aq = aq + z.scale(qdd);
+                    }
                 }
             }
+            b.w = p.w + wq;
+            b.wd = p.wd + wdq + p.w.cross(wq);
+            b.v = v + vq;
+            b.acc = acc + aq + p.w.cross(vq).scale(g.constant(2.0)) + wq.cross(vq);
         }
         world[k] = Some(b);
     }

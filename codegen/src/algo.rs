@@ -226,11 +226,8 @@ pub fn quaternion_rotation<'g>([x, y, z, w]: [Expr<'g>; 4]) -> M3<'g> {
 /// position `ṗ = R(q) v`. `None` if `index` is out of range. What forward-mode
 /// tangents along the motion ([`Graph::tangents`]) seed each `q` with.
 pub fn q_dot<'g>(g: &'g Graph, model: &Model, index: usize) -> Option<Expr<'g>> {
-    let mut j = 1;
-    while j <= model.dof() && model.q_offset(j) + model.joints[j - 1].kind.nq() <= index {
-        j += 1;
-    }
-    let joint = model.joints.get(j - 1)?;
+    let j = model.joint_of_q(index)?;
+    let joint = &model.joints[j - 1];
     let (k, qo, vo) = (
         index - model.q_offset(j),
         model.q_offset(j) as u32,

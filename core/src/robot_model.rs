@@ -95,8 +95,8 @@ pub struct FrameModel {
     pub translation: [f64; 3],
 }
 
-/// A fixed-base kinematic tree in regular labelling: `joints[j - 1]` carries
-/// `bodies[j - 1]` (body `j`).
+/// A kinematic tree in regular labelling: `joints[j - 1]` carries `bodies[j - 1]`
+/// (body `j`); body 0 is fixed (the base, or the world when joint 1 is a free flyer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RobotModel {
     pub name: &'static str,
@@ -107,6 +107,13 @@ pub struct RobotModel {
     pub joints: &'static [JointModel],
     pub bodies: &'static [BodyModel],
     /// Every named frame, the base link first; a generated robot's frame index
-    /// (`R::frame_index`, its frame enum) indexes this list.
+    /// ([`RobotModel::frame_index`], its frame enum) indexes this list.
     pub frames: &'static [FrameModel],
+}
+
+impl RobotModel {
+    /// The index in [`RobotModel::frames`] of the frame named `name`.
+    pub fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|f| f.name == name)
+    }
 }

@@ -25,6 +25,7 @@
 //! # }
 //! ```
 
+use crate::error::check_len;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options};
 use dyngen::{JointType, ReferenceFrame, Robot};
 use faer::Mat;
@@ -97,15 +98,10 @@ impl<R: Robot> FloatingBase<R> {
     /// the rows [`FloatingRows`] keeps are read; the others may hold anything finite
     /// or not.
     pub fn push(&mut self, q: &[f64], v: &[f64], a: &[f64], tau: &[f64]) -> Result<(), IdentifyError> {
-        for (what, x, n) in [("q", q, R::NQ), ("v", v, R::NV), ("a", a, R::NV), ("tau", tau, R::NV)] {
-            if x.len() != n {
-                return Err(IdentifyError::DimensionMismatch {
-                    what,
-                    expected: n,
-                    found: x.len(),
-                });
-            }
-        }
+        check_len(q, R::NQ, "q")?;
+        check_len(v, R::NV, "v")?;
+        check_len(a, R::NV, "a")?;
+        check_len(tau, R::NV, "tau")?;
         R::joint_torque_regressor(q, v, a, &mut self.y);
         let keep: Vec<bool> = (0..R::NV).map(|d| self.rows.keeps(d)).collect();
         let y = Mat::from_fn(R::NV, R::NPARAMS, |r, c| self.y[r * R::NPARAMS + c]);
@@ -124,20 +120,9 @@ impl<R: Robot> FloatingBase<R> {
         joint_torques: &[f64],
         contacts: &[Contact],
     ) -> Result<(), IdentifyError> {
-        if joint_torques.len() + 6 != R::NV {
-            return Err(IdentifyError::DimensionMismatch {
-                what: "joint torques",
-                expected: R::NV - 6,
-                found: joint_torques.len(),
-            });
-        }
-        if q.len() != R::NQ {
-            return Err(IdentifyError::DimensionMismatch {
-                what: "q",
-                expected: R::NQ,
-                found: q.len(),
-            });
-        }
+        // `q` before the Jacobians read it; `v` and `a` in `push`.
+        check_len(joint_torques, R::NV - 6, "joint torques")?;
+        check_len(q, R::NQ, "q")?;
         let mut tau = vec![0.0; R::NV];
         tau[6..].copy_from_slice(joint_torques);
         for c in contacts {

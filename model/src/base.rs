@@ -152,32 +152,25 @@ impl fmt::Display for BaseParams {
 /// `SEEDS[0]`, confirmed with `SEEDS[1]`, and the rank counted from the singular
 /// values of the same stacked matrix.
 pub fn analyse(model: &Model, parameterisation: Parameterisation) -> BaseParams {
-    let names = parameterisation.names_of(model);
-    let first = stacked(model, parameterisation, SEEDS[0]);
-    let sv = singular_values(&first);
-    let largest = sv.first().copied().unwrap_or(0.0);
-    let rank_check = sv.iter().filter(|&&s| s > RANK_TOLERANCE * largest && s > 0.0).count();
-    let mut base = from_stacked(first, &names);
-    let second = from_stacked(stacked(model, parameterisation, SEEDS[1]), &names);
-    base.confirmed = second.independent == base.independent;
-    BaseParams {
-        parameterisation,
-        rank_check,
-        ..base
-    }
+    analysed(model, parameterisation, None)
 }
 
 /// [`analyse`] on some rows of the dynamics only: `rows` lists the velocity
 /// coordinates whose equations are measured (e.g. `0..6`, the base wrench of a
 /// floating base from contact forces, or `6..nv`, the joint torques alone).
 pub fn analyse_rows(model: &Model, parameterisation: Parameterisation, rows: &[usize]) -> BaseParams {
+    analysed(model, parameterisation, Some(rows))
+}
+
+/// [`analyse`] on the rows `keep` (all when `None`).
+fn analysed(model: &Model, parameterisation: Parameterisation, keep: Option<&[usize]>) -> BaseParams {
     let names = parameterisation.names_of(model);
-    let first = stacked_rows(model, parameterisation, SEEDS[0], Some(rows));
+    let first = stacked(model, parameterisation, SEEDS[0], keep);
     let sv = singular_values(&first);
     let largest = sv.first().copied().unwrap_or(0.0);
     let rank_check = sv.iter().filter(|&&s| s > RANK_TOLERANCE * largest && s > 0.0).count();
     let mut base = from_stacked(first, &names);
-    let second = from_stacked(stacked_rows(model, parameterisation, SEEDS[1], Some(rows)), &names);
+    let second = from_stacked(stacked(model, parameterisation, SEEDS[1], keep), &names);
     base.confirmed = second.independent == base.independent;
     BaseParams {
         parameterisation,
@@ -186,13 +179,9 @@ pub fn analyse_rows(model: &Model, parameterisation: Parameterisation, rows: &[u
     }
 }
 
-/// The regressor stacked over [`SAMPLES`] structure states drawn with `seed`.
-fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64) -> Vec<Vec<f64>> {
-    stacked_rows(model, parameterisation, seed, None)
-}
-
-/// [`stacked`] keeping only the rows `keep` of each state (all when `None`).
-fn stacked_rows(model: &Model, parameterisation: Parameterisation, seed: u64, keep: Option<&[usize]>) -> Vec<Vec<f64>> {
+/// The regressor stacked over [`SAMPLES`] structure states drawn with `seed`,
+/// keeping only the rows `keep` of each state (all when `None`).
+fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64, keep: Option<&[usize]>) -> Vec<Vec<f64>> {
     let mut rows = Vec::with_capacity(SAMPLES * model.nv());
     for s in structure_states(model, SAMPLES, seed) {
         let mut y = torque_regressor(model, &s.q, &s.v, &s.a);

@@ -342,17 +342,30 @@ impl Model {
 
     /// The joint (1-based) that owns velocity coordinate `d`.
     pub fn joint_of_v(&self, d: usize) -> usize {
-        let mut start = 0;
-        for (k, joint) in self.joints.iter().enumerate() {
-            start += joint.kind.nv();
-            if d < start {
-                return k + 1;
-            }
-        }
-        panic!(
-            "velocity index {d} out of range: the model has {} velocities",
-            self.nv()
-        )
+        self.joint_owning(d, JointKind::nv).unwrap_or_else(|| {
+            // ok: the generator's own indices, always below `nv`.
+            panic!(
+                "velocity index {d} out of range: the model has {} velocities",
+                self.nv()
+            )
+        })
+    }
+
+    /// The joint (1-based) that owns position coordinate `i`, if any.
+    pub fn joint_of_q(&self, i: usize) -> Option<usize> {
+        self.joint_owning(i, JointKind::nq)
+    }
+
+    /// The joint whose coordinates, `width` of them per joint, include `index`.
+    fn joint_owning(&self, index: usize, width: fn(JointKind) -> usize) -> Option<usize> {
+        let mut end = 0;
+        self.joints
+            .iter()
+            .position(|j| {
+                end += width(j.kind);
+                index < end
+            })
+            .map(|k| k + 1)
     }
 
     /// Whether the base floats: joint 1 is a free flyer.

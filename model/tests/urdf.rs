@@ -287,6 +287,15 @@ fn floating_and_spherical_joints_have_their_coordinates() {
         (model.joint_of_v(5), model.joint_of_v(6), model.joint_of_v(9)),
         (1, 2, 3)
     );
+    assert_eq!(
+        (
+            model.joint_of_q(6),
+            model.joint_of_q(7),
+            model.joint_of_q(11),
+            model.joint_of_q(12)
+        ),
+        (Some(1), Some(2), Some(3), None)
+    );
     assert_eq!(model.joints[0].axis, [0.0; 3]);
     assert_eq!(model.multi_dof_joint().map(|j| j.name.as_str()), Some("free"));
 }

@@ -46,9 +46,7 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         .map(|f| {
             let name = f["name"].as_str().unwrap();
             let k = R::MODEL
-                .frames
-                .iter()
-                .position(|m| m.name == name)
+                .frame_index(name)
                 .unwrap_or_else(|| panic!("{who}: no frame {name}"));
             assert_eq!(
                 R::MODEL.frames[k].body as u64,

@@ -51,7 +51,6 @@ fn check<R: Robot>(fixture: &str) -> Worst {
     let params = R::nominal_params();
     for (s, x) in fx["samples"].as_array().unwrap().iter().enumerate() {
         let (q, v, a) = (nums(&x["q"]), nums(&x["v"]), nums(&x["a"]));
-        let zero = vec![0.0; nv];
         let mut out = vec![0.0; nv];
         R::rnea(&q, &v, &a, params, &mut out);
         worst.add("rnea", who, s, &out, &nums(&x["tau"]), 1.0);
@@ -74,9 +73,7 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         for f in x["frames"].as_array().unwrap() {
             let name = f["name"].as_str().unwrap();
             let k = R::MODEL
-                .frames
-                .iter()
-                .position(|m| m.name == name)
+                .frame_index(name)
                 .unwrap_or_else(|| panic!("{who}: no frame {name}"));
             let mut jac = vec![0.0; 6 * nv];
             let pose = R::frame_jacobian(&q, k, ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
@@ -140,7 +137,6 @@ fn check<R: Robot>(fixture: &str) -> Worst {
         let mut alone = vec![0.0; nv * nv];
         R::inverse_inertia(&q, params, &mut alone);
         worst.add("inverse_inertia", who, s, &alone, &nums(&x["Minv"]), 1.0);
-        let _ = &zero;
     }
     worst
 }

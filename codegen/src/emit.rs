@@ -144,8 +144,29 @@ impl Inlined {
     }
 }
 
-/// Emits `spec` as an associated function (plus its parts, if split).
-pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (TokenStream, FnReport) {
+/// An emitted function: a thin associated function of the robot type, and its body,
+/// a free function in the module `home::name` (with its parts, if split).
+///
+/// The bodies live outside the robot type's `impl` because rustc assigns a method to
+/// the codegen unit of its self type: in the `impl`, every generated function would
+/// go to one unit and LLVM would optimise them all on one core. As free functions in
+/// their own modules they spread over the codegen units and build in parallel.
+pub struct Emitted {
+    /// The associated function, for the type's `impl`.
+    pub method: TokenStream,
+    /// The module holding the body, for the robot's [`home`] module.
+    pub body: TokenStream,
+}
+
+/// The module (beside the robot type `ty`) that holds the bodies of its generated
+/// functions, one submodule each.
+pub fn home(ty: &Ident) -> Ident {
+    format_ident!("__{}_generated", ty)
+}
+
+/// Emits `spec` as an associated function whose body lives in the module
+/// `home::name` (see [`Emitted`]).
+pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize, home: &Ident) -> (Emitted, FnReport) {
     let scheduled = schedule(graph, &spec.outputs);
     let inlined = Inlined::new(graph, &scheduled, &spec.outputs);
     let stmts: Vec<Stmt> = scheduled
@@ -187,6 +208,22 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         ops.trig,
         stmts.len()
     );
+    let emitted = |body: TokenStream| Emitted {
+        method: quote! {
+            #(#[doc = #doc])*
+            #[doc = ""]
+            #[doc = #op_doc]
+            #[inline]
+            #vis fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+                #home::#fname::#fname(#(#arg_names,)* #out_arg)
+            }
+        },
+        body: quote! {
+            pub mod #fname {
+                #body
+            }
+        },
+    };
     let chunks: Vec<&[Stmt]> = if stmts.len() <= max_statements.max(1) {
         vec![&stmts[..]]
     } else {
@@ -283,18 +320,14 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             }
             Output::InPlace { .. } => TokenStream::new(),
         };
-        let tokens = quote! {
-            #(#[doc = #doc])*
-            #[doc = ""]
-            #[doc = #op_doc]
-            #[inline]
-            #vis fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+        let body = quote! {
+            pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
                 #(#early_stores)*
                 #(#body)*
                 #value
             }
         };
-        return (tokens, report);
+        return (emitted(body), report);
     }
 
     // Split: values crossing a part boundary (or returned by value) live in `w`.
@@ -336,7 +369,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
     let mut parts = Vec::new();
     let mut calls = Vec::new();
     for (c, chunk) in chunks.iter().enumerate() {
-        let part = format_ident!("__{}_part{}", spec.name, c);
+        let part = format_ident!("part{}", c);
         // Each part says which section it starts in.
         let mut current = None;
         let local: HashMap<NodeId, usize> = HashMap::new();
@@ -374,16 +407,14 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
             })
         });
         parts.push(quote! {
-            #[doc(hidden)]
             #[inline(never)]
-            #[allow(unused_variables)]
             fn #part<S: ::dyngen::Scalar>(#(#params,)* w: &mut [S; #width], #out_param) {
                 #(#load_stmts)*
                 #(#body)*
                 #(#spills)*
             }
         });
-        calls.push(quote!(Self::#part(#(#arg_names,)* &mut w, #out_arg);));
+        calls.push(quote!(#part(#(#arg_names,)* &mut w, #out_arg);));
     }
     let value = match &spec.output {
         Output::Return(assemble) => {
@@ -407,11 +438,8 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         }
         Output::InPlace { .. } => TokenStream::new(),
     };
-    let tokens = quote! {
-        #(#[doc = #doc])*
-        #[doc = ""]
-        #[doc = #op_doc]
-        #vis fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
+    let body = quote! {
+        pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
             let mut w = [<S as ::dyngen::Scalar>::ZERO; #width];
             #(#early_stores)*
             #(#calls)*
@@ -419,7 +447,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize) -> (Toke
         }
         #(#parts)*
     };
-    (tokens, report)
+    (emitted(body), report)
 }
 
 /// The graph's sections ([`Graph::mark`]), to say in the code where each starts.

@@ -419,6 +419,8 @@ pub(crate) struct FrameFns {
     pub enum_item: TokenStream,
     /// Inherent functions and constants of the robot type, by name.
     pub items: Vec<(String, TokenStream)>,
+    /// The bodies of the generated functions ([`emit::Emitted`]), by name.
+    pub bodies: Vec<(String, TokenStream)>,
     /// `Robot` methods.
     pub methods: TokenStream,
     pub reports: Vec<FnReport>,
@@ -436,14 +438,17 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let [n_l, nq_l, nf_l] = [n, sizes.nq, nf].map(emit::usize_lit);
     let fty = frame_type(ty);
     let variants = variant_names(model);
+    let home = emit::home(ty);
     let mut items = Vec::new();
     let mut reports = Vec::new();
+    let mut bodies = Vec::new();
     // Emits `spec`, reporting its operation count under `report_as`.
     let mut emit_one = |spec: FnSpec<'_>, g: &Graph, report_as: String| {
-        let (tokens, mut report) = emit::emit_fn(g, &spec, max_statements);
+        let (emitted, mut report) = emit::emit_fn(g, &spec, max_statements, &home);
         report.name = report_as;
         reports.push(report);
-        tokens
+        bodies.push((spec.name.to_string(), emitted.body));
+        emitted.method
     };
     let q = || arg(ARG_Q, "q", sizes.nq);
     let pose_ret = Record::Pose.ty();
@@ -732,7 +737,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     ));
 
     let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
-    let bodies = model.frames.iter().map(|f| emit::usize_lit(f.body));
+    let frame_bodies = model.frames.iter().map(|f| emit::usize_lit(f.body));
     let indices = (0..nf).map(emit::usize_lit);
     let variant_docs = model.frames.iter().map(|f| {
         let what = match f.body {
@@ -765,7 +770,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             /// Frame names (the description's link names), in index order.
             pub const NAMES: [&'static str; #nf_l] = [#(#names),*];
             /// The body each frame is attached to (0 = base), in index order.
-            pub const BODIES: [usize; #nf_l] = [#(#bodies),*];
+            pub const BODIES: [usize; #nf_l] = [#(#frame_bodies),*];
 
             /// The frame's index in `ALL` and in the robot's `MODEL.frames`.
             pub const fn index(self) -> usize {
@@ -847,6 +852,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     FrameFns {
         enum_item,
         items,
+        bodies,
         methods,
         reports,
     }

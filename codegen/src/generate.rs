@@ -32,8 +32,11 @@ impl Default for Options {
 pub struct GeneratedCode {
     pub tokens: TokenStream,
     pub functions: Vec<FnReport>,
-    /// Each generated function (with its parts) on its own, by name.
+    /// Each associated function of the robot type on its own, by name.
     pub items: Vec<(String, TokenStream)>,
+    /// The bodies of the generated functions (with their parts, see
+    /// [`emit::Emitted`]), by name.
+    pub bodies: Vec<(String, TokenStream)>,
 }
 
 impl GeneratedCode {
@@ -55,10 +58,12 @@ impl GeneratedCode {
         )
     }
 
-    /// One function, formatted, inside an `impl` of the robot type.
+    /// One function, formatted, inside an `impl` of the robot type, followed by its
+    /// body's module if it has one.
     pub fn pretty_function(&self, name: &str) -> Option<String> {
         let (_, tokens) = self.items.iter().find(|(n, _)| n == name)?;
-        let file = syn::parse2::<syn::File>(quote!(impl Robot { #tokens })).ok()?;
+        let body = self.bodies.iter().find(|(n, _)| n == name).map(|(_, t)| t);
+        let file = syn::parse2::<syn::File>(quote!(impl Robot { #tokens } #body)).ok()?;
         Some(emit::comment_markers(&prettyplease::unparse(&file)))
     }
 
@@ -714,37 +719,61 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
         nbt: bases.principal.count(),
         nbj: bases.joints.count(),
     };
+    let ty = format_ident!("{}", name);
+    let home = emit::home(&ty);
     let mut functions = Vec::new();
     let mut items = Vec::new();
+    let mut bodies = Vec::new();
     let mut methods = Vec::new();
     for algorithm in ALGORITHMS {
         let g = Graph::new();
         let spec = algorithm.spec(&g, model, bases, &sizes);
-        let (tokens, report) = emit::emit_fn(&g, &spec, options.max_statements);
-        items.push((report.name.clone(), tokens));
+        let (emitted, report) = emit::emit_fn(&g, &spec, options.max_statements, &home);
+        items.push((report.name.clone(), emitted.method));
+        bodies.push((report.name.clone(), emitted.body));
         functions.push(report);
-        methods.push(algorithm.trait_method(&format_ident!("{}", name), &sizes));
+        methods.push(algorithm.trait_method(&ty, &sizes));
     }
-    let joints = crate::joints::generate(model, bases, &sizes, options.max_statements);
+    let joints = crate::joints::generate(model, bases, &sizes, options.max_statements, &home);
     functions.extend(joints.reports);
     items.extend(joints.items);
+    bodies.extend(joints.bodies);
     methods.extend(joints.methods);
-    let (derivative_items, derivative_reports) = derivative_items(model, &sizes, options.max_statements);
-    functions.extend(derivative_reports);
-    items.extend(derivative_items);
+    let derivatives = derivative_items(model, &sizes, options.max_statements, &home);
+    functions.extend(derivatives.reports);
+    items.extend(derivatives.items);
+    bodies.extend(derivatives.bodies);
     methods.push(derivative_methods(sizes.nv));
-    let ty = format_ident!("{}", name);
     let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
     functions.extend(frames.reports);
     items.extend(frames.items);
+    bodies.extend(frames.bodies);
     methods.push(frames.methods);
     let mut tokens = robot_type(model, &ty, bases, &functions, &items, &methods);
+    let body_items = bodies.iter().map(|(_, t)| t);
+    tokens.extend(quote! {
+        #[doc(hidden)]
+        #[allow(non_snake_case, clippy::all, clippy::pedantic, unused_variables, unused_parens)]
+        mod #home {
+            #(#body_items)*
+        }
+    });
     tokens.extend(frames.enum_item);
     GeneratedCode {
         tokens,
         functions,
         items,
+        bodies,
     }
+}
+
+/// The functions of [`derivative_items`].
+struct DerivativeFns {
+    /// Associated functions, by name.
+    items: Vec<(String, TokenStream)>,
+    /// The bodies of the generated ones ([`emit::Emitted`]), by name.
+    bodies: Vec<(String, TokenStream)>,
+    reports: Vec<FnReport>,
 }
 
 /// The statement budget of a part of the derivative functions (see [`derivative_items`]).
@@ -752,12 +781,8 @@ const DERIVATIVE_MAX_STATEMENTS: usize = 800;
 
 /// The derivatives of the dynamics (`crate::derivatives`) as inherent functions
 /// writing `dyngen::RneaDerivatives` / `dyngen::AbaDerivatives`, and `M⁻¹` alone.
-fn derivative_items(
-    model: &Model,
-    sizes: &Sizes,
-    max_statements: usize,
-) -> (Vec<(String, TokenStream)>, Vec<FnReport>) {
-    use crate::derivatives::{self, Ddq};
+fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &proc_macro2::Ident) -> DerivativeFns {
+    use crate::derivatives;
     // Parts of at most 800 statements: measured on the Panda (release, 2 cores),
     // aba_derivatives ran 967 ns in parts of 1,200 and 811 ns in parts of 800 (400:
     // 772 ns, but the UR5's and rnea_derivatives got slower); rnea_derivatives was
@@ -800,9 +825,9 @@ fn derivative_items(
         }
     };
     let ids = |m: &[Vec<Expr<'_>>]| m.iter().flatten().map(|x| x.id()).collect::<Vec<_>>();
-    let products = times_minus_minv(model);
     let clear = quote!(*out = ::core::default::Default::default(););
     let mut items = Vec::new();
+    let mut bodies = Vec::new();
     let mut reports = Vec::new();
 
     let g = Graph::new();
@@ -826,40 +851,75 @@ fn derivative_items(
         },
         outputs,
     };
-    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
-    items.push(("rnea_derivatives".to_string(), t));
+    let (e, r) = emit::emit_fn(&g, &spec, max_statements, home);
+    items.push(("rnea_derivatives".to_string(), e.method));
+    bodies.push(("rnea_derivatives".to_string(), e.body));
     reports.push(r);
 
+    // M⁻¹, with each coordinate's rotor inertia `Ia` (joint_params[4 i]) on the
+    // diagonal of M: the public `inverse_inertia` passes zeros, the forward-dynamics
+    // derivatives with the joint models their armature.
+    let nj_l = emit::usize_lit(4 * n);
     let g = Graph::new();
-    let d = derivatives::aba_derivative_parts(&g, model, Ddq::InverseInertia);
-    let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
-    outputs.extend(ids(&d.dtau_dq));
-    outputs.extend(ids(&d.dtau_dv));
-    outputs.extend(ids(&d.minv));
-    let (q, v, tau, params) = (
-        arg(ARG_Q, "q", sizes.nq),
-        arg(ARG_V, "v", n),
-        arg(ARG_TAU, "tau", n),
-        arg(ARG_PARAMS, "params", 10 * sizes.n),
-    );
-    let aba_doc = doc_attrs(&format!(
-        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. `M⁻¹` comes from the tree's `LᵀDL`\nfactorisation (no fill-in; one division per velocity coordinate); the two products with it run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+    let mut m = algo::crba(&g, model);
+    for (i, row) in m.iter_mut().enumerate() {
+        row[i] = row[i] + g.input(algo::ARG_JOINT_PARAMS, (4 * i) as u32);
+    }
+    let minv = derivatives::inverse_inertia(&g, model, &m);
+    let spec = FnSpec {
+        name: "__inverse_inertia",
+        public: false,
+        doc: "`(M(q) + diag(Ia))⁻¹`, `Ia` the rotor inertias in `joint_params`, written to `out`.".to_string(),
+        args: vec![
+            arg(ARG_Q, "q", sizes.nq),
+            arg(ARG_PARAMS, "params", 10 * sizes.n),
+            arg(ARG_JOINT_PARAMS, "joint_params", 4 * n),
+        ],
+        ret: quote!([[S; #n_l]; #n_l]),
+        output: emit::matrix_output(n),
+        outputs: ids(&minv),
+    };
+    let (inverse, mut r) = emit::emit_fn(&g, &spec, max_statements, home);
+    bodies.push(("__inverse_inertia".to_string(), inverse.body));
+    let inverse = inverse.method;
+    r.name = "inverse_inertia".to_string();
+    let inverse_doc = doc_attrs(&format!(
+        "`M(q)⁻¹` ({n} × {n}, symmetric; Pinocchio's `computeMinverse`) from the tree's `LᵀDL`\nfactorisation of [`Self::crba`]'s matrix, written to `out`. {}.",
         sizes.params()
     ));
-    let spec = FnSpec {
-        name: "__aba_derivative_parts",
-        public: false,
-        doc: "The generated part of [`Self::aba_derivatives`]: `ddq`, `M⁻¹`, and `∂τ/∂q`, `∂τ/∂v`\nat `a = ddq` in the places of `∂q̈/∂q`, `∂q̈/∂v`.".to_string(),
-        args: vec![q, v, tau, params],
-        ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
-        output: Output::InPlace {
-            place: Box::new(place(&[("ddq", false), ("ddq_dq", true), ("ddq_dv", true), ("minv", true)])),
-            clear: clear.clone(),
+    items.push((
+        "inverse_inertia".to_string(),
+        quote! {
+            #inverse_doc
+            #[inline]
+            pub fn inverse_inertia<S: ::dyngen::Scalar>(q: &[S; #nq_l], params: &[S; #np_l], out: &mut [[S; #n_l]; #n_l]) {
+                Self::__inverse_inertia(q, params, &[<S as ::dyngen::Scalar>::ZERO; #nj_l], out);
+            }
+            #inverse
         },
-        outputs,
+    ));
+    reports.push(r);
+
+    // Forward dynamics and its derivatives, composed from the functions above (one
+    // copy of the generated code serves all of them): `M⁻¹`, `q̈ = M⁻¹ (τ − h)`, the
+    // inverse-dynamics derivatives at `a = q̈` and, in loops, the products by `−M⁻¹`.
+    // `slope` adds friction's `∂/∂v` to `∂τ/∂v` before the products.
+    let products = times_minus_minv(model);
+    let forward = |slope: TokenStream| {
+        quote! {
+            let h = Self::nonlinear_effects(q, v, params);
+            ::dyngen::__private::accelerations(out, driving, &h);
+            let mut d = ::dyngen::RneaDerivatives::<S, #n_l>::default();
+            Self::rnea_derivatives(q, v, &out.ddq, params, &mut d);
+            #slope
+            #products
+        }
     };
-    let (parts, mut r) = emit::emit_fn(&g, &spec, max_statements);
-    r.name = "aba_derivatives".to_string();
+    let plain = forward(TokenStream::new());
+    let aba_doc = doc_attrs(&format!(
+        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. Composed of [`Self::inverse_inertia`],\n[`Self::nonlinear_effects`] and [`Self::rnea_derivatives`]; the products with `M⁻¹` run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+        sizes.params()
+    ));
     items.push((
         "aba_derivatives".to_string(),
         quote! {
@@ -869,53 +929,25 @@ fn derivative_items(
                 q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
-                Self::__aba_derivative_parts(q, v, tau, params, out);
-                #products
+                Self::inverse_inertia(q, params, &mut out.minv);
+                let driving = tau;
+                #plain
             }
-            #parts
         },
     ));
-    reports.push(r);
 
     // With the joint models: the rotor inertias in M, friction taken off τ first and
     // its slope added to ∂τ/∂v before the products.
-    let g = Graph::new();
-    let d = derivatives::aba_joints_derivative_parts(&g, model);
-    let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
-    outputs.extend(ids(&d.dtau_dq));
-    outputs.extend(ids(&d.dtau_dv));
-    outputs.extend(ids(&d.minv));
-    let nj_l = emit::usize_lit(4 * n);
+    let with_slope = forward(quote! {
+        for j in 0..#n_l {
+            d.dtau_dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
+        }
+    });
     let joints_doc = doc_attrs(&format!(
         "[`Self::aba_derivatives`] of [`Self::aba_joints`], the forward dynamics with the joint\nmodels: `ddq = (M + diag(Ia))⁻¹ (tau − h − Fv·v − Fc·c(v) − F0)`, its derivatives\n`−(M + diag(Ia))⁻¹ ∂τ/∂q` and `−(M + diag(Ia))⁻¹ (∂τ/∂v + diag(Fv + Fc·c′(v)))`, and\n`(M + diag(Ia))⁻¹` in `minv`. With `Coulomb::Sign`, `c′ = 0` (the model is not\ndifferentiable at `v = 0`); `Coulomb::smooth(ε)` gives a smooth linearisation. {}; {}.",
         sizes.params(),
         sizes.joint_params()
     ));
-    let spec = FnSpec {
-        name: "__aba_joints_derivative_parts",
-        public: false,
-        doc: "The generated part of [`Self::aba_joints_derivatives`].".to_string(),
-        args: vec![
-            arg(ARG_Q, "q", sizes.nq),
-            arg(ARG_V, "v", n),
-            arg(ARG_TAU, "tau", n),
-            arg(ARG_PARAMS, "params", 10 * sizes.n),
-            arg(ARG_JOINT_PARAMS, "joint_params", 4 * n),
-        ],
-        ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
-        output: Output::InPlace {
-            place: Box::new(place(&[
-                ("ddq", false),
-                ("ddq_dq", true),
-                ("ddq_dv", true),
-                ("minv", true),
-            ])),
-            clear: clear.clone(),
-        },
-        outputs,
-    };
-    let (parts, mut r) = emit::emit_fn(&g, &spec, max_statements);
-    r.name = "aba_joints_derivatives".to_string();
     items.push((
         "aba_joints_derivatives".to_string(),
         quote! {
@@ -926,40 +958,17 @@ fn derivative_items(
                 joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
-                let mut driving = *tau;
+                let mut friction_free = *tau;
                 for j in 0..#n_l {
-                    driving[j] -= ::dyngen::__private::joint_at(joint_params, j).friction(v[j], coulomb);
+                    friction_free[j] -= ::dyngen::__private::joint_at(joint_params, j).friction(v[j], coulomb);
                 }
-                Self::__aba_joints_derivative_parts(q, v, &driving, params, joint_params, out);
-                for j in 0..#n_l {
-                    out.ddq_dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
-                }
-                #products
+                Self::__inverse_inertia(q, params, joint_params, &mut out.minv);
+                let driving = &friction_free;
+                #with_slope
             }
-            #parts
         },
     ));
-    reports.push(r);
-
-    let g = Graph::new();
-    let m = algo::crba(&g, model);
-    let minv = derivatives::inverse_inertia(&g, model, &m);
-    let spec = FnSpec {
-        name: "inverse_inertia",
-        public: true,
-        doc: format!(
-            "`M(q)⁻¹` ({n} × {n}, symmetric; Pinocchio's `computeMinverse`) from the tree's `LᵀDL`\nfactorisation of [`Self::crba`]'s matrix, written to `out`. {}.",
-            sizes.params()
-        ),
-        args: vec![arg(ARG_Q, "q", sizes.nq), arg(ARG_PARAMS, "params", 10 * sizes.n)],
-        ret: quote!([[S; #n_l]; #n_l]),
-        output: emit::matrix_output(n),
-        outputs: ids(&minv),
-    };
-    let (t, r) = emit::emit_fn(&g, &spec, max_statements);
-    items.push(("inverse_inertia".to_string(), t));
-    reports.push(r);
-    (items, reports)
+    DerivativeFns { items, bodies, reports }
 }
 
 /// The products by `−M⁻¹` that finish the forward-dynamics derivatives: over the
@@ -973,7 +982,7 @@ fn times_minus_minv(model: &Model) -> TokenStream {
     };
     let support: Vec<Vec<usize>> = (0..nv).map(|c| (0..nv).filter(|&k| on_path(k, c)).collect()).collect();
     if support.iter().all(|rows| rows.len() == nv) {
-        return quote!(::dyngen::__private::times_minus_minv(out););
+        return quote!(::dyngen::__private::times_minus_minv(out, &d););
     }
     let n_l = emit::usize_lit(nv);
     let columns = support.iter().map(|rows| {
@@ -984,7 +993,7 @@ fn times_minus_minv(model: &Model) -> TokenStream {
         // Column c of ∂τ/∂q and ∂τ/∂v is zero outside the coordinates of the joints
         // on one path with c's.
         const SUPPORT: [&[usize]; #n_l] = [#(#columns),*];
-        ::dyngen::__private::times_minus_minv_sparse(out, &SUPPORT);
+        ::dyngen::__private::times_minus_minv_sparse(out, &d, &SUPPORT);
     }
 }
 

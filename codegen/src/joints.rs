@@ -19,6 +19,8 @@ use quote::quote;
 pub(crate) struct JointFns {
     /// Inherent functions, by name.
     pub items: Vec<(String, TokenStream)>,
+    /// The bodies of the generated functions ([`emit::Emitted`]), by name.
+    pub bodies: Vec<(String, TokenStream)>,
     /// `Robot` methods.
     pub methods: Vec<TokenStream>,
     /// The operation count of the generated forward dynamics, reported as `aba_joints`.
@@ -34,7 +36,13 @@ fn doc(text: &str) -> TokenStream {
 }
 
 /// The joint functions of the robot type and their `Robot` methods.
-pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statements: usize) -> JointFns {
+pub(crate) fn generate(
+    model: &Model,
+    bases: &Bases,
+    sizes: &Sizes,
+    max_statements: usize,
+    home: &proc_macro2::Ident,
+) -> JointFns {
     // Rows and joint parameters go by velocity coordinate; parameters by body.
     let n = sizes.nv;
     let (np, nj, nb, nbj) = (10 * sizes.n, 4 * n, sizes.nb, sizes.nbj);
@@ -81,7 +89,11 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
         output: Output::Return(Box::new(|outs: &[TokenStream]| quote!([#(#outs),*]))),
         outputs: algo::aba(&g, model, Armature::Input).iter().map(|x| x.id()).collect(),
     };
-    let (aba_armature, mut report) = emit::emit_fn(&g, &spec, max_statements);
+    let (aba_armature, mut report) = emit::emit_fn(&g, &spec, max_statements, home);
+    let (aba_armature, bodies) = (
+        aba_armature.method,
+        vec![("aba_armature".to_string(), aba_armature.body)],
+    );
     report.name = "aba_joints".to_string();
 
     let rnea_doc = doc(&format!(
@@ -274,6 +286,7 @@ pub(crate) fn generate(model: &Model, bases: &Bases, sizes: &Sizes, max_statemen
     ];
     JointFns {
         items,
+        bodies,
         methods,
         reports: vec![report],
     }

@@ -103,12 +103,30 @@ impl<S: Scalar, const N: usize> Linearization<S, N> {
     }
 }
 
-/// Support for generated code: `ddq_dq ← −M⁻¹ ddq_dq`, `ddq_dv ← −M⁻¹ ddq_dv`, where
-/// the generated part left `∂τ/∂q` and `∂τ/∂v` (loops: small code, vectorised).
+/// Support for generated code: `ddq ← M⁻¹ (tau − h)` with the `M⁻¹` already in
+/// `d.minv` (`h` the nonlinear effects; `tau` the joint torques, friction taken off).
 #[doc(hidden)]
 #[inline]
-pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>) {
-    let (dq, dv) = (d.ddq_dq, d.ddq_dv);
+pub fn __accelerations<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, tau: &[S; N], h: &[S; N]) {
+    let mut b = [S::ZERO; N];
+    for j in 0..N {
+        b[j] = tau[j] - h[j];
+    }
+    for i in 0..N {
+        let mut s = S::ZERO;
+        for j in 0..N {
+            s += d.minv[i][j] * b[j];
+        }
+        d.ddq[i] = s;
+    }
+}
+
+/// Support for generated code: `ddq_dq ← −M⁻¹ ∂τ/∂q`, `ddq_dv ← −M⁻¹ ∂τ/∂v` from the
+/// inverse-dynamics derivatives taken at `a = ddq` (loops: small code, vectorised).
+#[doc(hidden)]
+#[inline]
+pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, r: &RneaDerivatives<S, N>) {
+    let (dq, dv) = (&r.dtau_dq, &r.dtau_dv);
     for i in 0..N {
         let row = &d.minv[i];
         let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
@@ -133,8 +151,12 @@ pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N
 /// serves as its column.
 #[doc(hidden)]
 #[inline]
-pub fn __times_minus_minv_sparse<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, support: &[&[usize]; N]) {
-    let (dq, dv) = (d.ddq_dq, d.ddq_dv);
+pub fn __times_minus_minv_sparse<S: Scalar, const N: usize>(
+    d: &mut AbaDerivatives<S, N>,
+    r: &RneaDerivatives<S, N>,
+    support: &[&[usize]; N],
+) {
+    let (dq, dv) = (&r.dtau_dq, &r.dtau_dv);
     for c in 0..N {
         let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
         for &k in support[c] {

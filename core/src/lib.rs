@@ -45,6 +45,7 @@ pub use scalar::Scalar;
 /// Support for generated code; not a public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::derivatives::__accelerations as accelerations;
     pub use crate::derivatives::__times_minus_minv as times_minus_minv;
     pub use crate::derivatives::__times_minus_minv_sparse as times_minus_minv_sparse;
     pub use crate::frames::__express_jacobian as express_jacobian;

@@ -43,11 +43,13 @@
 //!
 //! In [`aba_derivatives`] the same closed form is taken at `a = q̈`, with the spatial
 //! accelerations and bias forces built as `aba` builds them (so they are `aba`'s
-//! nodes) and `∂q̈/∂(q, v) = −M⁻¹ ∂τ/∂(q, v)`. Generated code does not emit that
-//! graph: its `aba_derivatives` calls the generated `inverse_inertia`,
-//! `nonlinear_effects` and `rnea_derivatives` and does the products in loops, so a
-//! large tree's crate carries one copy of each (the single graph shares the
-//! kinematics, but its code was as long as the three functions together).
+//! nodes) and `∂q̈/∂(q, v) = −M⁻¹ ∂τ/∂(q, v)`. Generated code emits the parts
+//! ([`aba_joints_derivative_parts`]: `q̈ = M⁻¹ (τ − h)` and an rnea at `q̈`, which on
+//! the arms ran faster than next to `aba`) once, with the rotor inertias as inputs,
+//! for `aba_derivatives` (zeros) and `aba_joints_derivatives`. For large trees it
+//! emits no such graph: their `aba_derivatives` calls the generated
+//! `inverse_inertia`, `nonlinear_effects` and `rnea_derivatives`, whose code the
+//! single graph repeats in full.
 //!
 //! # `M⁻¹`
 //!
@@ -140,7 +142,9 @@ pub fn aba_derivatives_with<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaDer
 }
 
 /// What [`aba_derivatives_with`] multiplies: `q̈`, `∂τ/∂q` and `∂τ/∂v` at `a = q̈`, and
-/// `M⁻¹`.
+/// `M⁻¹`. Generated code takes these and does the two `n × n` products in a loop:
+/// written out, they would add `2 n²(2n − 1)` straight-line operations to a function
+/// that is already larger than the instruction cache.
 pub struct AbaParts<'g> {
     pub ddq: Vec<Expr<'g>>,
     pub dtau_dq: Vec<Vec<Expr<'g>>>,
@@ -150,12 +154,29 @@ pub struct AbaParts<'g> {
 
 /// The parts of [`aba_derivatives_with`], before the products with `−M⁻¹`.
 pub fn aba_derivative_parts<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaParts<'g> {
-    parts(g, model, how)
+    parts(g, model, how, false)
 }
 
-fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq) -> AbaParts<'g> {
+/// [`aba_derivative_parts`] with each joint's rotor inertia `Ia` (read from
+/// `joint_params[4(j−1)]`, [`algo::ARG_JOINT_PARAMS`]) on the diagonal of `M`:
+/// `q̈ = (M + diag(Ia))⁻¹ (τ − h)`, the rigid `∂τ/∂q`, `∂τ/∂v` at `a = q̈` (`Ia·q̈` does
+/// not depend on `q` or `v`), and `(M + diag(Ia))⁻¹`. `τ` is the torque left once
+/// friction is taken off (friction's `∂/∂v` is added at run time).
+pub fn aba_joints_derivative_parts<'g>(g: &'g Graph, model: &Model) -> AbaParts<'g> {
+    parts(g, model, Ddq::InverseInertia, true)
+}
+
+fn parts<'g>(g: &'g Graph, model: &Model, how: Ddq, armature: bool) -> AbaParts<'g> {
     let n = model.nv();
-    let mass_matrix = || algo::crba(g, model);
+    let mass_matrix = || {
+        let mut m = algo::crba(g, model);
+        if armature {
+            for (i, row) in m.iter_mut().enumerate() {
+                row[i] = row[i] + g.input(algo::ARG_JOINT_PARAMS, (4 * i) as u32);
+            }
+        }
+        m
+    };
     let (ddq, minv) = match how {
         Ddq::Aba => {
             let ddq = algo::aba(g, model, algo::Armature::None);

@@ -455,6 +455,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let assemble_pose = |outs: &[TokenStream]| Record::Pose.build(outs);
 
     // Per frame: placement, Jacobian, motion; private, dispatched by the enum.
+    let large = n > crate::generate::LARGE_TREE_NV;
     let mut placement_fns = Vec::new();
     let mut jacobian_fns = Vec::new();
     let mut jacobian_dot_fns = Vec::new();
@@ -468,18 +469,23 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             format!("__frame_jacobian_dot_{f}"),
             format!("__frame_motion_{f}"),
         );
-        let g = Graph::new();
-        let outputs = build_placement(&g, model, f);
-        let spec = FnSpec {
-            name: &pn,
-            public: false,
-            doc: format!("The placement of frame `{label}`."),
-            args: vec![q()],
-            ret: pose_ret.clone(),
-            output: Output::Return(Box::new(assemble_pose)),
-            outputs,
-        };
-        let mut t = emit_one(spec, &g, format!("frame_placement[{label}]"));
+        // A large tree takes one frame's placement from all of them (`frame_placements`,
+        // below) rather than carry a function per frame.
+        let mut t = TokenStream::new();
+        if !large {
+            let g = Graph::new();
+            let outputs = build_placement(&g, model, f);
+            let spec = FnSpec {
+                name: &pn,
+                public: false,
+                doc: format!("The placement of frame `{label}`."),
+                args: vec![q()],
+                ret: pose_ret.clone(),
+                output: Output::Return(Box::new(assemble_pose)),
+                outputs,
+            };
+            t.extend(emit_one(spec, &g, format!("frame_placement[{label}]")));
+        }
 
         let g = Graph::new();
         let outputs = build_jacobian(&g, model, f);
@@ -529,32 +535,36 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
         };
         t.extend(emit_one(spec, &g, format!("frame_jacobian_time_variation[{label}]")));
 
-        let g = Graph::new();
-        let outputs = build_motion(&g, model, f);
-        let assemble = |o: &[TokenStream]| {
-            let pose = Record::Pose.build(&o[..12]);
-            let m = |s: &[TokenStream]| {
-                let (l, a) = (&s[..3], &s[3..]);
-                quote!(::dyngen::Motion {
-                    linear: ::dyngen::nalgebra::Vector3::new(#(#l),*),
-                    angular: ::dyngen::nalgebra::Vector3::new(#(#a),*),
-                })
+        // A large tree takes the motion from `J` and `J̇` (above) rather than carry a
+        // function per frame for it.
+        if !large {
+            let g = Graph::new();
+            let outputs = build_motion(&g, model, f);
+            let assemble = |o: &[TokenStream]| {
+                let pose = Record::Pose.build(&o[..12]);
+                let m = |s: &[TokenStream]| {
+                    let (l, a) = (&s[..3], &s[3..]);
+                    quote!(::dyngen::Motion {
+                        linear: ::dyngen::nalgebra::Vector3::new(#(#l),*),
+                        angular: ::dyngen::nalgebra::Vector3::new(#(#a),*),
+                    })
+                };
+                let (v, a) = (m(&o[12..18]), m(&o[18..24]));
+                quote!(::dyngen::FrameMotion { placement: #pose, velocity: #v, acceleration: #a })
             };
-            let (v, a) = (m(&o[12..18]), m(&o[18..24]));
-            quote!(::dyngen::FrameMotion { placement: #pose, velocity: #v, acceleration: #a })
-        };
-        let spec = FnSpec {
-            name: &mn,
-            public: false,
-            doc: format!(
-                "The placement, velocity and classical acceleration of frame `{label}`,\n`LOCAL_WORLD_ALIGNED`."
-            ),
-            args: vec![q(), arg(ARG_V, "v", n), arg(ARG_A, "a", n)],
-            ret: quote!(::dyngen::FrameMotion<S>),
-            output: Output::Return(Box::new(assemble)),
-            outputs,
-        };
-        t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
+            let spec = FnSpec {
+                name: &mn,
+                public: false,
+                doc: format!(
+                    "The placement, velocity and classical acceleration of frame `{label}`,\n`LOCAL_WORLD_ALIGNED`."
+                ),
+                args: vec![q(), arg(ARG_V, "v", n), arg(ARG_A, "a", n)],
+                ret: quote!(::dyngen::FrameMotion<S>),
+                output: Output::Return(Box::new(assemble)),
+                outputs,
+            };
+            t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
+        }
         per_frame.push(t);
         let v = &variants[f];
         let (pn, jn, dn, mn) = (
@@ -661,8 +671,19 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let centroidal_dot = emit_one(spec, &g, "centroidal_map_time_variation".to_string());
 
     let zero_a = quote!(&[<S as ::dyngen::Scalar>::ZERO; #n_l]);
+    let (placement_body, walks) = if large {
+        (
+            quote!(Self::frame_placements(q)[frame.index()]),
+            format!("Taken from [`Self::frame_placements`] (a tree of more than\n{} coordinates carries no function per frame for it).", crate::generate::LARGE_TREE_NV),
+        )
+    } else {
+        (
+            quote!(match frame { #(#placement_fns,)* }),
+            "Walks only the bodies between the\nbase and the frame.".to_string(),
+        )
+    };
     let dispatch_doc = doc_attrs(&format!(
-        "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. Walks only the bodies between the\nbase and the frame."
+        "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. {walks}"
     ));
     let jacobian_doc = doc_attrs(&format!(
         "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`."
@@ -670,9 +691,25 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let jacobian_dot_doc = doc_attrs(&format!(
         "Frame `frame`'s placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × {n} each)\nin `reference` (Pinocchio's `getFrameJacobianTimeVariation`), written to `out`:\n`ẍ = J q̈ + J̇ q̇`. `J̇` is the time derivative of `J` along `q̇ = v`."
     ));
-    let motion_doc = doc_attrs(
-        "Frame `frame`'s placement, velocity and classical acceleration at `(q, v, a)`,\n`LOCAL_WORLD_ALIGNED`; `FrameMotion::velocity_in` and\n`FrameMotion::classical_acceleration_in` express them in another reference frame.",
-    );
+    let (motion_body, motion_how) = if large {
+        (
+            quote! {
+                let mut jacobians = ::dyngen::FrameJacobianTimeVariation::<S, #n_l>::default();
+                let out = &mut jacobians;
+                match frame { #(#jacobian_dot_fns,)* }
+                ::dyngen::__private::frame_motion(&jacobians, v, a)
+            },
+            format!(
+                " From the frame's\n`LOCAL_WORLD_ALIGNED` `J` and `J̇`: `J v` and `J a + J̇ v` (a tree of more than {}\ncoordinates carries no function per frame for it).",
+                crate::generate::LARGE_TREE_NV
+            ),
+        )
+    } else {
+        (quote!(match frame { #(#motion_fns,)* }), String::new())
+    };
+    let motion_doc = doc_attrs(&format!(
+        "Frame `frame`'s placement, velocity and classical acceleration at `(q, v, a)`,\n`LOCAL_WORLD_ALIGNED`; `FrameMotion::velocity_in` and\n`FrameMotion::classical_acceleration_in` express them in another reference frame.{motion_how}",
+    ));
     let velocity_doc =
         doc_attrs("Frame `frame`'s velocity at `(q, v)` in `reference` (Pinocchio's `getFrameVelocity`):\n`J(q) v`.");
     let acc_doc = doc_attrs(
@@ -689,7 +726,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             #dispatch_doc
             #[inline]
             pub fn frame_placement<S: ::dyngen::Scalar>(q: &[S; #nq_l], frame: #fty) -> ::dyngen::Pose<S> {
-                match frame { #(#placement_fns,)* }
+                #placement_body
             }
             #jacobian_doc
             #[inline]
@@ -711,7 +748,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
             #motion_doc
             #[inline]
             pub fn frame_motion<S: ::dyngen::Scalar>(q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], frame: #fty) -> ::dyngen::FrameMotion<S> {
-                match frame { #(#motion_fns,)* }
+                #motion_body
             }
             #velocity_doc
             #[inline]

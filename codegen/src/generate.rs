@@ -707,6 +707,66 @@ impl Algorithm {
     }
 }
 
+/// The inherent function of `algorithm` composed of other generated functions, on a
+/// tree above [`LARGE_TREE_NV`] coordinates (`None`: emit its own graph): `aba` is the
+/// forward dynamics with rotor inertias at zero armature, `nonlinear_effects` is
+/// `rnea` at zero acceleration, and the base regressors are the independent columns
+/// of the full ones (which is what their graphs compute).
+fn composed(algorithm: &Algorithm, sizes: &Sizes) -> Option<TokenStream> {
+    if sizes.nv <= LARGE_TREE_NV {
+        return None;
+    }
+    let [n_l, nq_l, np_l, nj_l] = [sizes.nv, sizes.nq, 10 * sizes.n, 4 * sizes.nv].map(emit::usize_lit);
+    let zero = quote!(<S as ::dyngen::Scalar>::ZERO);
+    let columns = |full: &str, cols: usize, index: &str, base: usize| {
+        let (full, index) = (format_ident!("{}", full), format_ident!("{}", index));
+        let (c_l, b_l) = (emit::usize_lit(cols), emit::usize_lit(base));
+        (
+            quote!(q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], out: &mut [[S; #b_l]; #n_l]),
+            quote!(),
+            quote! {
+                let mut y = [[#zero; #c_l]; #n_l];
+                Self::#full(q, v, a, &mut y);
+                for (row, full) in out.iter_mut().zip(&y) {
+                    for (x, &c) in row.iter_mut().zip(&Self::#index) {
+                        *x = full[c];
+                    }
+                }
+            },
+            format!("the columns `Self::{index}` of [`Self::{full}`]"),
+        )
+    };
+    let (params, ret, body, how) = match algorithm.name {
+        "aba" => (
+            quote!(q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l]),
+            quote!(-> [S; #n_l]),
+            quote!(Self::aba_armature(q, v, tau, params, &[#zero; #nj_l])),
+            "[`Self::aba_joints`]' forward dynamics with zero rotor inertias".to_string(),
+        ),
+        "nonlinear_effects" => (
+            quote!(q: &[S; #nq_l], v: &[S; #n_l], params: &[S; #np_l]),
+            quote!(-> [S; #n_l]),
+            quote!(Self::rnea(q, v, &[#zero; #n_l], params)),
+            "[`Self::rnea`] at zero acceleration".to_string(),
+        ),
+        "base_regressor" => columns("joint_torque_regressor", 10 * sizes.n, "BASE_INDEX", sizes.nb),
+        "principal_base_regressor" => columns("principal_regressor", 4 * sizes.n, "PRINCIPAL_BASE_INDEX", sizes.nbt),
+        _ => return None,
+    };
+    let fname = format_ident!("{}", algorithm.name);
+    let doc = doc_attrs(&format!(
+        "{}\n\nComposed (a tree of more than {LARGE_TREE_NV} coordinates): {how}.",
+        (algorithm.doc)(sizes)
+    ));
+    Some(quote! {
+        #doc
+        #[inline]
+        pub fn #fname<S: ::dyngen::Scalar>(#params) #ret {
+            #body
+        }
+    })
+}
+
 /// Generates the robot type `name` for `model`, with the base parameters `bases`
 /// found by [`crate::base::analyse_model`] for the same model. `name` must be a Rust
 /// identifier (see [`is_type_name`]).
@@ -726,6 +786,11 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     let mut bodies = Vec::new();
     let mut methods = Vec::new();
     for algorithm in ALGORITHMS {
+        if let Some(item) = composed(algorithm, &sizes) {
+            items.push((algorithm.name.to_string(), item));
+            methods.push(algorithm.trait_method(&ty, &sizes));
+            continue;
+        }
         let g = Graph::new();
         let spec = algorithm.spec(&g, model, bases, &sizes);
         let (emitted, report) = emit::emit_fn(&g, &spec, options.max_statements, &home);
@@ -775,6 +840,19 @@ struct DerivativeFns {
     bodies: Vec<(String, TokenStream)>,
     reports: Vec<FnReport>,
 }
+
+/// Trees with more velocity coordinates than this get functions composed of other
+/// generated functions wherever a graph of their own would repeat another one's code
+/// (see [`composed`], `aba_derivatives` in [`derivative_items`], and `frame_placement`
+/// and `frame_motion` in [`crate::frames`]): what they save in build time matters more
+/// there than the speed they give up.
+///
+/// `aba_derivatives`, measured on the 37-coordinate floating humanoid (release, 2
+/// cores): its own graph adds 37k lines, and the crate with every function rebuilt in
+/// 44.5–45.9 s against 35.7–36.0 s composed (peak 1.43 against 1.25 GB); the
+/// composition ran 24.9 µs against 22.2 µs. On the arms the graph is twice as fast
+/// (Panda 0.82 against 1.59 µs) and small.
+pub(crate) const LARGE_TREE_NV: usize = 24;
 
 /// The statement budget of a part of the derivative functions (see [`derivative_items`]).
 const DERIVATIVE_MAX_STATEMENTS: usize = 800;
@@ -900,24 +978,78 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
     ));
     reports.push(r);
 
-    // Forward dynamics and its derivatives, composed from the functions above (one
-    // copy of the generated code serves all of them): `M⁻¹`, `q̈ = M⁻¹ (τ − h)`, the
-    // inverse-dynamics derivatives at `a = q̈` and, in loops, the products by `−M⁻¹`.
-    // `slope` adds friction's `∂/∂v` to `∂τ/∂v` before the products.
-    let products = times_minus_minv(model);
-    let forward = |slope: TokenStream| {
-        quote! {
-            let h = Self::nonlinear_effects(q, v, params);
-            ::dyngen::__private::accelerations(out, driving, &h);
-            let mut d = ::dyngen::RneaDerivatives::<S, #n_l>::default();
-            Self::rnea_derivatives(q, v, &out.ddq, params, &mut d);
-            #slope
-            #products
-        }
+    // Forward dynamics and its derivatives. `driving` is τ (friction taken off, with
+    // the joint models); each path leaves `∂τ/∂q`, `∂τ/∂v` at `a = q̈` in `dq`, `dv`,
+    // `slope` adds friction's `∂/∂v` to `dv`, then the products by `−M⁻¹` run as loops.
+    let forward = if n > LARGE_TREE_NV {
+        // Composed of the functions above, so a large tree carries one copy of each:
+        // `M⁻¹` (with the rotor inertias), `q̈ = M⁻¹ (τ − h)`, rnea derivatives at `q̈`.
+        let products = times_minus_minv(model, quote!(&d.dtau_dq), quote!(&d.dtau_dv));
+        let n_l = n_l.clone();
+        Box::new(move |joint_params: TokenStream, slope: TokenStream| {
+            quote! {
+                Self::__inverse_inertia(q, params, #joint_params, &mut out.minv);
+                let h = Self::nonlinear_effects(q, v, params);
+                ::dyngen::__private::accelerations(out, driving, &h);
+                let mut d = ::dyngen::RneaDerivatives::<S, #n_l>::default();
+                Self::rnea_derivatives(q, v, &out.ddq, params, &mut d);
+                let dv = &mut d.dtau_dv;
+                #slope
+                #products
+            }
+        }) as Box<dyn Fn(TokenStream, TokenStream) -> TokenStream>
+    } else {
+        // One generated graph (sharing the kinematics of M⁻¹, h and the rnea at q̈)
+        // with the rotor inertias as inputs, for both functions.
+        let g = Graph::new();
+        let d = derivatives::aba_joints_derivative_parts(&g, model);
+        let mut outputs: Vec<NodeId> = d.ddq.iter().map(|x| x.id()).collect();
+        outputs.extend(ids(&d.dtau_dq));
+        outputs.extend(ids(&d.dtau_dv));
+        outputs.extend(ids(&d.minv));
+        let spec = FnSpec {
+            name: "__aba_derivative_parts",
+            public: false,
+            doc: "The generated part of [`Self::aba_derivatives`] and [`Self::aba_joints_derivatives`]:\n`ddq`, `(M + diag(Ia))⁻¹`, and `∂τ/∂q`, `∂τ/∂v` at `a = ddq` in the places of `∂q̈/∂q`,\n`∂q̈/∂v`.".to_string(),
+            args: vec![
+                arg(ARG_Q, "q", sizes.nq),
+                arg(ARG_V, "v", n),
+                arg(ARG_TAU, "tau", n),
+                arg(ARG_PARAMS, "params", 10 * sizes.n),
+                arg(ARG_JOINT_PARAMS, "joint_params", 4 * n),
+            ],
+            ret: quote!(::dyngen::AbaDerivatives<S, #n_l>),
+            output: Output::InPlace {
+                place: Box::new(place(&[("ddq", false), ("ddq_dq", true), ("ddq_dv", true), ("minv", true)])),
+                clear,
+            },
+            outputs,
+        };
+        let (e, mut r) = emit::emit_fn(&g, &spec, max_statements, home);
+        r.name = "aba_derivatives".to_string();
+        reports.push(r);
+        items.push(("__aba_derivative_parts".to_string(), e.method));
+        bodies.push(("__aba_derivative_parts".to_string(), e.body));
+        let products = times_minus_minv(model, quote!(&dq), quote!(&*dv));
+        Box::new(move |joint_params: TokenStream, slope: TokenStream| {
+            quote! {
+                Self::__aba_derivative_parts(q, v, driving, params, #joint_params, out);
+                let (dq, mut dv) = (out.ddq_dq, out.ddq_dv);
+                let dv = &mut dv;
+                #slope
+                #products
+            }
+        })
     };
-    let plain = forward(TokenStream::new());
+    let zeros = quote!(&[<S as ::dyngen::Scalar>::ZERO; #nj_l]);
+    let plain = forward(zeros, TokenStream::new());
     let aba_doc = doc_attrs(&format!(
-        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. Composed of [`Self::inverse_inertia`],\n[`Self::nonlinear_effects`] and [`Self::rnea_derivatives`]; the products with `M⁻¹` run\nas loops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+        "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. {}; the products with `M⁻¹` run as\nloops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
+        if n > LARGE_TREE_NV {
+            "Composed of [`Self::inverse_inertia`], [`Self::nonlinear_effects`] and\n[`Self::rnea_derivatives`] (a large tree: one copy of their code)"
+        } else {
+            "`M⁻¹` from the tree's `LᵀDL` factorisation (no fill-in;\none division per velocity coordinate), `∂τ/∂q` and `∂τ/∂v` in closed form"
+        },
         sizes.params()
     ));
     items.push((
@@ -929,7 +1061,6 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
                 q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                 out: &mut ::dyngen::AbaDerivatives<S, #n_l>,
             ) {
-                Self::inverse_inertia(q, params, &mut out.minv);
                 let driving = tau;
                 #plain
             }
@@ -938,11 +1069,14 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
 
     // With the joint models: the rotor inertias in M, friction taken off τ first and
     // its slope added to ∂τ/∂v before the products.
-    let with_slope = forward(quote! {
-        for j in 0..#n_l {
-            d.dtau_dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
-        }
-    });
+    let with_slope = forward(
+        quote!(joint_params),
+        quote! {
+            for j in 0..#n_l {
+                dv[j][j] += ::dyngen::__private::joint_at(joint_params, j).friction_slope(v[j], coulomb);
+            }
+        },
+    );
     let joints_doc = doc_attrs(&format!(
         "[`Self::aba_derivatives`] of [`Self::aba_joints`], the forward dynamics with the joint\nmodels: `ddq = (M + diag(Ia))⁻¹ (tau − h − Fv·v − Fc·c(v) − F0)`, its derivatives\n`−(M + diag(Ia))⁻¹ ∂τ/∂q` and `−(M + diag(Ia))⁻¹ (∂τ/∂v + diag(Fv + Fc·c′(v)))`, and\n`(M + diag(Ia))⁻¹` in `minv`. With `Coulomb::Sign`, `c′ = 0` (the model is not\ndifferentiable at `v = 0`); `Coulomb::smooth(ε)` gives a smooth linearisation. {}; {}.",
         sizes.params(),
@@ -962,7 +1096,6 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
                 for j in 0..#n_l {
                     friction_free[j] -= ::dyngen::__private::joint_at(joint_params, j).friction(v[j], coulomb);
                 }
-                Self::__inverse_inertia(q, params, joint_params, &mut out.minv);
                 let driving = &friction_free;
                 #with_slope
             }
@@ -974,7 +1107,7 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
 /// The products by `−M⁻¹` that finish the forward-dynamics derivatives: over the
 /// structurally nonzero rows of each column (coordinates of joints on one path) when
 /// the tree has branches, dense loops when every pair of coordinates shares a path.
-fn times_minus_minv(model: &Model) -> TokenStream {
+fn times_minus_minv(model: &Model, dq: TokenStream, dv: TokenStream) -> TokenStream {
     let nv = model.nv();
     let on_path = |a: usize, b: usize| {
         let (ja, jb) = (model.joint_of_v(a), model.joint_of_v(b));
@@ -982,7 +1115,7 @@ fn times_minus_minv(model: &Model) -> TokenStream {
     };
     let support: Vec<Vec<usize>> = (0..nv).map(|c| (0..nv).filter(|&k| on_path(k, c)).collect()).collect();
     if support.iter().all(|rows| rows.len() == nv) {
-        return quote!(::dyngen::__private::times_minus_minv(out, &d););
+        return quote!(::dyngen::__private::times_minus_minv(out, #dq, #dv););
     }
     let n_l = emit::usize_lit(nv);
     let columns = support.iter().map(|rows| {
@@ -993,7 +1126,7 @@ fn times_minus_minv(model: &Model) -> TokenStream {
         // Column c of ∂τ/∂q and ∂τ/∂v is zero outside the coordinates of the joints
         // on one path with c's.
         const SUPPORT: [&[usize]; #n_l] = [#(#columns),*];
-        ::dyngen::__private::times_minus_minv_sparse(out, &d, &SUPPORT);
+        ::dyngen::__private::times_minus_minv_sparse(out, #dq, #dv, &SUPPORT);
     }
 }
 

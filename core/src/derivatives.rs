@@ -121,12 +121,12 @@ pub fn __accelerations<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, 
     }
 }
 
-/// Support for generated code: `ddq_dq ← −M⁻¹ ∂τ/∂q`, `ddq_dv ← −M⁻¹ ∂τ/∂v` from the
-/// inverse-dynamics derivatives taken at `a = ddq` (loops: small code, vectorised).
+/// Support for generated code: `ddq_dq ← −M⁻¹ dq`, `ddq_dv ← −M⁻¹ dv`, `dq` and `dv`
+/// the inverse-dynamics derivatives `∂τ/∂q`, `∂τ/∂v` taken at `a = ddq` (loops: small
+/// code, vectorised).
 #[doc(hidden)]
 #[inline]
-pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, r: &RneaDerivatives<S, N>) {
-    let (dq, dv) = (&r.dtau_dq, &r.dtau_dv);
+pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N>, dq: &[[S; N]; N], dv: &[[S; N]; N]) {
     for i in 0..N {
         let row = &d.minv[i];
         let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
@@ -153,10 +153,10 @@ pub fn __times_minus_minv<S: Scalar, const N: usize>(d: &mut AbaDerivatives<S, N
 #[inline]
 pub fn __times_minus_minv_sparse<S: Scalar, const N: usize>(
     d: &mut AbaDerivatives<S, N>,
-    r: &RneaDerivatives<S, N>,
+    dq: &[[S; N]; N],
+    dv: &[[S; N]; N],
     support: &[&[usize]; N],
 ) {
-    let (dq, dv) = (&r.dtau_dq, &r.dtau_dv);
     for c in 0..N {
         let (mut sq, mut sv) = ([S::ZERO; N], [S::ZERO; N]);
         for &k in support[c] {

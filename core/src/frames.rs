@@ -185,6 +185,33 @@ pub fn __express_jacobian_time_variation<S: Scalar, const N: usize>(
     j.express_from_lwa(v, reference);
 }
 
+/// Support for generated code: a frame's motion from its `LOCAL_WORLD_ALIGNED`
+/// Jacobian and its time variation: the velocity `J v` (the origin's velocity and the
+/// angular velocity) and the classical acceleration `J a + J̇ v`, the time derivative
+/// of `J v`.
+#[doc(hidden)]
+pub fn __frame_motion<S: Scalar, const N: usize>(
+    j: &FrameJacobianTimeVariation<S, N>,
+    v: &[S; N],
+    a: &[S; N],
+) -> FrameMotion<S> {
+    let row = |m: &[S; N], x: &[S; N]| m.iter().zip(x).fold(S::ZERO, |s, (&p, &q)| s + p * q);
+    let (mut vel, mut acc) = ([S::ZERO; 6], [S::ZERO; 6]);
+    for r in 0..6 {
+        vel[r] = row(&j.jacobian[r], v);
+        acc[r] = row(&j.jacobian[r], a) + row(&j.jacobian_dot[r], v);
+    }
+    let motion = |x: [S; 6]| Motion {
+        linear: Vector3::new(x[0], x[1], x[2]),
+        angular: Vector3::new(x[3], x[4], x[5]),
+    };
+    FrameMotion {
+        placement: j.placement,
+        velocity: motion(vel),
+        acceleration: motion(acc),
+    }
+}
+
 /// A frame's placement, velocity and classical acceleration, `LOCAL_WORLD_ALIGNED`,
 /// as the generated `frame_motion` computes them.
 #[derive(Clone, Copy, Debug, PartialEq)]

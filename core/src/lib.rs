@@ -50,6 +50,7 @@ pub mod __private {
     pub use crate::derivatives::__times_minus_minv_sparse as times_minus_minv_sparse;
     pub use crate::frames::__express_jacobian as express_jacobian;
     pub use crate::frames::__express_jacobian_time_variation as express_jacobian_time_variation;
+    pub use crate::frames::__frame_motion as frame_motion;
 
     /// A slice as a fixed-size array, with a message naming the argument when the
     /// length is wrong.

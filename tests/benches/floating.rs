@@ -70,6 +70,21 @@ macro_rules! bench_floating {
                 black_box(&jac);
             })
         });
+        // The drift `J̇ v` of `ẍ = J q̈ + J̇ q̇` (Pinocchio's `frame_classical_acc`: forward
+        // kinematics with `a = 0`, then `getFrameClassicalAcceleration`).
+        let zero = [0.0; NV];
+        group.bench_function("frame_classical_acceleration/generated", |b| {
+            b.iter(|| {
+                let (q, v, _) = next();
+                black_box(<$robot>::frame_classical_acceleration(
+                    black_box(q),
+                    black_box(v),
+                    &zero,
+                    $tool,
+                    ReferenceFrame::LocalWorldAligned,
+                ));
+            })
+        });
         let mut rd = RneaDerivatives::<f64, NV>::default();
         group.bench_function("rnea_derivatives/generated", |b| {
             b.iter(|| {

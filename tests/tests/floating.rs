@@ -367,3 +367,183 @@ fn quadruped12_joint_models_invert_and_match_the_regressor() {
         assert!(rel_err(&from_y, &tau, 1.0) < 1e-12);
     }
 }
+
+/// The humanoid's `aba_joints_derivatives` (a tree above `SHARED_DERIVATIVE_GRAPH_MAX_NV`
+/// coordinates: composed of `inverse_inertia`, `nonlinear_effects` and
+/// `rnea_derivatives`) with rotor inertias, viscous and smooth Coulomb friction and an
+/// offset, against central differences of the generated `aba_joints`: every column of
+/// `∂q̈/∂v` and `∂q̈/∂τ`, and the columns of `∂q̈/∂q` of the revolute joints (their
+/// coordinates are plain angles; the free flyer's tangent columns are checked against
+/// Pinocchio in `humanoid31_matches_pinocchio_free_flyer`). With zero joint parameters
+/// it is `aba_derivatives`.
+#[test]
+fn humanoid31_aba_joints_derivatives_match_finite_differences() {
+    type H = Humanoid31;
+    const NV: usize = H::NV;
+    let model = dyngen_reference::model_from_static(&<H as Robot>::MODEL);
+    let params = H::NOMINAL_PARAMS;
+    let mut jp = [0.0; 4 * NV];
+    for j in 0..NV {
+        jp[4 * j..4 * j + 4].copy_from_slice(&[0.05 + 0.01 * j as f64, 0.8, 1.5 - 0.03 * j as f64, 0.2]);
+    }
+    let coulomb = dyngen::Coulomb::smooth(0.05).unwrap();
+    let s = &dyngen_model::sample::sample_states(&model, 1, 5)[0];
+    let q: [f64; NV + 1] = s.q.clone().try_into().unwrap();
+    let v: [f64; NV] = s.v.clone().try_into().unwrap();
+    let tau: [f64; NV] = std::array::from_fn(|i| 2.0 - 0.1 * i as f64);
+    let mut d = dyngen::AbaDerivatives::<f64, NV>::default();
+    H::aba_joints_derivatives(&q, &v, &tau, &params, &jp, coulomb, &mut d);
+    let aba = |q: &[f64; NV + 1], v: &[f64; NV], tau: &[f64; NV]| H::aba_joints(q, v, tau, &params, &jp, coulomb);
+    let ddq = aba(&q, &v, &tau);
+    assert!(rel_err(&d.ddq, &ddq, 1.0) < 1e-12, "{:?} vs {ddq:?}", d.ddq);
+    let central = |f: &dyn Fn(f64) -> [f64; NV], h: f64| -> Vec<f64> {
+        f(h).iter().zip(f(-h)).map(|(p, m)| (p - m) / (2.0 * h)).collect()
+    };
+    let h = 1e-6;
+    let scale = ddq.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    let mut worst: f64 = 0.0;
+    for c in 0..NV {
+        let mut columns = vec![
+            (
+                central(
+                    &|e| {
+                        let mut w = v;
+                        w[c] += e;
+                        aba(&q, &w, &tau)
+                    },
+                    h,
+                ),
+                d.ddq_dv.map(|row| row[c]),
+            ),
+            (
+                central(
+                    &|e| {
+                        let mut t = tau;
+                        t[c] += e;
+                        aba(&q, &v, &t)
+                    },
+                    h,
+                ),
+                d.minv.map(|row| row[c]),
+            ),
+        ];
+        if c >= 6 {
+            // Velocity coordinate c ≥ 6 is the angle q[c + 1].
+            let fd = central(
+                &|e| {
+                    let mut p = q;
+                    p[c + 1] += e;
+                    aba(&p, &v, &tau)
+                },
+                h,
+            );
+            columns.push((fd, d.ddq_dq.map(|row| row[c])));
+        }
+        for (fd, got) in columns {
+            for r in 0..NV {
+                worst = worst.max((got[r] - fd[r]).abs() / scale);
+            }
+        }
+    }
+    eprintln!("humanoid31: aba_joints_derivatives against differences {worst:.1e}");
+    assert!(worst < 1e-6, "{worst:e}");
+
+    let zeros = [0.0; 4 * NV];
+    let mut dj = dyngen::AbaDerivatives::<f64, NV>::default();
+    H::aba_joints_derivatives(&q, &v, &tau, &params, &zeros, coulomb, &mut dj);
+    let mut da = dyngen::AbaDerivatives::<f64, NV>::default();
+    H::aba_derivatives(&q, &v, &tau, &params, &mut da);
+    assert_eq!(dj, da);
+}
+
+/// `Y_b β = τ` and `Y_pb β_p = τ` on states the base analysis never saw, worst
+/// relative error over both parameterisations. The humanoid's base regressors are
+/// composed (the independent columns of the full ones), the quadruped's generated
+/// on their own.
+fn base_regressors_reproduce_rnea<R: Robot>() -> f64 {
+    let model = dyngen_reference::model_from_static(&R::MODEL);
+    let nv = R::NV;
+    let (p, theta) = (R::nominal_params(), R::nominal_theta());
+    let (mut beta, mut beta_p) = (vec![0.0; R::NBASE], vec![0.0; R::NBASE_PRINCIPAL]);
+    R::base_params(p, &mut beta);
+    R::principal_base_params(theta, &mut beta_p);
+    let times = |y: &[f64], x: &[f64]| -> Vec<f64> {
+        y.chunks(x.len())
+            .map(|row| row.iter().zip(x).map(|(a, b)| a * b).sum())
+            .collect()
+    };
+    let mut worst: f64 = 0.0;
+    for s in dyngen_model::sample::sample_states(&model, 3, 9) {
+        let mut tau = vec![0.0; nv];
+        R::rnea(&s.q, &s.v, &s.a, p, &mut tau);
+        let mut y = vec![0.0; nv * R::NBASE];
+        R::base_regressor(&s.q, &s.v, &s.a, &mut y);
+        worst = worst.max(rel_err(&times(&y, &beta), &tau, 1.0));
+        let mut y = vec![0.0; nv * R::NBASE_PRINCIPAL];
+        R::principal_base_regressor(&s.q, &s.v, &s.a, &mut y);
+        worst = worst.max(rel_err(&times(&y, &beta_p), &tau, 1.0));
+    }
+    worst
+}
+
+#[test]
+fn base_regressors_reproduce_rnea_on_floating_robots() {
+    for (name, e) in [
+        ("quadruped12", base_regressors_reproduce_rnea::<Quadruped12>()),
+        ("humanoid31", base_regressors_reproduce_rnea::<Humanoid31>()),
+    ] {
+        eprintln!("{name}: base regressors against rnea {e:.1e}");
+        assert!(e < 1e-10, "{name}: {e:e}");
+    }
+}
+
+/// The humanoid's `frame_motion` (a tree above `LARGE_TREE_NV` coordinates: `J v` and
+/// `J a + J̇ v` from the frame's Jacobian and its time variation) against differences
+/// along the path `q(t) = q ⊕ (v t + a t²/2)`, whose velocity is `v` and acceleration
+/// `a` at `t = 0`: the frame origin's velocity and classical acceleration, and the
+/// angular velocity from `R(h) R(−h)ᵀ = exp(2h [ω]×)`, for every frame.
+#[test]
+fn humanoid31_frame_motion_matches_differences() {
+    type H = Humanoid31;
+    const NV: usize = H::NV;
+    let model = dyngen_reference::model_from_static(&<H as Robot>::MODEL);
+    let s = &dyngen_model::sample::sample_states(&model, 1, 13)[0];
+    let q: [f64; NV + 1] = s.q.clone().try_into().unwrap();
+    let v: [f64; NV] = s.v.clone().try_into().unwrap();
+    let a: [f64; NV] = s.a.clone().try_into().unwrap();
+    let at = |t: f64| -> [f64; NV + 1] {
+        let step: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v * t + 0.5 * a * t * t).collect();
+        let mut out = [0.0; NV + 1];
+        dyngen::configuration::integrate(&<H as Robot>::MODEL, &q, &step, &mut out).unwrap();
+        out
+    };
+    let h = 1e-4;
+    let (qp, qm) = (at(h), at(-h));
+    let mut worst: f64 = 0.0;
+    for frame in robot_humanoid31::Humanoid31Frame::ALL {
+        let m = H::frame_motion(&q, &v, &a, frame);
+        let (p0, pp, pm) = (
+            H::frame_placement(&q, frame),
+            H::frame_placement(&qp, frame),
+            H::frame_placement(&qm, frame),
+        );
+        let scale = 1.0 + m.velocity.linear.norm() + m.acceleration.linear.norm() + m.velocity.angular.norm();
+        for k in 0..3 {
+            let vel = (pp.translation[k] - pm.translation[k]) / (2.0 * h);
+            let acc = (pp.translation[k] - 2.0 * p0.translation[k] + pm.translation[k]) / (h * h);
+            worst = worst.max((vel - m.velocity.linear[k]).abs() / scale);
+            worst = worst.max((acc - m.acceleration.linear[k]).abs() / scale);
+        }
+        let turn = pp.rotation * pm.rotation.transpose();
+        let w = [
+            turn[(2, 1)] - turn[(1, 2)],
+            turn[(0, 2)] - turn[(2, 0)],
+            turn[(1, 0)] - turn[(0, 1)],
+        ];
+        for k in 0..3 {
+            worst = worst.max((w[k] / (4.0 * h) - m.velocity.angular[k]).abs() / scale);
+        }
+    }
+    eprintln!("humanoid31: frame_motion against differences {worst:.1e}");
+    assert!(worst < 1e-5, "{worst:e}");
+}

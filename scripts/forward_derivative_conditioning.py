@@ -10,6 +10,10 @@ metric `‖x − y‖∞ / ‖y‖∞`. `∂τ/∂q` at `a = q̈` comes from Pin
 (`computeRNEADerivatives`), so the script runs in Pinocchio's environment:
 
     $PIN_HOME/.venv/bin/python scripts/forward_derivative_conditioning.py tests/fixtures/floating/humanoid31.json
+
+With `--write`, also writes the extended-precision `M⁻¹` and `∂q̈/∂q` of each sample,
+rounded to double, beside the fixture (`humanoid31.json` → `humanoid31_extended.json`),
+for `tests/tests/floating.rs` to measure dyngen against.
 """
 
 import json
@@ -55,8 +59,9 @@ def rel(x, y):
     return float(np.max(np.abs(np.asarray(x, dtype=np.longdouble) - y)) / np.max(np.abs(y)))
 
 
-def main(path):
+def main(path, write):
     fx = json.load(open(path))
+    extended = []
     print(f"{path}: {fx['urdf']}, root joint {fx.get('root_joint')}")
     model = pin.buildModelFromUrdf(os.path.join(ROOT, fx["urdf"]), pin.JointModelFreeFlyer())
     data = model.createData()
@@ -69,11 +74,25 @@ def main(path):
         dq, _, _ = (x.copy() for x in pin.computeRNEADerivatives(model, data, q, v, ddq))
         dq = dq.astype(np.longdouble)
         ddq_dq = -minv @ dq
+        extended.append({"Minv": minv.astype(float).tolist(), "ddq_dq": ddq_dq.astype(float).tolist()})
         print(
             f"{s:6d}  {np.linalg.cond(m):8.2e}  {rel(sample['Minv'], minv):26.2e}  "
             f"{rel(sample['ddq_dq'], ddq_dq):28.2e}"
         )
 
 
+    if write:
+        out = path.replace(".json", "_extended.json")
+        doc = {
+            "generator": "scripts/forward_derivative_conditioning.py --write",
+            "source": os.path.relpath(path, ROOT),
+            "what": "M⁻¹ of the source's M and −M⁻¹ ∂τ/∂q (Pinocchio's, at a = ddq) in np.longdouble",
+            "samples": extended,
+        }
+        with open(out, "w") as f:
+            json.dump(doc, f)
+        print(f"wrote {out}")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(sys.argv[1], "--write" in sys.argv[2:])

@@ -1,10 +1,15 @@
-// A second UR5 through the `Config` builder, with a statement budget small enough
-// that every generated function is split into parts: the split code is checked
-// against the unsplit `robot_ur5::Ur5` in `tests/split_functions.rs`.
+// Two more UR5s through the `Config` builder, checked against `robot_ur5::Ur5`: one
+// with a statement budget small enough that every generated function is split into
+// parts (`tests/split_functions.rs`), one with every composable function composed of
+// the others, as large trees have them (`tests/composed_functions.rs`).
 fn main() -> Result<(), dyngen_codegen::Error> {
     dyngen_codegen::Config::new()
         .file_name("ur5_split.rs")
         .max_statements(40)
         .compile_urdf("../robots/ur5/ur5.urdf", "Ur5Split")?;
+    dyngen_codegen::Config::new()
+        .file_name("ur5_composed.rs")
+        .compose_above(0)
+        .compile_urdf("../robots/ur5/ur5.urdf", "Ur5Composed")?;
     Ok(())
 }

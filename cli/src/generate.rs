@@ -35,6 +35,12 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "N")]
     pub max_statements: Option<usize>,
 
+    /// Compose functions whose own code would repeat another's (aba_derivatives,
+    /// frame_motion, the base regressors, ...) when the robot has more than N velocity
+    /// coordinates (default 24): faster builds, slower functions.
+    #[arg(long, value_name = "N")]
+    pub compose_above: Option<usize>,
+
     #[command(flatten)]
     pub gravity: ModelArgs,
 }
@@ -50,6 +56,9 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
     }
     if let Some(n) = args.max_statements {
         config.max_statements(n);
+    }
+    if let Some(n) = args.compose_above {
+        config.compose_above(n);
     }
     let source = args
         .urdf

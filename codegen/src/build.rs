@@ -110,6 +110,19 @@ impl Config {
         self
     }
 
+    /// Above this many velocity coordinates (default
+    /// [`DEFAULT_COMPOSE_ABOVE_NV`](crate::DEFAULT_COMPOSE_ABOVE_NV), 24), functions whose
+    /// own graph would repeat another one's code are composed of the others instead:
+    /// `aba`, `nonlinear_effects`, the base regressors, `aba_derivatives`,
+    /// `aba_joints_derivatives`, `frame_placement` and `frame_motion`. Composition
+    /// builds faster and runs slower: on the 31-joint floating humanoid the crate with
+    /// every function rebuilds in 28–30 s instead of about 45 s, and `aba_derivatives`
+    /// takes 24.9 µs instead of 22.2 µs. `usize::MAX` never composes.
+    pub fn compose_above(&mut self, nv: usize) -> &mut Config {
+        self.options.compose_above_nv = nv;
+        self
+    }
+
     /// Generates type `type_name` from the URDF at `urdf` (relative paths are taken
     /// from `CARGO_MANIFEST_DIR` when set) and writes it; returns the file written.
     pub fn compile_urdf(&self, urdf: impl AsRef<Path>, type_name: &str) -> Result<PathBuf, Error> {

@@ -431,7 +431,8 @@ fn arg(id: u8, name: &'static str, len: usize) -> Arg {
 }
 
 /// The frame enum and every frame function of the robot type `ty`.
-pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statements: usize) -> FrameFns {
+pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &crate::Options) -> FrameFns {
+    let (max_statements, above) = (options.max_statements, options.compose_above_nv);
     // Columns, velocities and accelerations go by velocity coordinate.
     let n = sizes.nv;
     let nf = model.frames.len();
@@ -455,7 +456,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let assemble_pose = |outs: &[TokenStream]| Record::Pose.build(outs);
 
     // Per frame: placement, Jacobian, motion; private, dispatched by the enum.
-    let large = n > crate::generate::LARGE_TREE_NV;
+    let large = n > above;
     let mut placement_fns = Vec::new();
     let mut jacobian_fns = Vec::new();
     let mut jacobian_dot_fns = Vec::new();
@@ -674,7 +675,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
     let (placement_body, walks) = if large {
         (
             quote!(Self::frame_placements(q)[frame.index()]),
-            format!("Taken from [`Self::frame_placements`] (a tree of more than\n{} coordinates carries no function per frame for it).", crate::generate::LARGE_TREE_NV),
+            format!("Taken from [`Self::frame_placements`] (a robot of more than\n{above} velocity coordinates carries no function per frame for it)."),
         )
     } else {
         (
@@ -700,8 +701,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, max_statem
                 ::dyngen::__private::frame_motion(&jacobians, v, a)
             },
             format!(
-                " From the frame's\n`LOCAL_WORLD_ALIGNED` `J` and `J̇`: `J v` and `J a + J̇ v` (a tree of more than {}\ncoordinates carries no function per frame for it).",
-                crate::generate::LARGE_TREE_NV
+                " From the frame's\n`LOCAL_WORLD_ALIGNED` `J` and `J̇`: `J v` and `J a + J̇ v` (a robot of more than {above}\nvelocity coordinates carries no function per frame for it)."
             ),
         )
     } else {

@@ -18,12 +18,17 @@ use quote::{format_ident, quote};
 pub struct Options {
     /// Statements per emitted function before it is split into parts.
     pub max_statements: usize,
+    /// A robot with more velocity coordinates than this gets functions composed of
+    /// other generated functions where a graph of their own would repeat another
+    /// one's code ([`DEFAULT_COMPOSE_ABOVE_NV`]).
+    pub compose_above_nv: usize,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Options {
             max_statements: emit::DEFAULT_MAX_STATEMENTS,
+            compose_above_nv: DEFAULT_COMPOSE_ABOVE_NV,
         }
     }
 }
@@ -708,12 +713,12 @@ impl Algorithm {
 }
 
 /// The inherent function of `algorithm` composed of other generated functions, on a
-/// tree above [`LARGE_TREE_NV`] coordinates (`None`: emit its own graph): `aba` is the
+/// robot of more than `above` velocity coordinates (`None`: emit its own graph): `aba` is the
 /// forward dynamics with rotor inertias at zero armature, `nonlinear_effects` is
 /// `rnea` at zero acceleration, and the base regressors are the independent columns
 /// of the full ones (which is what their graphs compute).
-fn composed(algorithm: &Algorithm, sizes: &Sizes) -> Option<TokenStream> {
-    if sizes.nv <= LARGE_TREE_NV {
+fn composed(algorithm: &Algorithm, sizes: &Sizes, above: usize) -> Option<TokenStream> {
+    if sizes.nv <= above {
         return None;
     }
     let [n_l, nq_l, np_l, nj_l] = [sizes.nv, sizes.nq, 10 * sizes.n, 4 * sizes.nv].map(emit::usize_lit);
@@ -755,7 +760,7 @@ fn composed(algorithm: &Algorithm, sizes: &Sizes) -> Option<TokenStream> {
     };
     let fname = format_ident!("{}", algorithm.name);
     let doc = doc_attrs(&format!(
-        "{}\n\nComposed (a tree of more than {LARGE_TREE_NV} coordinates): {how}.",
+        "{}\n\nComposed (a robot of more than {above} velocity coordinates): {how}.",
         (algorithm.doc)(sizes)
     ));
     Some(quote! {
@@ -786,7 +791,7 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     let mut bodies = Vec::new();
     let mut methods = Vec::new();
     for algorithm in ALGORITHMS {
-        if let Some(item) = composed(algorithm, &sizes) {
+        if let Some(item) = composed(algorithm, &sizes, options.compose_above_nv) {
             items.push((algorithm.name.to_string(), item));
             methods.push(algorithm.trait_method(&ty, &sizes));
             continue;
@@ -804,12 +809,12 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     items.extend(joints.items);
     bodies.extend(joints.bodies);
     methods.extend(joints.methods);
-    let derivatives = derivative_items(model, &sizes, options.max_statements, &home);
+    let derivatives = derivative_items(model, &sizes, options, &home);
     functions.extend(derivatives.reports);
     items.extend(derivatives.items);
     bodies.extend(derivatives.bodies);
     methods.push(derivative_methods(sizes.nv));
-    let frames = crate::frames::generate(model, &ty, &sizes, options.max_statements);
+    let frames = crate::frames::generate(model, &ty, &sizes, options);
     functions.extend(frames.reports);
     items.extend(frames.items);
     bodies.extend(frames.bodies);
@@ -841,25 +846,27 @@ struct DerivativeFns {
     reports: Vec<FnReport>,
 }
 
-/// Trees with more velocity coordinates than this get functions composed of other
-/// generated functions wherever a graph of their own would repeat another one's code
-/// (see [`composed`], `aba_derivatives` in [`derivative_items`], and `frame_placement`
-/// and `frame_motion` in [`crate::frames`]): what they save in build time matters more
-/// there than the speed they give up.
+/// By default, robots with more velocity coordinates than this get functions composed
+/// of other generated functions wherever a graph of their own would repeat another
+/// one's code ([`Options::compose_above_nv`], `Config::compose_above`): `aba`,
+/// `nonlinear_effects` and the base regressors (see `composed`), `aba_derivatives`
+/// and `aba_joints_derivatives`, `frame_placement` and `frame_motion`. On large trees
+/// what they save in build time matters more than the speed they give up.
 ///
 /// `aba_derivatives`, measured on the 37-coordinate floating humanoid (release, 2
 /// cores): its own graph adds 37k lines, and the crate with every function rebuilt in
 /// 44.5–45.9 s against 35.7–36.0 s composed (peak 1.43 against 1.25 GB); the
 /// composition ran 24.9 µs against 22.2 µs. On the arms the graph is twice as fast
 /// (Panda 0.82 against 1.59 µs) and small.
-pub(crate) const LARGE_TREE_NV: usize = 24;
+pub const DEFAULT_COMPOSE_ABOVE_NV: usize = 24;
 
 /// The statement budget of a part of the derivative functions (see [`derivative_items`]).
 const DERIVATIVE_MAX_STATEMENTS: usize = 800;
 
 /// The derivatives of the dynamics (`crate::derivatives`) as inherent functions
 /// writing `dyngen::RneaDerivatives` / `dyngen::AbaDerivatives`, and `M⁻¹` alone.
-fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &proc_macro2::Ident) -> DerivativeFns {
+fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc_macro2::Ident) -> DerivativeFns {
+    let (max_statements, above) = (options.max_statements, options.compose_above_nv);
     use crate::derivatives;
     // Parts of at most 800 statements: measured on the Panda (release, 2 cores),
     // aba_derivatives ran 967 ns in parts of 1,200 and 811 ns in parts of 800 (400:
@@ -981,7 +988,7 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
     // Forward dynamics and its derivatives. `driving` is τ (friction taken off, with
     // the joint models); each path leaves `∂τ/∂q`, `∂τ/∂v` at `a = q̈` in `dq`, `dv`,
     // `slope` adds friction's `∂/∂v` to `dv`, then the products by `−M⁻¹` run as loops.
-    let forward = if n > LARGE_TREE_NV {
+    let forward = if n > above {
         // Composed of the functions above, so a large tree carries one copy of each:
         // `M⁻¹` (with the rotor inertias), `q̈ = M⁻¹ (τ − h)`, rnea derivatives at `q̈`.
         let products = times_minus_minv(model, quote!(&d.dtau_dq), quote!(&d.dtau_dv));
@@ -1045,7 +1052,7 @@ fn derivative_items(model: &Model, sizes: &Sizes, max_statements: usize, home: &
     let plain = forward(zeros, TokenStream::new());
     let aba_doc = doc_attrs(&format!(
         "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. {}; the products with `M⁻¹` run as\nloops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
-        if n > LARGE_TREE_NV {
+        if n > above {
             "Composed of [`Self::inverse_inertia`], [`Self::nonlinear_effects`] and\n[`Self::rnea_derivatives`] (a large tree: one copy of their code)"
         } else {
             "`M⁻¹` from the tree's `LᵀDL` factorisation (no fill-in;\none division per velocity coordinate), `∂τ/∂q` and `∂τ/∂v` in closed form"

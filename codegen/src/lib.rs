@@ -25,7 +25,7 @@ pub mod sym;
 
 pub use base::{analyse_model, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
-pub use generate::{generate, is_type_name, GeneratedCode, Options};
+pub use generate::{generate, is_type_name, GeneratedCode, Options, DEFAULT_COMPOSE_ABOVE_NV};
 
 use proc_macro2::TokenStream;
 use quote::quote;

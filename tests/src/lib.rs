@@ -7,6 +7,13 @@ pub mod split {
     include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
 }
 
+/// UR5 generated with every composable function composed of the others, as robots
+/// of more than `Config::compose_above` velocity coordinates have them (see
+/// `build.rs`).
+pub mod composed {
+    include!(concat!(env!("OUT_DIR"), "/ur5_composed.rs"));
+}
+
 /// A 12-DOF branched tree (torso, head, two arms; revolute, continuous and
 /// prismatic joints, unaligned axes, a merged fixed link): the largest tree the
 /// tests generate and compile.

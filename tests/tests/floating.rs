@@ -370,7 +370,7 @@ fn quadruped12_joint_models_invert_and_match_the_regressor() {
     }
 }
 
-/// The humanoid's `aba_joints_derivatives` (a tree above `SHARED_DERIVATIVE_GRAPH_MAX_NV`
+/// The humanoid's `aba_joints_derivatives` (above `Config::compose_above`'s 24
 /// coordinates: composed of `inverse_inertia`, `nonlinear_effects` and
 /// `rnea_derivatives`) with rotor inertias, viscous and smooth Coulomb friction and an
 /// offset, against central differences of the generated `aba_joints`: every column of
@@ -499,7 +499,7 @@ fn base_regressors_reproduce_rnea_on_floating_robots() {
     }
 }
 
-/// The humanoid's `frame_motion` (a tree above `LARGE_TREE_NV` coordinates: `J v` and
+/// The humanoid's `frame_motion` (above `Config::compose_above`'s 24 coordinates: `J v` and
 /// `J a + J̇ v` from the frame's Jacobian and its time variation) against differences
 /// along the path `q(t) = q ⊕ (v t + a t²/2)`, whose velocity is `v` and acceleration
 /// `a` at `t = 0`: the frame origin's velocity and classical acceleration, and the

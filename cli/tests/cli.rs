@@ -97,6 +97,34 @@ fn generate_writes_header_and_refuses_to_overwrite() {
     assert_error(&o, "not a valid Rust type name");
 }
 
+/// `--compose-above N` composes the functions whose graphs repeat others' on a robot
+/// of more than N coordinates: the UR5 (6) with `--compose-above 5` has no graph of
+/// its own for `aba_derivatives` and says so in `aba`'s doc; by default it has.
+#[test]
+fn generate_composes_above_the_given_size() {
+    let dir = temp_dir("dyngen-cli", "compose");
+    let (own, composed) = (dir.join("own.rs"), dir.join("composed.rs"));
+    assert_ok(&run!("generate", ur5(), "--name", "Ur5", "-o", own));
+    assert_ok(&run!(
+        "generate",
+        ur5(),
+        "--name",
+        "Ur5",
+        "-o",
+        composed,
+        "--compose-above",
+        "5"
+    ));
+    let (own, composed) = (
+        std::fs::read_to_string(own).unwrap(),
+        std::fs::read_to_string(composed).unwrap(),
+    );
+    assert!(own.contains("__aba_derivative_parts") && !own.contains("Composed (a robot of more than"));
+    assert!(!composed.contains("__aba_derivative_parts"));
+    assert!(composed.contains("Composed (a robot of more than 5 velocity coordinates)"));
+    assert!(composed.len() < own.len());
+}
+
 #[test]
 fn simulate_then_identify_recovers_the_torques() {
     let dir = temp_dir("dyngen-cli", "identify");

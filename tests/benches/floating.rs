@@ -70,6 +70,14 @@ macro_rules! bench_floating {
                 black_box(&jac);
             })
         });
+        // One frame's placement (on a large tree taken from all of them; Pinocchio's
+        // peer is `fk_q`, forward kinematics of every joint).
+        group.bench_function("frame_placement/generated", |b| {
+            b.iter(|| {
+                let (q, _, _) = next();
+                black_box(<$robot>::frame_placement(black_box(q), $tool));
+            })
+        });
         // The drift `J̇ v` of `ẍ = J q̈ + J̇ q̇` (Pinocchio's `frame_classical_acc`: forward
         // kinematics with `a = 0`, then `getFrameClassicalAcceleration`).
         let zero = [0.0; NV];

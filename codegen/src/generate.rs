@@ -854,8 +854,9 @@ struct DerivativeFns {
 /// what they save in build time matters more than the speed they give up.
 ///
 /// `aba_derivatives`, measured on the 37-coordinate floating humanoid (release, 2
-/// cores): its own graph adds 37k lines, and the crate with every function rebuilt in
-/// 44.5–45.9 s against 35.7–36.0 s composed (peak 1.43 against 1.25 GB); the
+/// cores) before the other functions were composed: its own graph adds 37k lines, and
+/// the crate with every function rebuilt in 44.5–45.9 s against 35.7–36.0 s composed
+/// (peak 1.43 against 1.25 GB); the
 /// composition ran 24.9 µs against 22.2 µs. On the arms the graph is twice as fast
 /// (Panda 0.82 against 1.59 µs) and small.
 pub const DEFAULT_COMPOSE_ABOVE_NV: usize = 24;
@@ -866,8 +867,8 @@ const DERIVATIVE_MAX_STATEMENTS: usize = 800;
 /// The derivatives of the dynamics (`crate::derivatives`) as inherent functions
 /// writing `dyngen::RneaDerivatives` / `dyngen::AbaDerivatives`, and `M⁻¹` alone.
 fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc_macro2::Ident) -> DerivativeFns {
-    let (max_statements, above) = (options.max_statements, options.compose_above_nv);
     use crate::derivatives;
+    let (max_statements, above) = (options.max_statements, options.compose_above_nv);
     // Parts of at most 800 statements: measured on the Panda (release, 2 cores),
     // aba_derivatives ran 967 ns in parts of 1,200 and 811 ns in parts of 800 (400:
     // 772 ns, but the UR5's and rnea_derivatives got slower); rnea_derivatives was

@@ -195,20 +195,25 @@ pub fn __frame_motion<S: Scalar, const N: usize>(
     v: &[S; N],
     a: &[S; N],
 ) -> FrameMotion<S> {
-    let row = |m: &[S; N], x: &[S; N]| m.iter().zip(x).fold(S::ZERO, |s, (&p, &q)| s + p * q);
-    let (mut vel, mut acc) = ([S::ZERO; 6], [S::ZERO; 6]);
-    for r in 0..6 {
-        vel[r] = row(&j.jacobian[r], v);
-        acc[r] = row(&j.jacobian[r], a) + row(&j.jacobian_dot[r], v);
-    }
-    let motion = |x: [S; 6]| Motion {
-        linear: Vector3::new(x[0], x[1], x[2]),
-        angular: Vector3::new(x[3], x[4], x[5]),
-    };
+    let placement = j.placement;
+    let (jac, jac_dot) = (
+        FrameJacobian {
+            placement,
+            jacobian: j.jacobian,
+        },
+        FrameJacobian {
+            placement,
+            jacobian: j.jacobian_dot,
+        },
+    );
+    let (ja, jdv) = (jac.velocity(a), jac_dot.velocity(v));
     FrameMotion {
-        placement: j.placement,
-        velocity: motion(vel),
-        acceleration: motion(acc),
+        placement,
+        velocity: jac.velocity(v),
+        acceleration: Motion {
+            linear: ja.linear + jdv.linear,
+            angular: ja.angular + jdv.angular,
+        },
     }
 }
 

@@ -321,19 +321,7 @@ fn ordered_qr(a: &[Vec<f64>], p: usize) -> (Vec<usize>, Vec<Vec<f64>>, usize) {
             continue;
         }
         kept.push(c);
-        // Householder reflector zeroing column c below row k, applied to this and
-        // later columns.
-        let sign = if cols[c][k] >= 0.0 { 1.0 } else { -1.0 };
-        let mut v: Vec<f64> = cols[c][k..].to_vec();
-        v[0] += sign * residual;
-        let vnorm2: f64 = v.iter().map(|x| x * x).sum();
-        for col in cols[c..].iter_mut() {
-            let dot: f64 = v.iter().zip(&col[k..]).map(|(vi, x)| vi * x).sum();
-            let f = 2.0 * dot / vnorm2;
-            for (vi, x) in v.iter().zip(col[k..].iter_mut()) {
-                *x -= f * vi;
-            }
-        }
+        crate::math::reflect(&mut cols, c, k, residual);
         k += 1;
     }
     let rank = kept.len();

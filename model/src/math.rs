@@ -257,21 +257,28 @@ fn rows_of_pivoted_r(mut cols: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
         if alpha == 0.0 {
             break; // the rest is exactly zero
         }
-        let sign = if cols[k][k] >= 0.0 { 1.0 } else { -1.0 };
-        let mut v: Vec<f64> = cols[k][k..].to_vec();
-        v[0] += sign * alpha;
-        let vnorm2 = norm2(&v);
-        for col in cols[k..].iter_mut() {
-            let dot: f64 = v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum();
-            let f = 2.0 * dot / vnorm2;
-            for (x, vi) in col[k..].iter_mut().zip(&v) {
-                *x -= f * vi;
-            }
-        }
+        reflect(&mut cols, k, k, alpha);
     }
     (0..p)
         .map(|i| (0..p).map(|j| if j >= i { cols[j][i] } else { 0.0 }).collect())
         .collect()
+}
+
+/// Householder QR's step on a matrix held as columns: the reflector that zeroes
+/// column `c` below row `k` (`norm`: that column's norm from row `k` down), applied to
+/// it and to the columns after it.
+pub(crate) fn reflect(cols: &mut [Vec<f64>], c: usize, k: usize, norm: f64) {
+    let sign = if cols[c][k] >= 0.0 { 1.0 } else { -1.0 };
+    let mut v: Vec<f64> = cols[c][k..].to_vec();
+    v[0] += sign * norm;
+    let vnorm2: f64 = v.iter().map(|x| x * x).sum();
+    for col in cols[c..].iter_mut() {
+        let dot: f64 = v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum();
+        let f = 2.0 * dot / vnorm2;
+        for (x, vi) in col[k..].iter_mut().zip(&v) {
+            *x -= f * vi;
+        }
+    }
 }
 
 /// One-sided Jacobi on `vectors` (the columns of a matrix): their norms once they

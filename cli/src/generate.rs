@@ -31,7 +31,8 @@ pub struct GenerateArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// Statements per generated function before it is split into parts.
+    /// Statements per generated function before it is split into parts (default 6000;
+    /// the regressors and derivatives are split at no more than 1200 and 800).
     #[arg(long, value_name = "N")]
     pub max_statements: Option<usize>,
 

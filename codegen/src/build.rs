@@ -104,7 +104,9 @@ impl Config {
         self
     }
 
-    /// Statements per generated function before it is split into parts (default 1200).
+    /// Statements per generated function before it is split into parts (default
+    /// 6,000; the regressors and the derivatives are split at no more than 1,200 and
+    /// 800).
     pub fn max_statements(&mut self, n: usize) -> &mut Config {
         self.options.max_statements = n.max(1);
         self

@@ -498,14 +498,14 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
                 let i = emit::usize_lit(k - 9);
                 quote!(out.placement.translation[#i])
             } else if k < 12 + 6 * n {
-                let (r, c) = (emit::usize_lit((k - 12) / n), emit::usize_lit((k - 12) % n));
-                quote!(out.jacobian[#r][#c])
+                let k = emit::usize_lit(k - 12);
+                quote!(jacobian[#k])
             } else {
-                let k = k - 12 - 6 * n;
-                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
-                quote!(out.jacobian_dot[#r][#c])
+                let k = emit::usize_lit(k - 12 - 6 * n);
+                quote!(jacobian_dot[#k])
             }
         };
+        let jacobian_view = quote!(let jacobian = out.jacobian.as_flattened_mut(););
         let spec = FnSpec {
             name: &jn,
             public: false,
@@ -515,6 +515,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             output: Output::InPlace {
                 place: Box::new(place),
                 clear: quote!(*out = ::core::default::Default::default();),
+                views: jacobian_view.clone(),
             },
             outputs,
         };
@@ -531,6 +532,10 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             output: Output::InPlace {
                 place: Box::new(place),
                 clear: quote!(*out = ::core::default::Default::default();),
+                views: quote! {
+                    #jacobian_view
+                    let jacobian_dot = out.jacobian_dot.as_flattened_mut();
+                },
             },
             outputs,
         };
@@ -627,7 +632,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         ),
         args: vec![q(), params()],
         ret: quote!([[S; #n_l]; 3]),
-        output: emit::matrix_output(n),
+        output: emit::matrix_output(),
         outputs,
     };
     let com_jacobian = emit_one(spec, &g, "com_jacobian".to_string());
@@ -643,7 +648,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         ),
         args: vec![q(), params()],
         ret: quote!([[S; #n_l]; 6]),
-        output: emit::matrix_output(n),
+        output: emit::matrix_output(),
         outputs,
     };
     let centroidal = emit_one(spec, &g, "centroidal_map".to_string());
@@ -661,11 +666,15 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         ret: quote!(([[S; #n_l]; 6], [[S; #n_l]; 6])),
         output: Output::InPlace {
             place: Box::new(move |k: usize| {
-                let (m, k) = (emit::usize_lit(k / (6 * n)), k % (6 * n));
-                let (r, c) = (emit::usize_lit(k / n), emit::usize_lit(k % n));
-                quote!(out.#m[#r][#c])
+                let (m, k) = (k / (6 * n), emit::usize_lit(k % (6 * n)));
+                let view = [format_ident!("map"), format_ident!("map_dot")][m].clone();
+                quote!(#view[#k])
             }),
             clear: quote!(*out = ([[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6], [[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6]);),
+            views: quote! {
+                let map = out.0.as_flattened_mut();
+                let map_dot = out.1.as_flattened_mut();
+            },
         },
         outputs,
     };

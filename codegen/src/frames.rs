@@ -666,9 +666,12 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         ret: quote!(([[S; #n_l]; 6], [[S; #n_l]; 6])),
         output: Output::InPlace {
             place: Box::new(move |k: usize| {
-                let (m, k) = (k / (6 * n), emit::usize_lit(k % (6 * n)));
-                let view = [format_ident!("map"), format_ident!("map_dot")][m].clone();
-                quote!(#view[#k])
+                let i = emit::usize_lit(k % (6 * n));
+                if k < 6 * n {
+                    quote!(map[#i])
+                } else {
+                    quote!(map_dot[#i])
+                }
             }),
             clear: quote!(*out = ([[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6], [[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6]);),
             views: quote! {

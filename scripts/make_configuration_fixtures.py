@@ -8,7 +8,8 @@ the shared oracle's venv has both):
     PY=python3    # or $PIN_HOME/.venv/bin/python
     $PY scripts/make_configuration_fixtures.py
 
-Writes tests/fixtures/configuration/pinocchio.json, read by core/tests/configuration.rs.
+Writes tests/fixtures/configuration/pinocchio.json and planar.json, read by
+core/tests/configuration.rs.
 
 The model is built by hand: a JointModelFreeFlyer on the universe ("root"), a
 JointModelSpherical child ("ball"), a JointModelRevoluteZ child of the ball ("wrist").
@@ -22,9 +23,20 @@ second, independent random configuration) and difference = pin.difference(model,
 q1). The rotation vectors of v have chosen magnitudes (ANGLES below, from 1e-7 rad
 to pi - 0.1, and 4 rad beyond pi) in random directions; the translations are
 uniform in [-1, 1]^3. Numbers are written with repr, so they read back bit for bit.
+
+planar.json: a JointModelPlanar on the universe ("base") and a JointModelRevoluteZ
+child ("arm"), nv = 3 + 1, Pinocchio nq = 4 + 1. dyngen's planar q is [x, y, theta]
+(Pinocchio's [x, y, cos theta, sin theta]), v = [vx, vy, w] in the child frame. The
+samples have |w| from 1e-7 to 3 rad; q1 turns the base by less than pi from q, since
+Pinocchio's difference wraps the angle and dyngen's does not. Written in dyngen's
+coordinates: `integrate` and `q1` with the angle, `integrate_cos_sin` Pinocchio's
+cos, sin of the result's angle. `integrate_exact` is the same step in 50-digit decimal
+arithmetic: Pinocchio's own result is off by 4.7e-10 at |w| = 1e-7 (its (1 - cos w)/w
+cancels), so the test holds dyngen to the exact value and to Pinocchio's loosely.
 """
 import json
 import os
+from decimal import Decimal, getcontext
 
 import numpy as np
 import pinocchio as pin
@@ -70,6 +82,84 @@ def rotation_vector(rng, angle):
 
 def flat(x):
     return [float(y) for y in np.asarray(x, dtype=float).reshape(-1)]
+
+
+PLANAR_OUT = os.path.join(ROOT, "tests", "fixtures", "configuration", "planar.json")
+PLANAR_W = [1.0e-7, 1.0e-3, 0.5, -2.0, 3.0]
+
+
+def dec_sin_cos(x):
+    """sin and cos of a float, by their Taylor series in 50-digit decimals."""
+    getcontext().prec = 50
+    x = Decimal(x)
+    s, c, term, n = Decimal(0), Decimal(0), Decimal(1), 0
+    while n < 200:
+        c += term
+        term *= x / (n + 1)
+        s += term
+        term *= -x / (n + 2)
+        n += 2
+    return s, c
+
+
+def planar_step_exact(q, v):
+    """The base's [x, y] after `integrate`, exactly: p + R(theta) V(w) [vx, vy]."""
+    x, y, t = (Decimal(a) for a in q[:3])
+    vx, vy, w = (Decimal(a) for a in v[:3])
+    sw, cw = dec_sin_cos(v[2])
+    st, ct = dec_sin_cos(q[2])
+    a, b = sw / w, (1 - cw) / w
+    dx, dy = a * vx - b * vy, b * vx + a * vy
+    return [float(x + ct * dx - st * dy), float(y + st * dx + ct * dy)]
+
+
+def planar():
+    model = pin.Model()
+    placement = pin.SE3(pin.rpy.rpyToMatrix(0.1, -0.2, 0.3), np.array([0.0, 0.1, 0.4]))
+    base = model.addJoint(0, pin.JointModelPlanar(), pin.SE3.Identity(), "base")
+    model.addJoint(base, pin.JointModelRZ(), placement, "arm")
+    assert (model.nq, model.nv) == (5, 4)
+    rng = np.random.default_rng(SEED)
+
+    def pin_q(ours):
+        x, y, t, arm = ours
+        return np.array([x, y, np.cos(t), np.sin(t), arm])
+
+    samples = []
+    for w in PLANAR_W:
+        q = np.concatenate([rng.uniform(-1.0, 1.0, 2), [rng.uniform(-np.pi, np.pi), rng.uniform(-2.0, 2.0)]])
+        v = np.array([rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), w, rng.uniform(-2.0, 2.0)])
+        moved = pin.integrate(model, pin_q(q), v)
+        q1 = np.concatenate([rng.uniform(-1.0, 1.0, 2), [q[2] + rng.uniform(-3.0, 3.0), rng.uniform(-2.0, 2.0)]])
+        samples.append({
+            "q": flat(q),
+            "v": flat(v),
+            "integrate": flat([moved[0], moved[1], q[2] + w, moved[4]]),
+            "integrate_cos_sin": flat(moved[2:4]),
+            "integrate_exact": planar_step_exact(q, v) + [float(q[2] + w), float(moved[4])],
+            "q1": flat(q1),
+            "difference": flat(pin.difference(model, pin_q(q), pin_q(q1))),
+        })
+    out = {
+        "name": "configuration_planar",
+        "pinocchio_version": pin.__version__,
+        "generator": "scripts/make_configuration_fixtures.py",
+        "seed": SEED,
+        "joints": ["base: JointModelPlanar", "arm: JointModelRZ"],
+        "conventions": {
+            "q": "[x, y, theta] (base; Pinocchio's x, y, cos theta, sin theta), angle (arm)",
+            "v": "[vx, vy, w] (base, child frame), rate (arm)",
+            "integrate": "pin.integrate(model, q, v), the base angle as q's plus w",
+            "integrate_cos_sin": "cos, sin of the base angle of pin.integrate(model, q, v)",
+            "integrate_exact": "the same step in 50-digit decimals, rounded",
+            "difference": "pin.difference(model, q, q1)",
+        },
+        "samples": samples,
+    }
+    with open(PLANAR_OUT, "w") as f:
+        json.dump(out, f, indent=1)
+        f.write("\n")
+    print(f"wrote {os.path.relpath(PLANAR_OUT, ROOT)}: {len(samples)} samples, pinocchio {pin.__version__}")
 
 
 def main():
@@ -119,6 +209,7 @@ def main():
         json.dump(out, f, indent=1)
         f.write("\n")
     print(f"wrote {os.path.relpath(OUT, ROOT)}: {len(samples)} samples, pinocchio {pin.__version__}")
+    planar()
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Write Pinocchio reference fixtures (JSON) for floating-base robots.
+"""Write Pinocchio reference fixtures (JSON) for floating-base robots and robots with
+planar joints.
 
 Usage (needs a python with `pip install pin==4.1.0 numpy`):
 
@@ -7,9 +8,11 @@ Usage (needs a python with `pip install pin==4.1.0 numpy`):
     $PY scripts/make_floating_fixtures.py            # every robot of ROBOTS
     $PY scripts/make_floating_fixtures.py --name quadruped12
 
-Each URDF of ROBOTS is loaded with its root link on a free flyer, as
-`pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer())` does (joint 1 `root_joint`).
-Per sample, in dyngen's coordinates (`q = [p; x, y, z, w; one number per joint]`: the
+Each URDF of ROBOTS marked "freeflyer" is loaded with its root link on a free flyer, as
+`pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer())` does (joint 1 `root_joint`);
+the others as they are (`mobile_arm`: two URDF `planar` joints, Pinocchio's
+JointModelPlanar). Per sample, in dyngen's coordinates (`q = [p; x, y, z, w]` for a free
+flyer, `[x, y, theta]` for a planar joint instead of Pinocchio's x, y, cos, sin, the
 angle of a continuous joint instead of Pinocchio's cos, sin; `v`, `a` as Pinocchio's):
 `tau = rnea(q, v, a)`, `nle = rnea(q, v, 0)`, `gravity = rnea(q, 0, 0)`, `M` (crba,
 mirrored), `ddq = aba(q, v, tau_rand)` for a random `tau_rand`, the joint torque
@@ -37,9 +40,11 @@ import pinocchio as pin
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT_DIR = os.path.join(ROOT, "tests", "fixtures", "floating")
 GENERATOR = "scripts/make_floating_fixtures.py"
+# name: (URDF, samples, seed, root joint)
 ROBOTS = {
-    "quadruped12": ("robots/quadruped12/quadruped12.urdf", 6, 11),
-    "humanoid31": ("robots/humanoid31/humanoid31.urdf", 4, 12),
+    "quadruped12": ("robots/quadruped12/quadruped12.urdf", 6, 11, "freeflyer"),
+    "humanoid31": ("robots/humanoid31/humanoid31.urdf", 4, 12, "freeflyer"),
+    "mobile_arm": ("tests/fixtures/mobile_arm.urdf", 6, 13, None),
 }
 TOL = 1e-9
 FD_TOL = 1e-6  # central differences (step 1e-6), relative to max(1, |dAg v|)
@@ -70,6 +75,11 @@ def sample(model, rng):
             q[iq:iq + 3] = p
             q[iq + 3:iq + 7] = quat
             ours += list(p) + list(quat)
+        elif name == "JointModelPlanar":
+            p = rng.uniform(-1.0, 1.0, 2)
+            t = rng.uniform(-math.pi, math.pi)
+            q[iq:iq + 4] = [p[0], p[1], math.cos(t), math.sin(t)]
+            ours += list(p) + [t]
         elif j.nq == 2:
             t = rng.uniform(-math.pi, math.pi)
             q[iq:iq + 2] = [math.cos(t), math.sin(t)]
@@ -89,8 +99,9 @@ def sample(model, rng):
     return q, np.array(ours), v, a, tau
 
 
-def make(name, urdf, samples, seed):
-    model = pin.buildModelFromUrdf(os.path.join(ROOT, urdf), pin.JointModelFreeFlyer())
+def make(name, urdf, samples, seed, root_joint):
+    path = os.path.join(ROOT, urdf)
+    model = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer()) if root_joint else pin.buildModelFromUrdf(path)
     data = model.createData()
     rng = np.random.default_rng(seed)
     pi = np.concatenate([model.inertias[i].toDynamicParameters() for i in range(1, model.njoints)])
@@ -151,7 +162,7 @@ def make(name, urdf, samples, seed):
         "generator": GENERATOR,
         "pinocchio": pin.__version__,
         "urdf": urdf,
-        "root_joint": "freeflyer",
+        "root_joint": root_joint or "none",
         "seed": seed,
         "model": {
             "nq_pinocchio": model.nq, "nv": model.nv,
@@ -169,10 +180,10 @@ def main():
     ap.add_argument("--name", choices=sorted(ROBOTS), help="one robot (default: all)")
     args = ap.parse_args()
     os.makedirs(OUT_DIR, exist_ok=True)
-    for name, (urdf, samples, seed) in ROBOTS.items():
+    for name, (urdf, samples, seed, root_joint) in ROBOTS.items():
         if args.name and name != args.name:
             continue
-        fix = make(name, urdf, samples, seed)
+        fix = make(name, urdf, samples, seed, root_joint)
         path = os.path.join(OUT_DIR, f"{name}.json")
         with open(path, "w") as f:
             json.dump(fix, f, separators=(",", ":"))

@@ -68,8 +68,8 @@ pub fn load_model(path: &Path, args: &ModelArgs) -> Result<Model> {
 
 /// Like [`load_model`], for the commands that run the dynamics at run time
 /// (identification, simulation, validation, NIM): refuses a model without moving
-/// joints, and one with a free flyer or a ball joint, which only the generated code
-/// handles so far.
+/// joints, and one with a free flyer, a ball or a planar joint, which only the
+/// generated code handles so far.
 pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
     let model = load_model(path, args)?;
     if model.dof() == 0 {
@@ -80,8 +80,8 @@ pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
             path,
             format!(
                 "joint `{}` is a {} joint ({} positions, {} velocities); this command runs on robots whose joints \
-                 each have one degree of freedom. Floating bases and ball joints are handled by the generated \
-                 code (`dyngen generate`, `build.rs`), including the floating-base regressor for identification",
+                 each have one degree of freedom. Floating bases, ball and planar joints are handled by the \
+                 generated code (`dyngen generate`, `build.rs`), including the floating-base regressor for identification",
                 j.name,
                 j.kind.urdf_name(),
                 j.kind.nq(),

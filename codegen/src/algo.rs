@@ -185,6 +185,11 @@ impl<'g> JointTransform<'g> {
                 motion: quaternion_rotation([q(3), q(4), q(5), q(6)]),
                 translation: t0 + origin.mul_vec(V3([q(0), q(1), q(2)])),
             },
+            JointKind::Planar => JointTransform {
+                origin,
+                motion: rotation_about(g, axis, q(2)),
+                translation: t0 + origin.mul_vec(in_plane(g, axis, q(0), q(1))),
+            },
         }
     }
 
@@ -201,6 +206,14 @@ impl<'g> JointTransform<'g> {
     pub fn rotation(&self) -> M3<'g> {
         self.origin.mul(&self.motion)
     }
+}
+
+/// `x e₁ + y e₂` on the plane axes ([`dyngen_model::math::plane_basis`]) of the normal
+/// `axis`: a planar joint's in-plane coordinates (positions, velocities or
+/// accelerations) as a vector of its frame.
+pub fn in_plane<'g>(g: &'g Graph, axis: [f64; 3], x: Expr<'g>, y: Expr<'g>) -> V3<'g> {
+    let (e1, e2) = dyngen_model::math::plane_basis(&axis);
+    V3::constant(g, e1).scale(x) + V3::constant(g, e2).scale(y)
 }
 
 /// The rotation of a unit quaternion stored `[x, y, z, w]` (Pinocchio's order), by
@@ -223,7 +236,7 @@ pub fn quaternion_rotation<'g>([x, y, z, w]: [Expr<'g>; 4]) -> M3<'g> {
 /// The time derivative of position coordinate `index` of `model` at velocity `v`
 /// (inputs [`ARG_Q`] and [`ARG_V`]): `v` itself for a joint with an axis; for a
 /// quaternion `q̇ = ½ q ⊗ (ω, 0)` with `ω` in the child frame; for a free flyer's
-/// position `ṗ = R(q) v`. `None` if `index` is out of range. What forward-mode
+/// position `ṗ = R(q) v`; for a planar joint's `[ẋ, ẏ] = R(θ) [vx, vy]`, `θ̇ = ω`. `None` if `index` is out of range. What forward-mode
 /// tangents along the motion ([`Graph::tangents`]) seed each `q` with.
 pub fn q_dot<'g>(g: &'g Graph, model: &Model, index: usize) -> Option<Expr<'g>> {
     let j = model.joint_of_q(index)?;
@@ -253,6 +266,15 @@ pub fn q_dot<'g>(g: &'g Graph, model: &Model, index: usize) -> Option<Expr<'g>> 
             r.mul_vec(V3([v(0), v(1), v(2)])).0[k]
         }
         JointKind::FreeFlyer => quaternion_rate(3, 3, k - 3),
+        JointKind::Planar if k < 2 => {
+            let (s, c) = (q(2).sin(), q(2).cos());
+            if k == 0 {
+                c * v(0) - s * v(1)
+            } else {
+                s * v(0) + c * v(1)
+            }
+        }
+        JointKind::Planar => v(2),
     })
 }
 
@@ -446,7 +468,8 @@ impl<'g> JointTransform<'g> {
 
 /// Joint `j`'s motion subspace in its own frame, one motion per degree of freedom:
 /// `(0, axis)` for rotation, `(axis, 0)` for translation, the three unit angular
-/// motions for a ball joint, the six unit motions (linear first) for a free flyer.
+/// motions for a ball joint, the six unit motions (linear first) for a free flyer,
+/// `(e₁, 0)`, `(e₂, 0)`, `(0, axis)` for a planar joint.
 pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Vec<Motion<'g>> {
     let joint = &model.joints[j - 1];
     let unit = |k: usize| {
@@ -475,6 +498,23 @@ pub fn subspace<'g>(g: &'g Graph, model: &Model, j: usize) -> Vec<Motion<'g>> {
                 w: if k < 3 { V3::zero(g) } else { unit(k - 3) },
             })
             .collect(),
+        JointKind::Planar => {
+            let (e1, e2) = dyngen_model::math::plane_basis(&joint.axis);
+            vec![
+                Motion {
+                    v: V3::constant(g, e1),
+                    w: V3::zero(g),
+                },
+                Motion {
+                    v: V3::constant(g, e2),
+                    w: V3::zero(g),
+                },
+                Motion {
+                    v: V3::zero(g),
+                    w: V3::constant(g, joint.axis),
+                },
+            ]
+        }
     }
 }
 
@@ -498,6 +538,10 @@ pub fn subspace_times<'g>(g: &'g Graph, model: &Model, j: usize, x: &[Expr<'g>])
         JointKind::FreeFlyer => Motion {
             v: V3([x[0], x[1], x[2]]),
             w: V3([x[3], x[4], x[5]]),
+        },
+        JointKind::Planar => Motion {
+            v: in_plane(g, joint.axis, x[0], x[1]),
+            w: axis.scale(x[2]),
         },
     }
 }

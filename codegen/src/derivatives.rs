@@ -398,10 +398,10 @@ fn partials<'g>(
     // Changing a coordinate of joint k turns what comes in from the parent: β and α
     // are taken at the motion coming in to body k. For a joint with one degree of
     // freedom that is the body's own motion (S × S = 0 makes the two equal); a ball
-    // joint or a free flyer takes the parent's motion seen in frame k.
+    // joint, a free flyer or a planar joint takes the parent's motion seen in frame k.
     let incoming: Vec<(Motion<'g>, Motion<'g>)> = (1..=n)
         .map(|j| {
-            if model.joints[j - 1].kind.has_axis() {
+            if model.joints[j - 1].kind.nv() == 1 {
                 (v[j], a[j])
             } else {
                 let p = model.parent(j);
@@ -423,7 +423,7 @@ fn partials<'g>(
     let beta_v: Vec<Option<Motion<'g>>> = (0..nv)
         .map(|d| {
             let b = body[d];
-            (!model.joints[b - 1].kind.has_axis()).then(|| beta[d] + v[b].cross_motion(s[d]))
+            (model.joints[b - 1].kind.nv() > 1).then(|| beta[d] + v[b].cross_motion(s[d]))
         })
         .collect();
     let ccs: Vec<Force<'g>> = (0..nv).map(|d| inertia_times(&cc[body[d] - 1], s[d])).collect();
@@ -491,8 +491,8 @@ fn partials<'g>(
 /// velocity coordinate. Symmetric: the upper triangle is built and mirrored.
 pub fn inverse_inertia<'g>(g: &'g Graph, model: &Model, m: &[Vec<Expr<'g>>]) -> Vec<Vec<Expr<'g>>> {
     let n = model.nv();
-    // The tree of velocity coordinates (1-based, 0 the base): a ball joint's or a free
-    // flyer's coordinates form a chain, the first one hanging from the last
+    // The tree of velocity coordinates (1-based, 0 the base): the coordinates of a ball
+    // joint, a free flyer or a planar joint form a chain, the first one hanging from the last
     // coordinate of the parent joint (Featherstone's expanded tree), so `M` still
     // factors without fill-in.
     let parents: Vec<usize> = (0..n)

@@ -129,6 +129,13 @@ fn walk<'g>(
                     dofs[3 + c] = WorldDof::Rotation(column(c));
                 }
             }
+            JointKind::Planar => {
+                // The child frame's plane axes and the normal (which the turn keeps).
+                let (e1, e2) = dyngen_model::math::plane_basis(&joint.axis);
+                dofs[0] = WorldDof::Translation(r.mul_vec(V3::constant(g, e1)));
+                dofs[1] = WorldDof::Translation(r.mul_vec(V3::constant(g, e2)));
+                dofs[2] = WorldDof::Rotation(r0.mul_vec(V3::constant(g, joint.axis)));
+            }
         }
         let wj = WorldJoint {
             dofs,

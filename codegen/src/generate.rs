@@ -1216,6 +1216,7 @@ fn model_expr(model: &Model) -> TokenStream {
             dyngen_model::JointKind::Prismatic => quote!(Prismatic),
             dyngen_model::JointKind::Spherical => quote!(Spherical),
             dyngen_model::JointKind::FreeFlyer => quote!(FreeFlyer),
+            dyngen_model::JointKind::Planar => quote!(Planar),
         };
         let parent = emit::usize_lit(j.parent);
         let rotation = mat3(&j.origin.rotation);

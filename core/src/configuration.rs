@@ -14,6 +14,7 @@
 //! | revolute, continuous, prismatic | the angle or displacement | its rate |
 //! | ball ([`JointType::Spherical`]) | unit quaternion `[x, y, z, w]` of the child in the joint frame | angular velocity `ω` in the child frame |
 //! | free flyer ([`JointType::FreeFlyer`]) | `[p; x, y, z, w]`: position of the body in the parent frame, unit quaternion of its orientation | `[v; ω]`, linear velocity of the body origin and angular velocity, both in the body frame |
+//! | planar ([`JointType::Planar`]) | `[x, y, θ]`: the body origin along the plane's axes, its turn about the normal | `[vx, vy, ω]`, linear velocity of the body origin along the body's plane axes and angular velocity about the normal |
 //!
 //! A quaternion `[x, y, z, w]` stands for the rotation `R(q)` of
 //! [`quaternion_to_matrix`]; `q` and `−q` are the same rotation.
@@ -165,7 +166,11 @@ impl std::error::Error for ConfigurationError {}
 ///   `V(ω) = E + (1 − cos θ)/θ² [ω]× + (θ − sin θ)/θ³ [ω]×²` (Taylor series below
 ///   `θ = 10⁻²`); the quaternion's sign is then chosen on `q₀`'s side (`q₀ · q₁ ≥ 0`),
 ///   as Pinocchio's free flyer does (the ball joint keeps `q₀ ⊗ exp(ω)`, which is the
-///   same for `|ω| ≤ π`).
+///   same for `|ω| ≤ π`);
+/// * planar: `M₁ = M₀ exp(v)` on SE(2) (Pinocchio's planar joint): `θ₁ = θ₀ + ω`,
+///   `[x₁, y₁] = [x₀, y₀] + R(θ₀) V(ω) [vx, vy]` with `V(ω) = [[a, −b], [b, a]]`,
+///   `a = sin ω / ω`, `b = (1 − cos ω)/ω`, from the half angle (`a = 2 sin(ω/2) cos(ω/2)/ω`,
+///   `b = 2 sin²(ω/2)/ω`, no cancellation) and by Taylor series below `|ω| = 10⁻²`.
 ///
 /// The input quaternions need not be exactly unit: the result is that of the
 /// normalised input.
@@ -206,6 +211,12 @@ pub fn integrate<S: Scalar>(model: &RobotModel, q: &[S], v: &[S], out: &mut [S])
                 out[..3].copy_from_slice(&[q[0] + t[0], q[1] + t[1], q[2] + t[2]]);
                 out[3..].copy_from_slice(&q1);
             }
+            JointType::Planar => {
+                let (a, b) = planar_v(v[2]);
+                let (dx, dy) = (a * v[0] - b * v[1], b * v[0] + a * v[1]);
+                let (s0, c0) = q[2].sin_cos();
+                out.copy_from_slice(&[q[0] + (c0 * dx - s0 * dy), q[1] + (s0 * dx + c0 * dy), q[2] + v[2]]);
+            }
         }
         check_finite(out, j, model)?;
         iq += kq;
@@ -229,7 +240,13 @@ pub fn integrate<S: Scalar>(model: &RobotModel, q: &[S], v: &[S], out: &mut [S])
 ///   `V(ω)⁻¹ = E − ½[ω]× + (1/θ²)(1 − θ sin θ / (2(1 − cos θ)))[ω]×²`, whose last
 ///   coefficient is evaluated as `(1 − (θ/2) cot(θ/2))/θ²` from the half angle of `r`
 ///   (no cancellation in `1 − cos θ`, finite up to `θ = π`), and by its Taylor series
-///   `1/12 + θ²/720 + θ⁴/30240` below `θ = 10⁻²`.
+///   `1/12 + θ²/720 + θ⁴/30240` below `θ = 10⁻²`;
+/// * planar: `log(M₀⁻¹ M₁)` on SE(2): `ω = θ₁ − θ₀` (no wrapping, as for the other
+///   angles), `[vx, vy] = V(ω)⁻¹ R(θ₀)ᵀ [x₁ − x₀, y₁ − y₀]` with
+///   `V(ω)⁻¹ = [[α, ω/2], [−ω/2, α]]`, `α = (ω/2) cot(ω/2)` (Taylor series
+///   `1 − ω²/12 − ω⁴/720 − ω⁶/30240` below `|ω| = 10⁻²`). `V(ω)` is singular at
+///   `ω = ±2π, ±4π, …`: angles that far apart have no such velocity unless the
+///   positions agree, and the result there is meaningless.
 ///
 /// The input quaternions need not be exactly unit: they are normalised first.
 ///
@@ -269,6 +286,14 @@ pub fn difference<S: Scalar>(model: &RobotModel, q0: &[S], q1: &[S], out: &mut [
                 out[..3].copy_from_slice(&[0, 1, 2].map(|i| d[i] - half * wxd[i] + beta * wwxd[i]));
                 out[3..].copy_from_slice(&w);
             }
+            JointType::Planar => {
+                let w = b[2] - a[2];
+                let (s0, c0) = a[2].sin_cos();
+                let (px, py) = (b[0] - a[0], b[1] - a[1]);
+                let (dx, dy) = (c0 * px + s0 * py, c0 * py - s0 * px);
+                let (alpha, half) = (planar_v_inverse(w), S::from_f64(0.5) * w);
+                out.copy_from_slice(&[alpha * dx + half * dy, alpha * dy - half * dx, w]);
+            }
         }
         check_finite(out, j, model)?;
         iq += kq;
@@ -278,8 +303,8 @@ pub fn difference<S: Scalar>(model: &RobotModel, q0: &[S], q1: &[S], out: &mut [
 }
 
 /// The neutral configuration into `out` (`nq` entries), Pinocchio's `neutral(model)`:
-/// zero for one-coordinate joints and free-flyer positions, the identity quaternion
-/// `[0, 0, 0, 1]` for ball joints and free flyers.
+/// zero for one-coordinate joints, planar joints and free-flyer positions, the identity
+/// quaternion `[0, 0, 0, 1]` for ball joints and free flyers.
 ///
 /// # Errors
 ///
@@ -501,6 +526,37 @@ fn normalized<S: Scalar>(q: [S; 4]) -> [S; 4] {
     let s = q.map(|x| x / m);
     let n = dot4(s, s).sqrt();
     s.map(|x| x / n)
+}
+
+/// The coefficients `(a, b) = (sin ω / ω, (1 − cos ω)/ω)` of the planar joint's
+/// `V(ω) = [[a, −b], [b, a]]`, from the half angle, by Taylor series below
+/// `|ω| = 10⁻²` (exact to rounding there).
+fn planar_v<S: Scalar>(w: S) -> (S, S) {
+    let c = S::from_f64;
+    let w2 = w * w;
+    if w < c(1e-2) && w > c(-1e-2) {
+        (
+            c(1.0) - w2 * (c(1.0 / 6.0) - w2 * (c(1.0 / 120.0) - w2 * c(1.0 / 5040.0))),
+            w * (c(0.5) - w2 * (c(1.0 / 24.0) - w2 * (c(1.0 / 720.0) - w2 * c(1.0 / 40320.0)))),
+        )
+    } else {
+        let (sh, ch) = (c(0.5) * w).sin_cos();
+        let two_sh = c(2.0) * sh;
+        (two_sh * ch / w, two_sh * sh / w)
+    }
+}
+
+/// `α = (ω/2) cot(ω/2)`, the diagonal of the planar joint's `V(ω)⁻¹`, by Taylor series
+/// below `|ω| = 10⁻²`.
+fn planar_v_inverse<S: Scalar>(w: S) -> S {
+    let c = S::from_f64;
+    let w2 = w * w;
+    if w < c(1e-2) && w > c(-1e-2) {
+        c(1.0) - w2 * (c(1.0 / 12.0) + w2 * (c(1.0 / 720.0) + w2 * c(1.0 / 30240.0)))
+    } else {
+        let (sh, ch) = (c(0.5) * w).sin_cos();
+        c(0.5) * w * ch / sh
+    }
 }
 
 /// `exp(ω)` as a unit quaternion `[sin(θ/2) ω/θ, cos(θ/2)]`, and the coefficients

@@ -17,13 +17,19 @@ pub enum JointType {
     /// The free flyer of a floating base (joint 1 only): 7 positions `[p; x, y, z, w]`,
     /// 6 velocities `[v; ω]` in the body frame, as Pinocchio's `JointModelFreeFlyer`.
     FreeFlyer,
+    /// Motion in the plane normal to the axis: 3 positions `[x, y, θ]` (the child's
+    /// origin along the plane's axes, its turn about the normal), 3 velocities
+    /// `[vx, vy, ω]` in the child frame. Pinocchio's `JointModelPlanar` for the normal
+    /// `z`, with the angle in place of its `(cos θ, sin θ)`.
+    Planar,
 }
 
 impl JointType {
-    /// Number of position coordinates: 1, 4 or 7.
+    /// Number of position coordinates: 1, 3, 4 or 7.
     pub const fn nq(self) -> usize {
         match self {
             JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
+            JointType::Planar => 3,
             JointType::Spherical => 4,
             JointType::FreeFlyer => 7,
         }
@@ -33,7 +39,7 @@ impl JointType {
     pub const fn nv(self) -> usize {
         match self {
             JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
-            JointType::Spherical => 3,
+            JointType::Spherical | JointType::Planar => 3,
             JointType::FreeFlyer => 6,
         }
     }
@@ -59,8 +65,8 @@ pub struct JointModel {
     /// `x_parent = rotation · x_joint + translation`.
     pub rotation: [[f64; 3]; 3],
     pub translation: [f64; 3],
-    /// Unit axis in the joint (= child body) frame; zero for a ball joint and a free
-    /// flyer.
+    /// Unit axis in the joint (= child body) frame: the plane normal of a planar joint;
+    /// zero for a ball joint and a free flyer.
     pub axis: [f64; 3],
     pub limits: Option<JointLimits>,
     /// Nominal viscous friction `Fv` (URDF `<dynamics damping>`): `τ += Fv·q̇`.

@@ -560,6 +560,86 @@ fn matches_pinocchio() {
     assert!(worst_difference <= 1e-12, "difference: {worst_difference:e}");
 }
 
+/// A planar base on the ground and an arm turning about z: the model of
+/// `planar.json`, nq = nv = 4.
+const PLANAR: RobotModel = RobotModel {
+    name: "planar_base",
+    gravity: [0.0, 0.0, -9.81],
+    base: "world",
+    joints: &[
+        joint("base", JointType::Planar, 0),
+        joint("arm", JointType::Revolute, 1),
+    ],
+    bodies: &[BODY, BODY],
+    frames: &[],
+};
+
+/// Pinocchio's `JointModelPlanar` (`q = [x, y, cos θ, sin θ]`): `integrate` to the exact
+/// step (50-digit decimals, in the fixture) and to Pinocchio's position and cos, sin of
+/// the angle; `difference` where the angles are less than π apart (Pinocchio wraps the
+/// angle, dyngen does not). Turns from 1e-7 to 3 rad cover the Taylor series and the
+/// closed forms. Pinocchio's own step is 4.7e-10 off the exact one at a turn of 1e-7
+/// rad (its `(1 − cos ω)/ω` cancels), hence the looser bound against it.
+#[test]
+fn planar_matches_pinocchio() {
+    let json = Json::parse(include_str!("../../tests/fixtures/configuration/planar.json"));
+    assert_eq!(json.get("pinocchio_version").as_str(), "4.1.0");
+    let samples = json.get("samples").as_array();
+    assert_eq!(samples.len(), 5);
+    let (mut worst_exact, mut worst_pinocchio, mut worst_difference) = (0.0f64, 0.0f64, 0.0f64);
+    for s in samples {
+        let (q, v, q1) = (s.get("q").as_f64s(), s.get("v").as_f64s(), s.get("q1").as_f64s());
+        let mut out = [0.0; 4];
+        integrate(&PLANAR, &q, &v, &mut out).unwrap();
+        worst_exact = worst_exact.max(max_abs_diff(&out, &s.get("integrate_exact").as_f64s()));
+        let (sin, cos) = out[2].sin_cos();
+        worst_pinocchio = worst_pinocchio
+            .max(max_abs_diff(&out, &s.get("integrate").as_f64s()))
+            .max(max_abs_diff(&[cos, sin], &s.get("integrate_cos_sin").as_f64s()));
+        let mut d = [0.0; 4];
+        difference(&PLANAR, &q, &q1, &mut d).unwrap();
+        worst_difference = worst_difference.max(max_abs_diff(&d, &s.get("difference").as_f64s()));
+        // And back: q ⊕ (q1 ⊖ q) = q1.
+        integrate(&PLANAR, &q, &d, &mut out).unwrap();
+        assert!(max_abs_diff(&out, &q1) < 1e-14, "{out:?} against {q1:?}");
+    }
+    println!(
+        "planar: max |integrate − exact| = {worst_exact:e}, |integrate − pin.integrate| = {worst_pinocchio:e}, \
+         |difference − pin.difference| = {worst_difference:e}"
+    );
+    assert!(
+        worst_exact <= 1e-15,
+        "integrate against the exact step: {worst_exact:e}"
+    );
+    assert!(
+        worst_pinocchio <= 1e-9,
+        "integrate against Pinocchio: {worst_pinocchio:e}"
+    );
+    assert!(worst_difference <= 1e-13, "difference: {worst_difference:e}");
+}
+
+/// A planar joint's neutral configuration is zero, `normalize` leaves it alone, and a
+/// non-finite coordinate is an error naming the joint.
+#[test]
+fn planar_neutral_normalize_and_errors() {
+    let mut q = [1.0; 4];
+    neutral(&PLANAR, &mut q).unwrap();
+    assert_eq!(q, [0.0; 4]);
+    let mut q = [0.3, -0.2, 5.0, 1.0];
+    normalize(&PLANAR, &mut q).unwrap();
+    assert_eq!(q, [0.3, -0.2, 5.0, 1.0]);
+    let mut out = [0.0; 4];
+    assert_eq!(
+        integrate(&PLANAR, &[0.0, f64::NAN, 0.0, 0.0], &[0.0; 4], &mut out),
+        Err(ConfigurationError::NonFinite { joint: 1, name: "base" })
+    );
+    let mut d = [0.0; 4];
+    assert_eq!(
+        difference(&PLANAR, &[0.0; 4], &[0.0, 0.0, f64::INFINITY, 0.0], &mut d),
+        Err(ConfigurationError::NonFinite { joint: 1, name: "base" })
+    );
+}
+
 /// Just enough JSON for the fixture (objects, arrays, numbers, strings without
 /// escapes, literals), so that core needs no JSON dependency.
 #[derive(Debug)]

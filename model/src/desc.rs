@@ -13,8 +13,6 @@ use std::collections::HashMap;
 pub enum DeclaredJointType {
     Moving(JointKind),
     Fixed,
-    /// Anything else (floating, planar, spherical, ...), by its declared name.
-    Unsupported(String),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -297,9 +295,6 @@ impl Description {
                 Some(&c) => parent_joint[c].push(k),
                 None => errors.push(err(el(), j.line, ErrorKind::UnknownChildLink(j.child.clone()))),
             }
-            if let DeclaredJointType::Unsupported(t) = &j.kind {
-                errors.push(err(el(), j.line, ErrorKind::UnsupportedJointType(t.clone())));
-            }
             if !finite_mat(&j.origin.rotation) {
                 errors.push(err(el(), j.line, ErrorKind::NonFiniteValue("origin")));
             } else if let Err(kind) = check_value("origin", &j.origin.translation) {
@@ -308,6 +303,7 @@ impl Description {
             if let DeclaredJointType::Moving(kind) = j.kind {
                 if !kind.has_axis() {
                     // A ball joint or a free flyer has no axis: whatever is given is unused.
+                    // (A planar joint's axis is its plane normal, checked as an axis.)
                 } else if let Err(kind) = check_value("axis", &j.axis) {
                     errors.push(err(el(), j.line, kind));
                 } else if math::norm(&j.axis) < 1e-12 {

@@ -180,7 +180,7 @@ impl fmt::Display for ErrorKind {
             ErrorKind::Cycle => write!(f, "closes a kinematic loop; only trees are supported (every link reachable from the root exactly once)"),
             ErrorKind::UnsupportedJointType(t) => write!(
                 f,
-                "joint type `{t}` is not supported; use revolute, continuous, prismatic, spherical, floating or fixed"
+                "joint type `{t}` is not supported; use revolute, continuous, prismatic, planar, spherical, floating or fixed"
             ),
             ErrorKind::FreeFlyerNotAtRoot => write!(
                 f,

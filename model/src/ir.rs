@@ -23,6 +23,13 @@ pub enum JointKind {
     /// the body-frame origin and the angular velocity, both in the body frame.
     /// Pinocchio's `JointModelFreeFlyer`; its "torques" are the wrench on the base.
     FreeFlyer,
+    /// Motion in the plane normal to `axis` (a URDF `planar` joint): 3 positions
+    /// `[x, y, θ]`, the child's origin in the plane and its turn about the normal; 3
+    /// velocities `[vx, vy, ω]` in the child frame. The plane's axes are
+    /// [`math::plane_basis`] of the normal (`x`, `y` for the normal `z`). With the normal
+    /// `z` this is Pinocchio's `JointModelPlanar` except that, as for a continuous joint,
+    /// the angle replaces Pinocchio's `(cos θ, sin θ)` pair.
+    Planar,
 }
 
 impl JointKind {
@@ -30,10 +37,12 @@ impl JointKind {
         matches!(self, JointKind::Revolute | JointKind::Continuous)
     }
 
-    /// Number of position coordinates: 1, 4 (quaternion) or 7 (position, quaternion).
+    /// Number of position coordinates: 1, 3 (planar), 4 (quaternion) or 7 (position,
+    /// quaternion).
     pub fn nq(self) -> usize {
         match self {
             JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+            JointKind::Planar => 3,
             JointKind::Spherical => 4,
             JointKind::FreeFlyer => 7,
         }
@@ -43,14 +52,15 @@ impl JointKind {
     pub fn nv(self) -> usize {
         match self {
             JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
-            JointKind::Spherical => 3,
+            JointKind::Spherical | JointKind::Planar => 3,
             JointKind::FreeFlyer => 6,
         }
     }
 
-    /// Whether the joint has an axis (one degree of freedom).
+    /// Whether the joint has an axis: the axis of a one-degree-of-freedom joint, or the
+    /// plane normal of a planar joint. A ball joint and a free flyer have none.
     pub fn has_axis(self) -> bool {
-        self.nv() == 1
+        self.nv() == 1 || self == JointKind::Planar
     }
 
     /// The URDF `type` attribute.
@@ -61,6 +71,7 @@ impl JointKind {
             JointKind::Prismatic => "prismatic",
             JointKind::Spherical => "spherical",
             JointKind::FreeFlyer => "floating",
+            JointKind::Planar => "planar",
         }
     }
 }
@@ -373,11 +384,11 @@ impl Model {
         self.joints.first().is_some_and(|j| j.kind == JointKind::FreeFlyer)
     }
 
-    /// The first joint with more than one degree of freedom (a free flyer or a ball
-    /// joint), if any: what the runtime layers that assume one coordinate per joint
-    /// refuse by name.
+    /// The first joint with more than one degree of freedom (a free flyer, a ball or a
+    /// planar joint), if any: what the runtime layers that assume one coordinate per
+    /// joint refuse by name.
     pub fn multi_dof_joint(&self) -> Option<&Joint> {
-        self.joints.iter().find(|j| !j.kind.has_axis())
+        self.joints.iter().find(|j| j.kind.nv() > 1)
     }
 
     /// Parent body of body `i` (1-based), 0 for the base.

@@ -78,6 +78,24 @@ pub fn quaternion_to_matrix([w, x, y, z]: [f64; 4]) -> Mat3 {
     ]
 }
 
+/// The axes `(e₁, e₂)` of the plane normal to the unit vector `n`, with
+/// `e₁ × e₂ = n`: the images of `x` and `y` under the shortest rotation that takes `z`
+/// to `n` (exactly `x`, `y` for `n = z`). For `n_z < −½` that rotation is found for
+/// `−n` and the two axes are swapped, which keeps the division well away from zero
+/// (so `n = −z` gives `(y, x)`). A planar joint's coordinates are along these axes.
+pub fn plane_basis(n: &Vec3) -> (Vec3, Vec3) {
+    let flip = n[2] < -0.5;
+    let m = if flip { scale(-1.0, n) } else { *n };
+    let k = 1.0 / (1.0 + m[2]);
+    let e1 = [1.0 - m[0] * m[0] * k, -m[0] * m[1] * k, -m[0]];
+    let e2 = [-m[0] * m[1] * k, 1.0 - m[1] * m[1] * k, -m[1]];
+    if flip {
+        (e2, e1)
+    } else {
+        (e1, e2)
+    }
+}
+
 pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
     let mut m = [[0.0; 3]; 3];
     for (i, row) in m.iter_mut().enumerate() {
@@ -343,6 +361,37 @@ mod tests {
                     assert!((a[i][j] - b[i][j]).abs() < 1e-14);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn plane_basis_is_orthonormal_and_right_handed() {
+        assert_eq!(plane_basis(&[0.0, 0.0, 1.0]), ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]));
+        assert_eq!(plane_basis(&[0.0, 0.0, -1.0]), ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0]));
+        assert_eq!(plane_basis(&[1.0, 0.0, 0.0]), ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0]));
+        let c = |a: &Vec3, b: &Vec3| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        for n in [
+            [0.3, -0.4, 0.5],
+            [0.1, 0.2, -0.6],
+            [-1.0, 0.0, -1.0],
+            [0.0, 1.0, -0.5001],
+            [0.0, 1.0, -0.4999],
+        ] {
+            let n = scale(1.0 / norm(&n), &n);
+            let (e1, e2) = plane_basis(&n);
+            assert!(
+                (norm(&e1) - 1.0).abs() < 1e-15 && (norm(&e2) - 1.0).abs() < 1e-15,
+                "{n:?}"
+            );
+            assert!(dot(&e1, &e2).abs() < 1e-15 && dot(&e1, &n).abs() < 1e-15 && dot(&e2, &n).abs() < 1e-15);
+            let m = c(&e1, &e2);
+            assert!((0..3).all(|i| (m[i] - n[i]).abs() < 1e-15), "{n:?}: e1 × e2 = {m:?}");
         }
     }
 

@@ -175,6 +175,21 @@ pub(crate) fn joint_state(model: &Model, j: usize, q: &[f64], v: &[f64], a: &[f6
                 [v3(v, vo + 3), v3(v, vo), v3(a, vo + 3), v3(a, vo)],
             )
         }
+        JointKind::Planar => {
+            let (e1, e2) = math::plane_basis(&z);
+            let in_plane = |x: &[f64], o: usize| math::add(&math::scale(x[o], &e1), &math::scale(x[o + 1], &e2));
+            let slide = math::mat_vec(&origin.rotation, &in_plane(q, qo));
+            (
+                math::mat_mul(&origin.rotation, &axis_rotation(&z, q[qo + 2])),
+                math::add(&origin.translation, &slide),
+                [
+                    math::scale(v[vo + 2], &z),
+                    in_plane(v, vo),
+                    math::scale(a[vo + 2], &z),
+                    in_plane(a, vo),
+                ],
+            )
+        }
     }
 }
 
@@ -215,7 +230,8 @@ pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Bod
 }
 
 /// Joint `j`'s rows of `τ = Sᵀ [f; n]` for the wrench `(f, n)` in its body frame:
-/// one for a joint with an axis, `n` for a ball joint, `[f; n]` for a free flyer.
+/// one for a joint with an axis, `n` for a ball joint, `[f; n]` for a free flyer, the
+/// two in-plane forces and the torque about the normal for a planar joint.
 pub(crate) fn joint_rows(model: &Model, j: usize, f: &Vec3, n: &Vec3) -> Vec<f64> {
     let joint = &model.joints[j - 1];
     match joint.kind {
@@ -223,6 +239,10 @@ pub(crate) fn joint_rows(model: &Model, j: usize, f: &Vec3, n: &Vec3) -> Vec<f64
         JointKind::Prismatic => vec![math::dot(&joint.axis, f)],
         JointKind::Spherical => n.to_vec(),
         JointKind::FreeFlyer => f.iter().chain(n).copied().collect(),
+        JointKind::Planar => {
+            let (e1, e2) = math::plane_basis(&joint.axis);
+            vec![math::dot(&e1, f), math::dot(&e2, f), math::dot(&joint.axis, n)]
+        }
     }
 }
 

@@ -52,7 +52,9 @@ pub struct State {
 
 /// `count` states drawn from [`SplitMix64`] seeded with `seed`: `q_i` uniform in
 /// `[−π, π]` (rotation) or `[−0.5, 0.5]` m (translation), narrowed to joint `i`'s
-/// limits when it has them; `v_i` and `a_i` uniform in `[−2, 2]`.
+/// limits when it has them; ball joints and free flyers a uniform rotation (free-flyer
+/// positions in `[−1, 1]` m), planar joints `[x, y]` in `[−1, 1]` m and the angle in
+/// `[−π, π]`; `v_i` and `a_i` uniform in `[−2, 2]`.
 ///
 /// The draw order is fixed (per state: all `q`, then all `v`, then all `a`), so
 /// the same model, count and seed give the same states in every version.
@@ -97,6 +99,10 @@ fn draw(model: &Model, count: usize, seed: u64, within_limits: bool) -> Vec<Stat
                     JointKind::FreeFlyer => {
                         q.extend((0..3).map(|_| rng.uniform(-1.0, 1.0)));
                         q.extend(unit_quaternion(&mut rng));
+                    }
+                    JointKind::Planar => {
+                        q.extend((0..2).map(|_| rng.uniform(-1.0, 1.0)));
+                        q.push(rng.uniform(-PI, PI));
                     }
                 }
             }

@@ -367,7 +367,7 @@ fn convert_type(t: &urdf_rs::JointType) -> DeclaredJointType {
         T::Prismatic => DeclaredJointType::Moving(JointKind::Prismatic),
         T::Fixed => DeclaredJointType::Fixed,
         T::Floating => DeclaredJointType::Moving(JointKind::FreeFlyer),
-        T::Planar => DeclaredJointType::Unsupported("planar".into()),
+        T::Planar => DeclaredJointType::Moving(JointKind::Planar),
         T::Spherical => DeclaredJointType::Moving(JointKind::Spherical),
     }
 }

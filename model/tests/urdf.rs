@@ -245,11 +245,42 @@ fn unsupported_joint_types() {
     let text = robot(&[
         r#"<link name="base"/>"#,
         &link("a"),
-        &joint("j", "planar", "base", "a", ""),
+        &joint("j", "screw", "base", "a", ""),
     ]);
     let e = single(&text, Element::Joint("j".into()), 4);
-    assert_eq!(e.kind, ErrorKind::UnsupportedJointType("planar".into()));
-    assert!(e.to_string().contains("joint type `planar` is not supported"), "{e}");
+    assert_eq!(e.kind, ErrorKind::UnsupportedJointType("screw".into()));
+    assert!(
+        e.to_string()
+            .contains("joint type `screw` is not supported; use revolute, continuous, prismatic, planar"),
+        "{e}"
+    );
+}
+
+/// A planar joint moves in the plane normal to its axis (normalised, as any axis):
+/// three coordinates, no limits (a `<limit>` is for one-coordinate joints).
+#[test]
+fn planar_joints_have_three_coordinates() {
+    let text = robot(&[
+        r#"<link name="ground"/>"#,
+        &link("base"),
+        &link("arm"),
+        &joint(
+            "drive",
+            "planar",
+            "ground",
+            "base",
+            r#"<axis xyz="0 0 2"/><limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        ),
+        &joint("shoulder", "continuous", "base", "arm", r#"<axis xyz="0 1 0"/>"#),
+    ]);
+    let model = parse_urdf(&text).unwrap();
+    let kinds: Vec<JointKind> = model.joints.iter().map(|j| j.kind).collect();
+    assert_eq!(kinds, [JointKind::Planar, JointKind::Continuous]);
+    assert!(!model.is_floating());
+    assert_eq!((model.nq(), model.nv(), model.v_offset(2)), (4, 4, 3));
+    assert_eq!(model.joints[0].axis, [0.0, 0.0, 1.0]);
+    assert_eq!(model.joints[0].limits, None);
+    assert_eq!(model.multi_dof_joint().map(|j| j.name.as_str()), Some("drive"));
 }
 
 #[test]
@@ -789,7 +820,7 @@ fn all_errors_of_a_file_are_reported_together() {
         &link("c"),
         &joint("ja", "continuous", "bsae", "a", ""),
         &joint("jb", "continuous", "base", "b", r#"<axis xyz="0 0 0"/>"#),
-        &joint("jc", "planar", "base", "c", ""),
+        &joint("jc", "planar", "base", "c", r#"<axis xyz="0 0 0"/>"#),
     ]);
     let e = parse_urdf(&text).unwrap_err();
     let kinds: Vec<(&Element, Option<usize>, &ErrorKind)> =
@@ -803,11 +834,7 @@ fn all_errors_of_a_file_are_reported_together() {
                 &ErrorKind::UnknownParentLink("bsae".into())
             ),
             (&Element::Joint("jb".into()), Some(7), &ErrorKind::ZeroAxis),
-            (
-                &Element::Joint("jc".into()),
-                Some(8),
-                &ErrorKind::UnsupportedJointType("planar".into())
-            ),
+            (&Element::Joint("jc".into()), Some(8), &ErrorKind::ZeroAxis),
         ]
     );
     assert_eq!(e.to_string().lines().count(), 3);

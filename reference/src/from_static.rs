@@ -23,6 +23,7 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     JointType::Prismatic => JointKind::Prismatic,
                     JointType::Spherical => JointKind::Spherical,
                     JointType::FreeFlyer => JointKind::FreeFlyer,
+                    JointType::Planar => JointKind::Planar,
                 },
                 parent: j.parent,
                 origin: Placement {

@@ -128,7 +128,7 @@ impl Reference {
                 let subspace = match j.kind {
                     JointKind::Revolute | JointKind::Continuous => stack(&Vector3::zeros(), &axis),
                     JointKind::Prismatic => stack(&axis, &Vector3::zeros()),
-                    JointKind::Spherical | JointKind::FreeFlyer => panic!(
+                    JointKind::Spherical | JointKind::FreeFlyer | JointKind::Planar => panic!(
                         "joint `{}` is a {} joint: the reference implementation takes joints with one degree \
                          of freedom (check `Model::multi_dof_joint` first)",
                         j.name,
@@ -180,7 +180,9 @@ impl Reference {
                 rotation: nalgebra::Matrix3::identity(),
                 translation: j.axis * q,
             },
-            JointKind::Spherical | JointKind::FreeFlyer => unreachable!("refused by `Reference::new`"),
+            JointKind::Spherical | JointKind::FreeFlyer | JointKind::Planar => {
+                unreachable!("refused by `Reference::new`")
+            }
         };
         j.origin.compose(&motion)
     }

@@ -43,7 +43,7 @@ fn joint(name: &str, kind: JointKind, parent: &str, child: &str, origin: Placeme
             velocity: 1.0,
             effort: 100.0,
         }),
-        JointKind::Continuous | JointKind::Spherical | JointKind::FreeFlyer => None,
+        JointKind::Continuous | JointKind::Spherical | JointKind::FreeFlyer | JointKind::Planar => None,
     };
     JointDesc {
         name: name.into(),

@@ -21,6 +21,12 @@ pub mod tree12 {
     dyngen::robot!(name: Tree12, urdf: "fixtures/tree12.urdf");
 }
 
+/// A mobile manipulator on two URDF `planar` joints (the base on the ground, a stage
+/// at the wrist with a tilted plane) and five one-coordinate joints: `nq = nv = 11`.
+pub mod mobile_arm {
+    dyngen::robot!(name: MobileArm, urdf: "fixtures/mobile_arm.urdf");
+}
+
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 

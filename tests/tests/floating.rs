@@ -1,10 +1,12 @@
 //! The floating-base robots (`robot-quadruped12`, `robot-humanoid31`: the root link on
-//! a free flyer) against Pinocchio 4.1 with `JointModelFreeFlyer` (fixtures in
+//! a free flyer) against Pinocchio 4.1 with `JointModelFreeFlyer`, and the mobile arm on
+//! two planar joints against its `JointModelPlanar` (fixtures in
 //! `tests/fixtures/floating/`, made by `scripts/make_floating_fixtures.py`): every
 //! generated algorithm, the base rows included, frames and Jacobians, the centre of
 //! mass and the centroidal map. Then identities of the generated code itself.
 
 use dyngen::{ReferenceFrame, Robot};
+use dyngen_tests::mobile_arm::MobileArm;
 use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err, Worst};
 use robot_humanoid31::Humanoid31;
 use robot_quadruped12::Quadruped12;
@@ -37,7 +39,8 @@ fn check<R: Robot>(fixture: &str) -> Worst {
     let (nq, nv, nb) = (R::NQ, R::NV, R::NBODIES);
     let model = &fx["model"];
     assert_eq!(nv, model["nv"].as_u64().unwrap() as usize, "{who}: nv");
-    assert_eq!(nq, nv + 1, "{who}: a free flyer and one coordinate per joint");
+    let samples = fx["samples"].as_array().unwrap();
+    assert_eq!(nq, samples[0]["q"].as_array().unwrap().len(), "{who}: nq");
     let names: Vec<&str> = model["joints"]
         .as_array()
         .unwrap()
@@ -51,7 +54,7 @@ fn check<R: Robot>(fixture: &str) -> Worst {
     worst.add("params", who, 0, R::nominal_params(), &nums(&model["params"]), 1.0);
 
     let params = R::nominal_params();
-    for (s, x) in fx["samples"].as_array().unwrap().iter().enumerate() {
+    for (s, x) in samples.iter().enumerate() {
         let (q, v, a) = (nums(&x["q"]), nums(&x["v"]), nums(&x["a"]));
         let mut out = vec![0.0; nv];
         R::rnea(&q, &v, &a, params, &mut out);
@@ -110,12 +113,19 @@ fn check<R: Robot>(fixture: &str) -> Worst {
             &nums(&x["dAg_v"]),
             1.0,
         );
-        // The base rows of rnea are the wrench on the base: joint_wrenches' first.
+        // The base rows of rnea are the wrench on the base, joint_wrenches' first: all
+        // of it for a free flyer; for a planar joint (normal z) the forces along x and
+        // y and the torque about z.
         let mut w = vec![dyngen::Wrench::default(); nb];
         R::joint_wrenches(&q, &v, &a, params, &mut w);
         R::rnea(&q, &v, &a, params, &mut out);
         let base = dyngen_tests::wrench_vec(&w[0]);
-        worst.add("base rows of rnea = joint 1's wrench", who, s, &out[..6], &base, 1.0);
+        let (rows, base) = match R::MODEL.joints[0].kind {
+            dyngen::JointType::FreeFlyer => (6, base.to_vec()),
+            dyngen::JointType::Planar => (3, vec![base[0], base[1], base[5]]),
+            k => panic!("{who}: joint 1 is {k:?}"),
+        };
+        worst.add("base rows of rnea = joint 1's wrench", who, s, &out[..rows], &base, 1.0);
         let (mut dq, mut dv, mut mm) = (vec![0.0; nv * nv], vec![0.0; nv * nv], vec![0.0; nv * nv]);
         R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut mm);
         worst.add("rnea_derivatives ∂τ/∂q", who, s, &dq, &nums(&x["dtau_dq"]), 1.0);
@@ -147,6 +157,14 @@ fn check<R: Robot>(fixture: &str) -> Worst {
 fn quadruped12_matches_pinocchio_free_flyer() {
     let w = check::<Quadruped12>("quadruped12");
     eprintln!("quadruped12: {:?}", w.items);
+}
+
+/// Two planar joints (the base on the ground, a tilted stage at the wrist) against
+/// Pinocchio's `JointModelPlanar`, converted from its `(x, y, cos θ, sin θ)`.
+#[test]
+fn mobile_arm_matches_pinocchio_planar() {
+    let w = check::<MobileArm>("mobile_arm");
+    eprintln!("mobile_arm: {:?}", w.items);
 }
 
 #[test]
@@ -599,4 +617,119 @@ fn forward_derivatives_against_extended_precision() {
         );
         assert!(w[0] <= 1e-12 && w[1] <= 1e-12, "{name}: {w:?}");
     }
+}
+
+dyngen::robot! {
+    name: Tilted,
+    incidence: [
+        [-1,  0,  0],
+        [ 1, -1,  0],
+        [ 0,  1, -1],
+        [ 0,  0,  1],
+    ],
+    joints: [planar([0.6, 0.0, 0.8]), revolute(y), planar(-z, rest: [0.2, -0.4, 0.3])],
+    body_joint_vectors: {
+        (0, 1): [0.1, 0.0, 0.2],
+        (1, 1): [0.0, 0.0, 0.0], (1, 2): [0.2, 0.05, 0.0],
+        (2, 2): [-0.1, 0.0, 0.0], (2, 3): [0.15, 0.0, 0.02],
+        (3, 3): [-0.05, 0.01, 0.0],
+    },
+    bodies: {
+        1: principal(mass: 5.0, moments: [0.1, 0.2, 0.25]),
+        2: cylinder(mass: 1.0, radius: 0.03, length: 0.2, axis: x),
+        3: principal(mass: 0.5, moments: [0.01, 0.02, 0.025]),
+    },
+}
+
+/// The generated code's tangent convention on planar joints, against central
+/// differences along `q ⊕ h e_c` (`configuration::integrate`), for every velocity
+/// coordinate `c`: each frame's Jacobian (`LOCAL_WORLD_ALIGNED`: the origin's velocity,
+/// the angular velocity from `R(h) R(−h)ᵀ`) and `∂τ/∂q`, `∂τ/∂v` of `rnea`. Also
+/// `aba` inverts `rnea`. Worst error relative to `1 + |value|`.
+fn tangent_checks<R: Robot>(seed: u64) -> f64 {
+    let (nq, nv) = (R::NQ, R::NV);
+    let model = dyngen_reference::model_from_static(&R::MODEL);
+    let params = R::nominal_params();
+    let frames = R::MODEL.frames.len();
+    assert!(frames > 0, "{}: no frames to check", R::NAME);
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for s in dyngen_model::sample::sample_states(&model, 3, seed) {
+        let (q, v, a) = (&s.q, &s.v, &s.a);
+        let moved = |c: usize, t: f64| {
+            let mut step = vec![0.0; nv];
+            step[c] = t;
+            let mut out = vec![0.0; nq];
+            dyngen::configuration::integrate(&R::MODEL, q, &step, &mut out).unwrap();
+            out
+        };
+        let mut tau = vec![0.0; nv];
+        R::rnea(q, v, a, params, &mut tau);
+        let mut back = vec![0.0; nv];
+        R::aba(q, v, &tau, params, &mut back);
+        worst = worst.max(rel_err(&back, a, 1.0));
+        let (mut dq, mut dv, mut m) = (vec![0.0; nv * nv], vec![0.0; nv * nv], vec![0.0; nv * nv]);
+        R::rnea_derivatives(q, v, a, params, &mut dq, &mut dv, &mut m);
+        let mut jac = vec![0.0; 6 * nv];
+        for c in 0..nv {
+            let (qp, qm) = (moved(c, h), moved(c, -h));
+            let (mut tp, mut tm) = (vec![0.0; nv], vec![0.0; nv]);
+            R::rnea(&qp, v, a, params, &mut tp);
+            R::rnea(&qm, v, a, params, &mut tm);
+            let (mut vp, mut vm) = (v.clone(), v.clone());
+            vp[c] += h;
+            vm[c] -= h;
+            let (mut up, mut um) = (vec![0.0; nv], vec![0.0; nv]);
+            R::rnea(q, &vp, a, params, &mut up);
+            R::rnea(q, &vm, a, params, &mut um);
+            for r in 0..nv {
+                let scale = 1.0 + dq[r * nv + c].abs() + dv[r * nv + c].abs();
+                worst = worst.max(((tp[r] - tm[r]) / (2.0 * h) - dq[r * nv + c]).abs() / scale);
+                worst = worst.max(((up[r] - um[r]) / (2.0 * h) - dv[r * nv + c]).abs() / scale);
+            }
+            for f in 0..frames {
+                R::frame_jacobian(q, f, ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
+                let (pp, pm) = (R::frame_placement(&qp, f).unwrap(), R::frame_placement(&qm, f).unwrap());
+                let turn = pp.rotation * pm.rotation.transpose();
+                let w = [
+                    turn[(2, 1)] - turn[(1, 2)],
+                    turn[(0, 2)] - turn[(2, 0)],
+                    turn[(1, 0)] - turn[(0, 1)],
+                ];
+                for k in 0..3 {
+                    let lin = (pp.translation[k] - pm.translation[k]) / (2.0 * h);
+                    let (jl, ja) = (jac[k * nv + c], jac[(3 + k) * nv + c]);
+                    worst = worst.max((lin - jl).abs() / (1.0 + jl.abs()));
+                    worst = worst.max((w[k] / (4.0 * h) - ja).abs() / (1.0 + ja.abs()));
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// Planar joints with tilted normals (`[0.6, 0, 0.8]` on the ground, `−z` under a
+/// turned origin): the kinematics and the derivatives follow `q ⊕ v`, and every
+/// body of a planar joint moves in its plane: the origin's displacement is normal to
+/// the plane's normal and the turn is about it.
+#[test]
+fn planar_joints_follow_the_configuration_manifold() {
+    let (tilted, mobile) = (tangent_checks::<Tilted>(3), tangent_checks::<MobileArm>(4));
+    eprintln!("planar joints against differences along q ⊕ h e: tilted {tilted:.1e}, mobile_arm {mobile:.1e}");
+    assert!(
+        tilted < 1e-7 && mobile < 1e-7,
+        "tilted {tilted:e}, mobile_arm {mobile:e}"
+    );
+
+    // Joint 1 of `Tilted` moves body 1 in the plane through its origin normal to n.
+    let n = [0.6, 0.0, 0.8];
+    let (q0, q1) = ([0.0; 7], [0.7, -0.4, 1.1, 0.3, 0.0, 0.0, 0.0]);
+    let body1 = Tilted::MODEL.frames.iter().position(|f| f.body == 1).unwrap();
+    let placement = |q: &[f64]| <Tilted as Robot>::frame_placement(q, body1).unwrap();
+    let (p0, p1) = (placement(&q0), placement(&q1));
+    let d = p1.translation - p0.translation;
+    assert!((d[0] * n[0] + d[1] * n[1] + d[2] * n[2]).abs() < 1e-15, "{d:?}");
+    assert!((d.norm() - (0.7f64.hypot(0.4))).abs() < 1e-15, "{d:?}");
+    let turned = p1.rotation * p0.rotation.transpose() * dyngen::nalgebra::Vector3::from(n);
+    assert!((0..3).all(|k| (turned[k] - n[k]).abs() < 1e-15), "{turned:?}");
 }

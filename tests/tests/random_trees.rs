@@ -624,7 +624,9 @@ fn generator_covers_every_kind_of_tree() {
                 JointKind::Revolute => revolute += 1,
                 JointKind::Continuous => continuous += 1,
                 JointKind::Prismatic => prismatic += 1,
-                JointKind::Spherical | JointKind::FreeFlyer => panic!("random trees have one-coordinate joints"),
+                JointKind::Spherical | JointKind::FreeFlyer | JointKind::Planar => {
+                    panic!("random trees have one-coordinate joints")
+                }
             }
             if j.axis.iter().filter(|&&c| c == 0.0).count() == 2 {
                 aligned += 1;

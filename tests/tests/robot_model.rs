@@ -28,6 +28,7 @@ fn check<R: Robot>(want: &Model) {
             JointKind::Prismatic => JointType::Prismatic,
             JointKind::Spherical => JointType::Spherical,
             JointKind::FreeFlyer => JointType::FreeFlyer,
+            JointKind::Planar => JointType::Planar,
         };
         assert_eq!(g.kind, kind, "{who}: {j} kind");
         assert_eq!(g.parent, w.parent, "{who}: {j} parent");
@@ -101,4 +102,6 @@ fn shipped_robots_carry_their_checked_model() {
     check::<Panda>(&crate_model("panda"));
     let tree12 = dyngen_model::load_urdf(&dyngen_tests::workspace_root().join("tests/fixtures/tree12.urdf"));
     check::<Tree12>(&tree12.unwrap_or_else(|e| panic!("{e}")));
+    let mobile = dyngen_model::load_urdf(&dyngen_tests::workspace_root().join("tests/fixtures/mobile_arm.urdf"));
+    check::<dyngen_tests::mobile_arm::MobileArm>(&mobile.unwrap_or_else(|e| panic!("{e}")));
 }

@@ -326,13 +326,19 @@ fn check_limits_ordered(cx: &Ctxt, joint: &Joint) {
 }
 
 /// A continuous joint is by definition a revolute joint without limits, and a ball
-/// joint or a free flyer has no single coordinate to limit; limits on them would be
-/// silently dropped.
+/// joint, a free flyer or a planar joint has no single coordinate to limit; limits on
+/// them would be silently dropped.
 fn check_continuous_has_no_limits(cx: &Ctxt, joint: &Joint) {
     if let (JointKind::Spherical | JointKind::FreeFlyer, Some(l)) = (joint.kind, &joint.limits) {
         cx.error_spanned_by(
             joint.kind_loc.to(l.key_loc),
             "a `spherical` or `free` joint has no position limits (its coordinates are a quaternion); remove `limits`",
+        );
+    }
+    if let (JointKind::Planar, Some(l)) = (joint.kind, &joint.limits) {
+        cx.error_spanned_by(
+            joint.kind_loc.to(l.key_loc),
+            "a `planar` joint has no position limits (it has three coordinates); remove `limits`",
         );
     }
     if let (JointKind::Continuous, Some(l)) = (joint.kind, &joint.limits) {

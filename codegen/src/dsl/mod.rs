@@ -254,6 +254,34 @@ mod tests {
     }
 
     #[test]
+    fn a_planar_joint_takes_its_normal_as_axis_and_no_limits() {
+        let robot = |joints: TokenStream| {
+            quote! {
+                name: Rover,
+                incidence: [[-1], [1]],
+                joints: #joints,
+                body_joint_vectors: { (0, 1): [0.0, 0.0, 0.1], (1, 1): [0.0, 0.0, 0.0] },
+                bodies: { 1: principal(mass: 1.0, moments: [0.1, 0.1, 0.1]) },
+            }
+        };
+        let model = description(robot(quote!([planar(-y)]))).build().unwrap();
+        assert_eq!(model.joints[0].kind, JointKind::Planar);
+        assert_eq!(model.joints[0].axis, [0.0, -1.0, 0.0]);
+        assert_eq!((model.nq(), model.nv()), (3, 3));
+        let m = messages(robot(quote!([planar()])));
+        assert!(
+            m.iter()
+                .any(|e| e.contains("expected the joint axis, as in `planar(z)`")),
+            "{m:?}"
+        );
+        let m = messages(robot(quote!([planar(z, limits: [-1.0, 1.0])])));
+        assert!(
+            m.iter().any(|e| e.contains("a `planar` joint has no position limits")),
+            "{m:?}"
+        );
+    }
+
+    #[test]
     fn planar2_lowers_to_the_expected_description() {
         let d = description(planar2());
         assert_eq!(d.name, "Planar2");

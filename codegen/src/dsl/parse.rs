@@ -367,7 +367,8 @@ fn joints(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<JointList> {
 fn joint(cx: &Ctxt, tokens: TokenStream) -> Option<Joint> {
     let valid = || {
         format!(
-            "valid joint types are {}, each as `type(axis)` (`spherical()` and `free()` take no axis)",
+            "valid joint types are {}, each as `type(axis)` (the axis of `planar` is the plane normal; \
+             `spherical()` and `free()` take no axis)",
             symbol::one_of(symbol::JOINT_TYPES)
         )
     };
@@ -391,6 +392,7 @@ fn joint(cx: &Ctxt, tokens: TokenStream) -> Option<Joint> {
         Some(symbol::PRISMATIC) => JointKind::Prismatic,
         Some(symbol::SPHERICAL) => JointKind::Spherical,
         Some(symbol::FREE) => JointKind::FreeFlyer,
+        Some(symbol::PLANAR) => JointKind::Planar,
         _ if kind_ident == symbol::FIXED => {
             cx.error_spanned_by(
                 &kind_ident,

@@ -42,7 +42,9 @@ pub const SPHERICAL: Symbol = Symbol("spherical");
 /// The free flyer of a floating base, `free()`: no axis; only between the base and
 /// body 1.
 pub const FREE: Symbol = Symbol("free");
-pub const JOINT_TYPES: &[Symbol] = &[REVOLUTE, CONTINUOUS, PRISMATIC, SPHERICAL, FREE];
+/// Motion in the plane normal to the axis, `planar(z)`.
+pub const PLANAR: Symbol = Symbol("planar");
+pub const JOINT_TYPES: &[Symbol] = &[REVOLUTE, CONTINUOUS, PRISMATIC, PLANAR, SPHERICAL, FREE];
 /// Not a joint type of the inline form; named only to explain why.
 pub const FIXED: Symbol = Symbol("fixed");
 

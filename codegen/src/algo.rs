@@ -895,6 +895,26 @@ impl<'g> Inertia6<'g> {
         }
     }
 
+    /// The inertia with row and column `k` of the 6 × 6 matrix `[[m, h], [hᵀ, j]]`
+    /// (acting on `[v; ω]`) set to zero: `k < 3` the linear coordinate `k`, else the
+    /// angular coordinate `k − 3`.
+    fn without(&self, g: &'g Graph, k: usize) -> Inertia6<'g> {
+        let mut out = *self;
+        let z = g.zero();
+        for r in 0..3 {
+            if k < 3 {
+                out.m.0[k][r] = z;
+                out.m.0[r][k] = z;
+                out.h.0[k][r] = z;
+            } else {
+                out.j.0[k - 3][r] = z;
+                out.j.0[r][k - 3] = z;
+                out.h.0[r][k - 3] = z;
+            }
+        }
+        out
+    }
+
     /// The same inertia seen from the parent frame: rotate every block, then shift
     /// the reference point: `H' = H − M S(p)`, `J' = J − Hᵀ S(p) + S(p) H − S(p) M S(p)`.
     fn in_parent(&self, x: &JointTransform<'g>) -> Inertia6<'g> {
@@ -917,6 +937,19 @@ impl<'g> Inertia6<'g> {
             h: h2,
             j: j2.mirror_upper(),
         }
+    }
+}
+
+/// The coordinate `k` (0–2 linear, 3–5 angular) when `m` is the unit motion `±e_k`
+/// of the body frame, with constant entries.
+fn unit_motion(m: Motion<'_>) -> Option<usize> {
+    let entries = [m.v.0, m.w.0].concat();
+    let values: Option<Vec<f64>> = entries.iter().map(|e| e.as_const()).collect();
+    let values = values?;
+    let nonzero: Vec<usize> = (0..6).filter(|&k| values[k] != 0.0).collect();
+    match nonzero[..] {
+        [k] if values[k].abs() == 1.0 => Some(k),
+        _ => None,
     }
 }
 
@@ -1038,7 +1071,16 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
             let gain: Vec<Expr<'g>> = (0..ui.len())
                 .map(|a| (0..ui.len()).fold(g.zero(), |acc, b| acc + id[a][b] * ui_scalar[b]))
                 .collect();
-            let a_ia = ia[i].minus_products(&ui, &w);
+            // Without rotor inertias Iᵃ S = U − U D⁻¹ D = 0 exactly. Where a column of S
+            // is a unit motion of the body frame (an axis along x, y or z), Iᵃ's row
+            // and column there are zero: say so rather than compute them as rounding
+            // noise, which spares their products here and in the transform to the
+            // parent. (With a rotor inertia, D = Sᵀ Iᴬ S + Ia and Iᵃ S = U Ia / D.)
+            let rigid = armature == Armature::None;
+            let a_ia = s[i - 1]
+                .iter()
+                .filter_map(|sk| unit_motion(*sk).filter(|_| rigid))
+                .fold(ia[i].minus_products(&ui, &w), |acc, k| acc.without(g, k));
             let a_pa = ui.iter().zip(&gain).fold(pa[i] + a_ia.apply(c[i]), |acc, (uk, gk)| {
                 acc + Force {
                     f: uk.f.scale(*gk),

@@ -491,22 +491,12 @@ fn partials<'g>(
 /// velocity coordinate. Symmetric: the upper triangle is built and mirrored.
 pub fn inverse_inertia<'g>(g: &'g Graph, model: &Model, m: &[Vec<Expr<'g>>]) -> Vec<Vec<Expr<'g>>> {
     let n = model.nv();
-    // The tree of velocity coordinates (1-based, 0 the base): the coordinates of a ball
-    // joint, a free flyer or a planar joint form a chain, the first one hanging from the last
-    // coordinate of the parent joint (Featherstone's expanded tree), so `M` still
-    // factors without fill-in.
-    let parents: Vec<usize> = (0..n)
-        .map(|d| {
-            let j = model.joint_of_v(d);
-            if d > model.v_offset(j) {
-                d
-            } else {
-                match model.parent(j) {
-                    0 => 0,
-                    p => model.v_offset(p) + model.joints[p - 1].kind.nv(),
-                }
-            }
-        })
+    // The tree of velocity coordinates (`Model::coordinate_parents`), 1-based, 0 the
+    // base: `M` factors on it without fill-in.
+    let parents: Vec<usize> = model
+        .coordinate_parents()
+        .into_iter()
+        .map(|p| p.map_or(0, |p| p + 1))
         .collect();
     let parent = |i: usize| parents[i - 1];
     g.mark("inverse of M: LᵀDL factorisation");

@@ -101,9 +101,11 @@ const MAX_EXPR_CHARS: usize = 64;
 
 /// Which computed nodes are written inside the one expression that uses them rather
 /// than as a `let` of their own. Only single-use nodes are, so nothing is computed
-/// twice and the operations and their order are exactly those of one `let` per node
-/// (Rust does not contract `a * b + c` into a fused multiply-add): the values are
-/// bit-identical, the code is shorter.
+/// twice. A product whose one use is a sum or difference is always written inside it,
+/// as `Scalar::mul_add` (one per sum): where the target fuses multiply and add, that is
+/// one instruction with one rounding, as a C++ compiler contracts `a * b + c`; elsewhere
+/// it is the product and the sum, and the values are bit-identical to one `let` per
+/// node (Rust itself never contracts).
 struct Inlined(HashSet<NodeId>);
 
 impl Inlined {
@@ -129,10 +131,18 @@ impl Inlined {
                 continue;
             }
             let mut len = 3 * operands(&s.node).len();
-            for op in operands(&s.node) {
+            let mut fusable = matches!(s.node, Node::Add(..) | Node::Sub(..));
+            // The right operand first: `fused` prefers it.
+            for op in operands(&s.node).into_iter().rev() {
                 let own = atom(op);
+                let single = uses.get(&op) == Some(&1);
                 match chars.get(&op) {
-                    Some(&inner) if uses.get(&op) == Some(&1) && len + inner + 2 <= MAX_EXPR_CHARS => {
+                    Some(&inner) if single && fusable && matches!(graph.node(op), Node::Mul(..)) => {
+                        fusable = false;
+                        inlined.insert(op);
+                        len += inner + 2;
+                    }
+                    Some(&inner) if single && len + inner + 2 <= MAX_EXPR_CHARS => {
                         inlined.insert(op);
                         len += inner + 2;
                     }
@@ -679,6 +689,9 @@ impl Names<'_> {
                 e
             }
         };
+        if let Some(fused) = self.fused(graph, node) {
+            return (fused, ATOM);
+        }
         match node {
             // The right operand of `-` and `/` (and, to keep the graph's grouping
             // exactly, of `+` and `*`) must bind more strongly than the operator.
@@ -711,6 +724,41 @@ impl Names<'_> {
                 (quote!(::dyngen::Scalar::cos(#a)), ATOM)
             }
             Node::Const(_) | Node::Input { .. } => (TokenStream::new(), ATOM),
+        }
+    }
+
+    /// A sum or difference with a product written inside it ([`Inlined`]) as
+    /// `Scalar::mul_add`, the right operand's product first: `a + x y` and `x y + b`
+    /// are `mul_add(x, y, ·)`, `a − x y` is `mul_add(−x, y, a)`, `x y − b` is
+    /// `mul_add(x, y, −b)`. Negation and the order of a sum's operands are exact, so
+    /// unfused these are the same values as the sum or difference.
+    fn fused(&self, graph: &Graph, node: Node) -> Option<TokenStream> {
+        let product = |id: NodeId| match graph.node(id) {
+            Node::Mul(x, y) if self.inlined.contains(id) => Some((x, y)),
+            _ => None,
+        };
+        let arg = |id: NodeId| self.inner(graph, id).0;
+        let negated = |id: NodeId| {
+            let (e, p) = self.inner(graph, id);
+            if p < ATOM {
+                quote!(-(#e))
+            } else {
+                quote!(-#e)
+            }
+        };
+        let mul_add = |x: TokenStream, y: TokenStream, z: TokenStream| quote!(::dyngen::Scalar::mul_add(#x, #y, #z));
+        match node {
+            Node::Add(a, b) => match (product(a), product(b)) {
+                (_, Some((x, y))) => Some(mul_add(arg(x), arg(y), arg(a))),
+                (Some((x, y)), None) => Some(mul_add(arg(x), arg(y), arg(b))),
+                (None, None) => None,
+            },
+            Node::Sub(a, b) => match (product(a), product(b)) {
+                (_, Some((x, y))) => Some(mul_add(negated(x), arg(y), arg(a))),
+                (Some((x, y)), None) => Some(mul_add(arg(x), arg(y), negated(b))),
+                (None, None) => None,
+            },
+            _ => None,
         }
     }
 

@@ -730,15 +730,16 @@ impl Algorithm {
 }
 
 /// The inherent function of `algorithm` composed of other generated functions, on a
-/// robot of more than `above` velocity coordinates (`None`: emit its own graph): `aba` is the
-/// forward dynamics with rotor inertias at zero armature, `nonlinear_effects` is
-/// `rnea` at zero acceleration, and the base regressors are the independent columns
-/// of the full ones (which is what their graphs compute).
+/// robot of more than `above` velocity coordinates (`None`: emit its own graph):
+/// `nonlinear_effects` is `rnea` at zero acceleration, and the base regressors are the
+/// independent columns of the full ones (which is what their graphs compute). `aba`
+/// always has its own graph: without rotor inertias the articulated inertia passed to
+/// the parent has zero rows along the joint axes, which the one with them lacks.
 fn composed(algorithm: &Algorithm, sizes: &Sizes, above: usize) -> Option<TokenStream> {
     if sizes.nv <= above {
         return None;
     }
-    let [n_l, nq_l, np_l, nj_l] = [sizes.nv, sizes.nq, 10 * sizes.n, 4 * sizes.nv].map(emit::usize_lit);
+    let [n_l, nq_l, np_l] = [sizes.nv, sizes.nq, 10 * sizes.n].map(emit::usize_lit);
     let zero = quote!(<S as ::dyngen::Scalar>::ZERO);
     let columns = |full: &str, cols: usize, index: &str, base: usize| {
         let (full, index) = (format_ident!("{}", full), format_ident!("{}", index));
@@ -759,12 +760,6 @@ fn composed(algorithm: &Algorithm, sizes: &Sizes, above: usize) -> Option<TokenS
         )
     };
     let (params, ret, body, how) = match algorithm.name {
-        "aba" => (
-            quote!(q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l]),
-            quote!(-> [S; #n_l]),
-            quote!(Self::aba_armature(q, v, tau, params, &[#zero; #nj_l])),
-            "[`Self::aba_joints`]' forward dynamics with zero rotor inertias".to_string(),
-        ),
         "nonlinear_effects" => (
             quote!(q: &[S; #nq_l], v: &[S; #n_l], params: &[S; #np_l]),
             quote!(-> [S; #n_l]),
@@ -821,7 +816,14 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
         functions.push(report);
         methods.push(algorithm.trait_method(&ty, &sizes));
     }
-    let joints = crate::joints::generate(model, bases, &sizes, options.max_statements, &home);
+    let joints = crate::joints::generate(
+        model,
+        bases,
+        &sizes,
+        options.max_statements,
+        options.compose_above_nv,
+        &home,
+    );
     functions.extend(joints.reports);
     items.extend(joints.items);
     bodies.extend(joints.bodies);
@@ -865,9 +867,10 @@ struct DerivativeFns {
 
 /// By default, robots with more velocity coordinates than this get functions composed
 /// of other generated functions wherever a graph of their own would repeat another
-/// one's code ([`Options::compose_above_nv`], `Config::compose_above`): `aba`,
-/// `nonlinear_effects` and the base regressors (see `composed`), `aba_derivatives`
-/// and `aba_joints_derivatives`, `frame_placement` and `frame_motion`. On large trees
+/// one's code ([`Options::compose_above_nv`], `Config::compose_above`):
+/// `nonlinear_effects` and the base regressors (see `composed`), `aba_joints` (see
+/// `crate::joints`), `aba_derivatives` and `aba_joints_derivatives`, `frame_placement`
+/// and `frame_motion`. On large trees
 /// what they save in build time matters more than the speed they give up.
 ///
 /// `aba_derivatives`, measured on the 37-coordinate floating humanoid (release, 2

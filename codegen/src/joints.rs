@@ -3,8 +3,9 @@
 //! joint only, so the `*_joints` functions are thin additions around the rigid ones
 //! (a diagonal, a per-joint torque, four regressor columns per joint); only forward
 //! dynamics is generated again, with the rotor inertias in the articulated-body
-//! recursion, and the base parameters come from the rank analysis over all `14n`
-//! columns (`Bases::joints`).
+//! recursion (on large trees composed instead: `M + diag(Ia)` solved by the tree's
+//! `LᵀDL` factorisation), and the base parameters come from the rank analysis over all
+//! `14n` columns (`Bases::joints`).
 
 use crate::algo::{self, Armature, ARG_JOINT_PARAMS, ARG_PARAMS, ARG_Q, ARG_TAU, ARG_V};
 use crate::base::Bases;
@@ -35,14 +36,18 @@ fn doc(text: &str) -> TokenStream {
     quote!(#(#[doc = #lines])*)
 }
 
-/// The joint functions of the robot type and their `Robot` methods.
+/// The joint functions of the robot type and their `Robot` methods. On a robot of more
+/// than `compose_above` velocity coordinates `aba_joints` is composed of other
+/// functions rather than generated.
 pub(crate) fn generate(
     model: &Model,
     bases: &Bases,
     sizes: &Sizes,
     max_statements: usize,
+    compose_above: usize,
     home: &proc_macro2::Ident,
 ) -> JointFns {
+    let compose = sizes.nv > compose_above;
     // Rows and joint parameters go by velocity coordinate; parameters by body.
     let n = sizes.nv;
     let (np, nj, nb, nbj) = (10 * sizes.n, 4 * n, sizes.nb, sizes.nbj);
@@ -51,50 +56,56 @@ pub(crate) fn generate(
     let jp = quote!(::dyngen::__private::joint_at(joint_params, j));
     let coulomb_doc = "`coulomb`: `Coulomb::Sign` or `Coulomb::smooth(ε)`";
 
-    // Forward dynamics with the rotor inertias, generated; friction is a torque.
-    let g = Graph::new();
-    let spec = FnSpec {
-        name: "aba_armature",
-        public: false,
-        doc: "Forward dynamics with rotor inertias, `(M + diag(Ia))⁻¹ (tau − h)`: the\ngenerated part of [`Self::aba_joints`]."
-            .to_string(),
-        args: vec![
-            Arg {
-                id: ARG_Q,
-                name: "q",
-                len: sizes.nq,
-            },
-            Arg {
-                id: ARG_V,
-                name: "v",
-                len: n,
-            },
-            Arg {
-                id: ARG_TAU,
-                name: "tau",
-                len: n,
-            },
-            Arg {
-                id: ARG_PARAMS,
-                name: "params",
-                len: np,
-            },
-            Arg {
-                id: ARG_JOINT_PARAMS,
-                name: "joint_params",
-                len: nj,
-            },
-        ],
-        ret: quote!([S; #n_l]),
-        output: Output::Return(Box::new(|outs: &[TokenStream]| quote!([#(#outs),*]))),
-        outputs: algo::aba(&g, model, Armature::Input).iter().map(|x| x.id()).collect(),
+    // Forward dynamics with the rotor inertias, generated (on large trees composed, see
+    // `aba_joints` below); friction is a torque.
+    let (aba_armature, bodies, reports) = if compose {
+        (quote!(), Vec::new(), Vec::new())
+    } else {
+        let g = Graph::new();
+        let spec = FnSpec {
+            name: "aba_armature",
+            public: false,
+            doc: "Forward dynamics with rotor inertias, `(M + diag(Ia))⁻¹ (tau − h)`: the\ngenerated part of [`Self::aba_joints`]."
+                .to_string(),
+            args: vec![
+                Arg {
+                    id: ARG_Q,
+                    name: "q",
+                    len: sizes.nq,
+                },
+                Arg {
+                    id: ARG_V,
+                    name: "v",
+                    len: n,
+                },
+                Arg {
+                    id: ARG_TAU,
+                    name: "tau",
+                    len: n,
+                },
+                Arg {
+                    id: ARG_PARAMS,
+                    name: "params",
+                    len: np,
+                },
+                Arg {
+                    id: ARG_JOINT_PARAMS,
+                    name: "joint_params",
+                    len: nj,
+                },
+            ],
+            ret: quote!([S; #n_l]),
+            output: Output::Return(Box::new(|outs: &[TokenStream]| quote!([#(#outs),*]))),
+            outputs: algo::aba(&g, model, Armature::Input).iter().map(|x| x.id()).collect(),
+        };
+        let (emitted, mut report) = emit::emit_fn(&g, &spec, max_statements, home);
+        report.name = "aba_joints".to_string();
+        (
+            emitted.method,
+            vec![("aba_armature".to_string(), emitted.body)],
+            vec![report],
+        )
     };
-    let (aba_armature, mut report) = emit::emit_fn(&g, &spec, max_statements, home);
-    let (aba_armature, bodies) = (
-        aba_armature.method,
-        vec![("aba_armature".to_string(), aba_armature.body)],
-    );
-    report.name = "aba_joints".to_string();
 
     let rnea_doc = doc(&format!(
         "Inverse dynamics with the joint models: per joint\n`tau_j = rnea_j(q, v, a) + Ia_j·a_j + Fv_j·v_j + Fc_j·c(v_j) + F0_j`, `c` the\nCoulomb model. {}; {};\n{}; {}.",
@@ -108,12 +119,46 @@ pub(crate) fn generate(
         sizes.params(),
         sizes.joint_params()
     ));
+    let aba_how = if compose {
+        format!(
+            "`M + diag(Ia)` of [`Self::crba_joints`] and `h` of\n[`Self::nonlinear_effects`], solved by the tree's `LᵀDL` factorisation (no fill-in;\ncomposed, a robot of more than {compose_above} velocity coordinates)"
+        )
+    } else {
+        "the articulated-body\nalgorithm with each rotor inertia added along its joint axis".to_string()
+    };
     let aba_doc = doc(&format!(
-        "Forward dynamics with the joint models,\n`a = (M(q) + diag(Ia))⁻¹ (tau − h(q, v) − Fv·v − Fc·c(v) − F0)`: the articulated-body\nalgorithm with each rotor inertia added along its joint axis, after the friction is\ntaken from `tau`. Inverts [`Self::rnea_joints`]. {}; {}; {}.",
+        "Forward dynamics with the joint models,\n`a = (M(q) + diag(Ia))⁻¹ (tau − h(q, v) − Fv·v − Fc·c(v) − F0)`: {aba_how}, after the\nfriction is taken from `tau`. Inverts [`Self::rnea_joints`]. {}; {}; {}.",
         sizes.params(),
         sizes.joint_params(),
         coulomb_doc
     ));
+    let aba_body = if compose {
+        let parents = model.coordinate_parents();
+        let ancestors = (0..n).map(|d| {
+            let up = std::iter::successors(parents[d], |&p| parents[p]).map(emit::usize_lit);
+            quote!(&[#(#up),*])
+        });
+        quote! {
+            const ANCESTORS: [&[usize]; #n_l] = [#(#ancestors),*];
+            let mut m = [[#s::ZERO; #n_l]; #n_l];
+            Self::crba_joints(q, params, joint_params, &mut m);
+            let h = Self::nonlinear_effects(q, v, params);
+            let mut a = *tau;
+            for j in 0..#n_l {
+                a[j] -= #jp.friction(v[j], coulomb) + h[j];
+            }
+            ::dyngen::__private::tree_ldl_solve(&ANCESTORS, &mut m, &mut a);
+            a
+        }
+    } else {
+        quote! {
+            let mut driving = *tau;
+            for j in 0..#n_l {
+                driving[j] -= #jp.friction(v[j], coulomb);
+            }
+            Self::aba_armature(q, v, &driving, params, joint_params)
+        }
+    };
     let reg_doc = doc(&format!(
         "The joint torque regressor widened with the joint parameters ({n} × {}):\n`tau = Y · [params; joint_params]` equals [`Self::rnea_joints`]. Columns `0..{np}` are\n[`Self::joint_torque_regressor`]; joint `j`'s (1-based) four columns start at\n`{np} + 4(j−1)` and hold `[a_j, v_j, c(v_j), 1]` in row `j`, zero elsewhere. {}; {}.",
         np + nj,
@@ -204,11 +249,7 @@ pub(crate) fn generate(
                     q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l],
                     joint_params: &[S; #nj_l], coulomb: ::dyngen::Coulomb<S>,
                 ) -> [S; #n_l] {
-                    let mut driving = *tau;
-                    for j in 0..#n_l {
-                        driving[j] -= #jp.friction(v[j], coulomb);
-                    }
-                    Self::aba_armature(q, v, &driving, params, joint_params)
+                    #aba_body
                 }
                 #aba_armature
             },
@@ -288,6 +329,6 @@ pub(crate) fn generate(
         items,
         bodies,
         methods,
-        reports: vec![report],
+        reports,
     }
 }

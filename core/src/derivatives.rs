@@ -184,9 +184,11 @@ impl<S: Scalar, const N: usize> AbaDerivatives<S, N> {
     ///      [dt·∂q̈/∂q,      E + dt·∂q̈/∂v     ]],         [dt·M⁻¹ ]]
     /// ```
     ///
-    /// (`q ⊕ dt·v` is `q + dt·v` here: every joint coordinate is an angle or a
-    /// displacement. With a free flyer or a ball joint `q` has more coordinates than
-    /// `v` and does not fit `[S; N]`: step the configuration with
+    /// (`q ⊕ dt·v` is `q + dt·v` here, which holds when every joint coordinate is an
+    /// angle or a displacement. With a free flyer or a ball joint `q` has more
+    /// coordinates than `v` and does not fit `[S; N]`. A planar joint's `[x, y, θ]`
+    /// fits but is not stepped by `q + dt·v` (its velocity is in the child frame), so
+    /// `q_next` is wrong for it. For all three, step the configuration with
     /// [`crate::configuration::integrate`]; the derivatives are then with respect to
     /// the tangent of the configuration, as Pinocchio's.)
     pub fn semi_implicit_euler(&self, q: &[S; N], v: &[S; N], dt: S) -> Linearization<S, N> {

@@ -51,6 +51,7 @@ pub mod __private {
     pub use crate::frames::__express_jacobian as express_jacobian;
     pub use crate::frames::__express_jacobian_time_variation as express_jacobian_time_variation;
     pub use crate::frames::__frame_motion as frame_motion;
+    pub use crate::joints::__tree_ldl_solve as tree_ldl_solve;
 
     /// A slice as a fixed-size array, with a message naming the argument when the
     /// length is wrong.

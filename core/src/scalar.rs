@@ -41,6 +41,16 @@ pub trait Scalar:
     /// The angle of the point `(other, self)`: `atan2(y = self, x = other)`, for the
     /// logarithm of a rotation ([`crate::log3`]).
     fn atan2(self, other: Self) -> Self;
+    /// `self · a + b`: what generated code writes for a product that is only summed.
+    /// `f64` and `f32` fuse it into one instruction with one rounding where the target
+    /// has one and the standard library is linked (x86-64 with `-C target-cpu=native`
+    /// on any processor since 2013, or `-C target-feature=+fma`; every aarch64), and
+    /// otherwise compute the product and the sum, so that no build calls a software
+    /// fused multiply-add. The default is the product and the sum.
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        self * a + b
+    }
 }
 
 macro_rules! impl_scalar {
@@ -80,9 +90,43 @@ macro_rules! impl_scalar {
             fn atan2(self, other: Self) -> Self {
                 num_traits::Float::atan2(self, other)
             }
+            #[inline(always)]
+            fn mul_add(self, a: Self, b: Self) -> Self {
+                #[cfg(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64")))]
+                {
+                    num_traits::Float::mul_add(self, a, b)
+                }
+                #[cfg(not(all(feature = "std", any(target_feature = "fma", target_arch = "aarch64"))))]
+                {
+                    self * a + b
+                }
+            }
         }
     };
 }
 
 impl_scalar!(f64);
 impl_scalar!(f32);
+
+#[cfg(test)]
+mod tests {
+    use super::Scalar;
+
+    /// `(1 + 2⁻³⁰)(1 − 2⁻³⁰) − 1 = −2⁻⁶⁰` exactly; the rounded product is 1, so the
+    /// product and the sum give 0, the fused operation gives `−2⁻⁶⁰`. Which one a build
+    /// computes is fixed by its target.
+    #[test]
+    fn mul_add_is_fused_exactly_where_the_target_fuses() {
+        let e = 2f64.powi(-30);
+        let got = Scalar::mul_add(1.0 + e, 1.0 - e, -1.0);
+        if cfg!(all(
+            feature = "std",
+            any(target_feature = "fma", target_arch = "aarch64")
+        )) {
+            assert_eq!(got, -2f64.powi(-60));
+        } else {
+            assert_eq!(got, 0.0);
+        }
+        assert_eq!(Scalar::mul_add(3.0f32, 0.5, 0.25), 1.75);
+    }
+}

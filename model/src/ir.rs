@@ -362,6 +362,27 @@ impl Model {
         })
     }
 
+    /// The tree of velocity coordinates (0-based): coordinate `d`'s parent coordinate,
+    /// `None` at the base. The coordinates of a joint with several form a chain, the
+    /// first one hanging from the last coordinate of the parent joint (Featherstone's
+    /// expanded tree), so the joint-space inertia matrix is nonzero only where one
+    /// coordinate supports another and factors without fill-in.
+    pub fn coordinate_parents(&self) -> Vec<Option<usize>> {
+        (0..self.nv())
+            .map(|d| {
+                let j = self.joint_of_v(d);
+                if d > self.v_offset(j) {
+                    Some(d - 1)
+                } else {
+                    match self.parent(j) {
+                        0 => None,
+                        p => Some(self.v_offset(p) + self.joints[p - 1].kind.nv() - 1),
+                    }
+                }
+            })
+            .collect()
+    }
+
     /// The joint (1-based) that owns position coordinate `i`, if any.
     pub fn joint_of_q(&self, i: usize) -> Option<usize> {
         self.joint_owning(i, JointKind::nq)

@@ -1,6 +1,6 @@
 //! The floating-base robots (`robot-quadruped12`, `robot-humanoid31`: the root link on
 //! a free flyer) through their inherent (fixed-size) functions: `rnea`, `crba`, `aba`,
-//! the centroidal momentum matrix (against Pinocchio's `ccrba`), the frame Jacobian of
+//! `aba_joints`, the centroidal momentum matrix (against Pinocchio's `ccrba`), the frame Jacobian of
 //! the URDF's last frame and the dynamics derivatives. Each call takes the next of 1,000
 //! random states (unit quaternions), as Pinocchio's benchmark does with
 //! `BENCH_FREEFLYER=1`; ratios measured in the same sitting are in docs/benchmarks.md.
@@ -52,6 +52,22 @@ macro_rules! bench_floating {
             b.iter(|| {
                 let (q, v, tau) = next();
                 black_box(<$robot>::aba(black_box(q), black_box(v), black_box(tau), &params))
+            })
+        });
+        // With rotor inertias and friction: the articulated-body recursion on the
+        // quadruped, `M + diag(Ia)` solved by the tree's LᵀDL on the humanoid.
+        let joint_params = [0.05; 4 * NV];
+        group.bench_function("aba_joints/generated", |b| {
+            b.iter(|| {
+                let (q, v, tau) = next();
+                black_box(<$robot>::aba_joints(
+                    black_box(q),
+                    black_box(v),
+                    black_box(tau),
+                    &params,
+                    &joint_params,
+                    dyngen::Coulomb::Sign,
+                ))
             })
         });
         let mut ag = [[0.0; NV]; 6];

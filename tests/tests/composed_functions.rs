@@ -1,4 +1,4 @@
-//! The functions a large tree composes of other generated functions (`aba`,
+//! The functions a large tree composes of other generated functions (`aba_joints`,
 //! `nonlinear_effects`, the base regressors, `frame_placement`, `frame_motion`,
 //! `aba_derivatives`, `aba_joints_derivatives`) compute what their own graphs do: a
 //! UR5 generated with `compose_above(0)` against `robot_ur5::Ur5`. The UR5 is a
@@ -26,10 +26,17 @@ fn derivatives(d: &AbaDerivatives<f64, 6>) -> Vec<f64> {
 #[test]
 fn composed_functions_are_composed() {
     let names: Vec<&str> = Ur5Composed::OP_COUNTS.iter().map(|(n, _)| *n).collect();
-    for composed in ["aba", "nonlinear_effects", "base_regressor", "principal_base_regressor"] {
+    for composed in [
+        "aba_joints",
+        "nonlinear_effects",
+        "base_regressor",
+        "principal_base_regressor",
+    ] {
         assert!(!names.contains(&composed), "{composed} has a graph of its own");
         assert!(Ur5::OP_COUNTS.iter().any(|(n, _)| *n == composed), "{composed}");
     }
+    // `aba` keeps its own graph on every tree (zero rows along the joint axes).
+    assert!(names.contains(&"aba"));
     assert!(!names
         .iter()
         .any(|n| n.starts_with("frame_placement[") || n.starts_with("frame_motion[")));
@@ -57,6 +64,10 @@ fn composed_functions_agree_with_their_own_graphs() {
         check(
             &Ur5Composed::aba(&q, &v, &tau, &params),
             &Ur5::aba(&q, &v, &tau, &params),
+        );
+        check(
+            &Ur5Composed::aba_joints(&q, &v, &tau, &params, &jp, coulomb),
+            &Ur5::aba_joints(&q, &v, &tau, &params, &jp, coulomb),
         );
         check(
             &Ur5Composed::nonlinear_effects(&q, &v, &params),

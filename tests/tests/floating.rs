@@ -355,8 +355,14 @@ fn dsl_floating_base_with_a_ball_joint() {
 /// friction everywhere, `crba_joints` adds the rotor inertias to `M`'s diagonal, and
 /// the widened regressor reproduces `rnea_joints`.
 #[test]
-fn quadruped12_joint_models_invert_and_match_the_regressor() {
-    type R = Quadruped12;
+fn joint_models_invert_and_match_the_regressor_on_floating_robots() {
+    joint_models_invert_and_match_the_regressor::<Quadruped12>();
+    // Above `Config::compose_above`'s 24 coordinates, `aba_joints` is composed:
+    // `M + diag(Ia)` solved by the tree's `LᵀDL` factorisation.
+    joint_models_invert_and_match_the_regressor::<Humanoid31>();
+}
+
+fn joint_models_invert_and_match_the_regressor<R: Robot>() {
     let (nv, np) = (<R as Robot>::NV, <R as Robot>::NPARAMS);
     let model = dyngen_reference::model_from_static(&<R as Robot>::MODEL);
     let params = <R as Robot>::nominal_params();

@@ -746,7 +746,8 @@ impl Names<'_> {
                 quote!(-#e)
             }
         };
-        let mul_add = |x: TokenStream, y: TokenStream, z: TokenStream| quote!(::dyngen::Scalar::mul_add(#x, #y, #z));
+        let mul_add =
+            |x: TokenStream, y: TokenStream, z: TokenStream| quote!(<S as ::dyngen::Scalar>::mul_add(#x, #y, #z));
         match node {
             Node::Add(a, b) => match (product(a), product(b)) {
                 (_, Some((x, y))) => Some(mul_add(arg(x), arg(y), arg(a))),

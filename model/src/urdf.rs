@@ -80,7 +80,7 @@ pub fn load_urdf_options(path: &Path, options: LoadOptions) -> Result<Model, Mod
 /// callers that want to adjust it (gravity, say) before checking.
 pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
     let fail = |errors| ModelErrors { file: None, errors };
-    let (desc, _, unsupported) = read(text).map_err(fail)?;
+    let (desc, _, unsupported, _) = read(text).map_err(fail)?;
     if !unsupported.is_empty() {
         return Err(fail(unsupported));
     }
@@ -89,15 +89,25 @@ pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
 
 fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
     let strict = options.strict;
-    let (mut desc, robot_line, unsupported) = read(text)?;
+    let (mut desc, robot_line, unsupported, notes) = read(text)?;
     if options.free_flyer {
         desc = desc.with_free_flyer();
     }
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
     let mut errors = match desc.build_checked(SiblingOrder::Name, strict) {
-        Ok(model) if unsupported.is_empty() => return Ok(model),
+        Ok(mut model) if unsupported.is_empty() && (!strict || notes.is_empty()) => {
+            model.warnings.extend(notes);
+            return Ok(model);
+        }
+        // A strict build refuses what it would accept with a warning.
+        Ok(_) if strict => notes,
         Ok(_) => Vec::new(),
-        Err(errors) => errors,
+        Err(mut errors) => {
+            if strict {
+                errors.extend(notes);
+            }
+            errors
+        }
     };
     // Robot-wide errors (several roots, nothing moves) point at `<robot>`.
     for e in &mut errors {
@@ -119,10 +129,11 @@ fn robot_error(line: Option<usize>, kind: ErrorKind) -> ModelError {
     }
 }
 
-/// What [`read`] gives: the description, the line of `<robot>`, and what the file
-/// asks for that the description cannot hold (mimic joints), reported with the
-/// checks of the description.
-type ReadOutcome = (Description, Option<usize>, Vec<ModelError>);
+/// What [`read`] gives: the description, the line of `<robot>`, what the file asks
+/// for that the description cannot hold (mimic joints), reported with the checks of
+/// the description, and what it is read with a warning for (a planar joint without
+/// `<axis>`).
+type ReadOutcome = (Description, Option<usize>, Vec<ModelError>, Vec<ModelError>);
 
 /// Reads URDF text into a description and the line of its `<robot>` element.
 fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
@@ -227,13 +238,33 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
         })
         .collect();
 
+    // A planar joint without <axis> moves, as URDF says, in the plane normal to x;
+    // Pinocchio's reader takes z whatever the axis, and a base on the floor wants z.
+    let notes = robot
+        .joints
+        .iter()
+        .enumerate()
+        .filter_map(|(k, joint)| {
+            let source = outline.joint(k, &joint.name)?;
+            (matches!(joint.joint_type, urdf_rs::JointType::Planar) && !source.has_child("axis")).then(|| ModelError {
+                element: Element::Joint(joint.name.clone()),
+                line: Some(source.tag.line),
+                kind: ErrorKind::Ignored(
+                    "this planar joint has no <axis>, so its plane is normal to URDF's default axis x (it \
+                         moves along y and z); Pinocchio's reader would take z. Give <axis xyz=\"0 0 1\"/> for a \
+                         base moving on the floor"
+                        .to_string(),
+                ),
+            })
+        })
+        .collect();
     let desc = Description {
         name: robot.name.clone(),
         gravity: DEFAULT_GRAVITY,
         links,
         joints,
     };
-    Ok((desc, outline.robot_line, unsupported))
+    Ok((desc, outline.robot_line, unsupported, notes))
 }
 
 /// The numeric attributes of the elements dyngen reads, with how many numbers each

@@ -4,7 +4,9 @@
 
 use dyngen_model::math;
 use dyngen_model::urdf::urdf_description;
-use dyngen_model::{load_urdf, parse_urdf, to_urdf, Element, ErrorKind, JointKind, Model, ModelError, ModelErrors};
+use dyngen_model::{
+    load_urdf, parse_urdf, parse_urdf_with, to_urdf, Element, ErrorKind, JointKind, Model, ModelError, ModelErrors,
+};
 use std::path::PathBuf;
 
 /// A robot whose body is `lines`, so that `lines[k]` sits on line `k + 2`.
@@ -281,6 +283,28 @@ fn planar_joints_have_three_coordinates() {
     assert_eq!(model.joints[0].axis, [0.0, 0.0, 1.0]);
     assert_eq!(model.joints[0].limits, None);
     assert_eq!(model.multi_dof_joint().map(|j| j.name.as_str()), Some("drive"));
+    assert!(model.warnings.is_empty());
+}
+
+/// Without `<axis>` a planar joint follows URDF's default axis x (Pinocchio's reader
+/// would take z): accepted with a warning naming the joint and its line, refused by a
+/// strict build.
+#[test]
+fn a_planar_joint_without_an_axis_is_warned_about() {
+    let text = robot(&[
+        r#"<link name="ground"/>"#,
+        &link("base"),
+        &joint("drive", "planar", "ground", "base", ""),
+    ]);
+    let model = parse_urdf(&text).unwrap();
+    assert_eq!(model.joints[0].axis, [1.0, 0.0, 0.0]);
+    assert_eq!(model.warnings.len(), 1);
+    let w = &model.warnings[0];
+    assert_eq!((&w.element, w.line), (&Element::Joint("drive".into()), Some(4)));
+    assert!(w.warning_message().contains("has no <axis>"), "{}", w.warning_message());
+    let e = parse_urdf_with(&text, true).unwrap_err();
+    assert_eq!(e.errors.len(), 1);
+    assert!(e.to_string().contains("Give <axis xyz=\"0 0 1\"/>"), "{e}");
 }
 
 #[test]

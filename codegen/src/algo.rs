@@ -236,8 +236,9 @@ pub fn quaternion_rotation<'g>([x, y, z, w]: [Expr<'g>; 4]) -> M3<'g> {
 /// The time derivative of position coordinate `index` of `model` at velocity `v`
 /// (inputs [`ARG_Q`] and [`ARG_V`]): `v` itself for a joint with an axis; for a
 /// quaternion `q̇ = ½ q ⊗ (ω, 0)` with `ω` in the child frame; for a free flyer's
-/// position `ṗ = R(q) v`; for a planar joint's `[ẋ, ẏ] = R(θ) [vx, vy]`, `θ̇ = ω`. `None` if `index` is out of range. What forward-mode
-/// tangents along the motion ([`Graph::tangents`]) seed each `q` with.
+/// position `ṗ = R(q) v`; for a planar joint's `[ẋ, ẏ] = R(θ) [vx, vy]`, `θ̇ = ω`.
+/// `None` if `index` is out of range. What forward-mode tangents along the motion
+/// ([`Graph::tangents`]) seed each `q` with.
 pub fn q_dot<'g>(g: &'g Graph, model: &Model, index: usize) -> Option<Expr<'g>> {
     let j = model.joint_of_q(index)?;
     let joint = &model.joints[j - 1];
@@ -1079,7 +1080,8 @@ pub fn aba<'g>(g: &'g Graph, model: &Model, armature: Armature) -> Vec<Expr<'g>>
             let rigid = armature == Armature::None;
             let a_ia = s[i - 1]
                 .iter()
-                .filter_map(|sk| unit_motion(*sk).filter(|_| rigid))
+                .filter(|_| rigid)
+                .filter_map(|sk| unit_motion(*sk))
                 .fold(ia[i].minus_products(&ui, &w), |acc, k| acc.without(g, k));
             let a_pa = ui.iter().zip(&gain).fold(pa[i] + a_ia.apply(c[i]), |acc, (uk, gk)| {
                 acc + Force {

@@ -115,11 +115,12 @@ impl Config {
     /// Above this many velocity coordinates (default
     /// [`DEFAULT_COMPOSE_ABOVE_NV`](crate::DEFAULT_COMPOSE_ABOVE_NV), 24), functions whose
     /// own graph would repeat another one's code are composed of the others instead:
-    /// `aba`, `nonlinear_effects`, the base regressors, `aba_derivatives`,
+    /// `aba_joints`, `nonlinear_effects`, the base regressors, `aba_derivatives`,
     /// `aba_joints_derivatives`, `frame_placement` and `frame_motion`. Composition
     /// builds faster and runs slower: on the 31-joint floating humanoid the crate with
-    /// every function rebuilds in 28–30 s instead of about 45 s, and `aba_derivatives`
-    /// takes 24.9 µs instead of 22.2 µs. `usize::MAX` never composes.
+    /// every function rebuilt in 28–30 s instead of about 45 s (one host; timings in
+    /// `docs/benchmarks.md`), and `aba_derivatives` takes 24.9 µs instead of 22.2 µs.
+    /// `usize::MAX` never composes.
     pub fn compose_above(&mut self, nv: usize) -> &mut Config {
         self.options.compose_above_nv = nv;
         self

@@ -172,16 +172,12 @@ impl<S: Scalar> JointParams<S> {
 pub fn __tree_ldl_solve<S: Scalar, const N: usize>(ancestors: &[&[usize]; N], h: &mut [[S; N]; N], b: &mut [S; N]) {
     for k in (0..N).rev() {
         let up = ancestors[k];
-        // Row k is only read until its entries become L's: a copy tells the compiler
-        // that the rows written below are other memory.
-        let row = h[k];
-        let inv = S::ONE / row[k];
+        let inv = S::ONE / h[k][k];
         for (m, &i) in up.iter().enumerate() {
-            let a = row[i] * inv;
-            let hi = &mut h[i];
-            hi[i] -= a * row[i];
+            let a = h[k][i] * inv;
+            h[i][i] -= a * h[k][i];
             for &j in &up[m + 1..] {
-                hi[j] -= a * row[j];
+                h[i][j] -= a * h[k][j];
             }
             h[k][i] = a;
         }

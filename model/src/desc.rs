@@ -303,7 +303,6 @@ impl Description {
             if let DeclaredJointType::Moving(kind) = j.kind {
                 if !kind.has_axis() {
                     // A ball joint or a free flyer has no axis: whatever is given is unused.
-                    // (A planar joint's axis is its plane normal, checked as an axis.)
                 } else if let Err(kind) = check_value("axis", &j.axis) {
                     errors.push(err(el(), j.line, kind));
                 } else if math::norm(&j.axis) < 1e-12 {

@@ -329,17 +329,17 @@ fn check_limits_ordered(cx: &Ctxt, joint: &Joint) {
 /// joint, a free flyer or a planar joint has no single coordinate to limit; limits on
 /// them would be silently dropped.
 fn check_continuous_has_no_limits(cx: &Ctxt, joint: &Joint) {
-    if let (JointKind::Spherical | JointKind::FreeFlyer, Some(l)) = (joint.kind, &joint.limits) {
-        cx.error_spanned_by(
-            joint.kind_loc.to(l.key_loc),
+    let several = match joint.kind {
+        JointKind::Spherical | JointKind::FreeFlyer => Some(
             "a `spherical` or `free` joint has no position limits (its coordinates are a quaternion); remove `limits`",
-        );
-    }
-    if let (JointKind::Planar, Some(l)) = (joint.kind, &joint.limits) {
-        cx.error_spanned_by(
-            joint.kind_loc.to(l.key_loc),
-            "a `planar` joint has no position limits (it has three coordinates); remove `limits`",
-        );
+        ),
+        JointKind::Planar => {
+            Some("a `planar` joint has no position limits (it has three coordinates); remove `limits`")
+        }
+        _ => None,
+    };
+    if let (Some(message), Some(l)) = (several, &joint.limits) {
+        cx.error_spanned_by(joint.kind_loc.to(l.key_loc), message);
     }
     if let (JointKind::Continuous, Some(l)) = (joint.kind, &joint.limits) {
         cx.error_spanned_by(

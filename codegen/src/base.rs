@@ -22,13 +22,20 @@ pub struct Bases {
 
 /// The base-parameter analysis of `model` in the three parameterisations
 /// (`dyngen_model::base::analyse`: ordered QR on stacked random regressors, with a
-/// second seed and a singular-value count as checks).
+/// second seed and a singular-value count as checks). The largest, of the standard
+/// and joint parameters together, runs on a thread of its own beside the other two.
 pub fn analyse_model(model: &Model) -> Bases {
-    Bases {
-        standard: analyse(model, Parameterisation::Standard),
-        principal: analyse(model, Parameterisation::Principal),
-        joints: analyse(model, Parameterisation::StandardAndJoints),
-    }
+    std::thread::scope(|s| {
+        let joints = s.spawn(|| analyse(model, Parameterisation::StandardAndJoints));
+        let standard = analyse(model, Parameterisation::Standard);
+        let principal = analyse(model, Parameterisation::Principal);
+        Bases {
+            standard,
+            principal,
+            // A panic in the analysis is a bug; it is carried over as it was.
+            joints: joints.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
+        }
+    })
 }
 
 #[cfg(test)]

@@ -242,16 +242,70 @@ pub fn build_jacobian(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     out
 }
 
+/// The time derivatives of `ids` along `q̇ = v`: one forward-mode tangent
+/// ([`Graph::tangents`]), reusing every node of `ids`.
+fn time_derivatives<'g>(g: &'g Graph, model: &Model, ids: &[NodeId]) -> Vec<Expr<'g>> {
+    g.tangents(ids, |id| match g.node(id) {
+        crate::sym::Node::Input { arg, index } if arg == ARG_Q => crate::algo::q_dot(g, model, index as usize),
+        _ => None,
+    })
+}
+
 /// Frame `f`'s placement (12), `LOCAL_WORLD_ALIGNED` Jacobian (6 × n) and its time
 /// variation `J̇(q, v)` (6 × n): one forward-mode tangent of the Jacobian along `q̇ = v`.
 pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<NodeId> {
     let mut out = build_jacobian(g, model, f);
-    let dot = g.tangents(&out[12..], |id| match g.node(id) {
-        crate::sym::Node::Input { arg, index } if arg == ARG_Q => crate::algo::q_dot(g, model, index as usize),
-        _ => None,
-    });
+    let dot = time_derivatives(g, model, &out[12..]);
     out.extend(dot.iter().map(|x| x.id()));
     out
+}
+
+/// What a large tree composes every frame's Jacobian of
+/// (`dyngen::__private::frame_jacobian_from_axes`): each velocity coordinate's axis
+/// `z` and origin `o` in the world, 6 per coordinate (the origin of a translation
+/// unused), then each frame's placement, 12 per frame; and whether each coordinate
+/// is a rotation (`true`) or a translation.
+pub fn build_axes(g: &Graph, model: &Model) -> (Vec<NodeId>, Vec<bool>) {
+    let n = model.dof();
+    let all: Vec<usize> = (1..=n).collect();
+    let (world, joints) = walk(g, model, &all, Walk::Placement);
+    let mut out = vec![g.zero().id(); 6 * model.nv()];
+    let mut rotation = vec![false; model.nv()];
+    for k in 1..=n {
+        let j = walked(&joints, k);
+        for (dof, c) in j.dofs().iter().zip(crate::algo::dofs(model, k)) {
+            let z = match dof {
+                WorldDof::Rotation(z) => {
+                    rotation[c] = true;
+                    z
+                }
+                WorldDof::Translation(z) => z,
+            };
+            for (r, x) in v3_ids(z).chain(v3_ids(&j.o)).enumerate() {
+                out[6 * c + r] = x;
+            }
+        }
+    }
+    for f in 0..model.frames.len() {
+        let (r, t, _) = frame_pose(g, model, f, &walked(&world, model.frames[f].body));
+        out.extend(pose_ids(&r, &t));
+    }
+    (out, rotation)
+}
+
+/// [`build_axes`] followed by the time derivatives along `q̇ = v` of the axes and
+/// origins (6 per coordinate) and of the frame origins (3 per frame): what a large
+/// tree composes every frame's `J̇` of.
+pub fn build_axes_time_variation(g: &Graph, model: &Model) -> (Vec<NodeId>, Vec<bool>) {
+    let (mut out, rotation) = build_axes(g, model);
+    let axes = 6 * model.nv();
+    let mut moving = out[..axes].to_vec();
+    for f in 0..model.frames.len() {
+        moving.extend(&out[axes + 12 * f + 9..axes + 12 * f + 12]);
+    }
+    let dot = time_derivatives(g, model, &moving);
+    out.extend(dot.iter().map(|x| x.id()));
+    (out, rotation)
 }
 
 /// Frame `f`'s placement (12), velocity (6) and classical acceleration (6) of its
@@ -376,10 +430,7 @@ pub fn build_centroidal_map(g: &Graph, model: &Model) -> Vec<NodeId> {
 /// ([`Graph::tangents`]), so it reuses every node of `A_g`.
 pub fn build_centroidal_map_time_variation(g: &Graph, model: &Model) -> Vec<NodeId> {
     let a_g = build_centroidal_map(g, model);
-    let dot = g.tangents(&a_g, |id| match g.node(id) {
-        crate::sym::Node::Input { arg, index } if arg == ARG_Q => crate::algo::q_dot(g, model, index as usize),
-        _ => None,
-    });
+    let dot = time_derivatives(g, model, &a_g);
     a_g.into_iter().chain(dot.iter().map(|x| x.id())).collect()
 }
 
@@ -495,6 +546,11 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             t.extend(emit_one(spec, &g, format!("frame_placement[{label}]")));
         }
 
+        // A large tree composes every frame's Jacobian and its time variation of the
+        // axes of all coordinates (`__frame_axes`, below).
+        if large {
+            continue;
+        }
         let g = Graph::new();
         let outputs = build_jacobian(&g, model, f);
         let place = move |k: usize| {
@@ -548,9 +604,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         };
         t.extend(emit_one(spec, &g, format!("frame_jacobian_time_variation[{label}]")));
 
-        // A large tree takes the motion from `J` and `J̇` (above) rather than carry a
-        // function per frame for it.
-        if !large {
+        {
             let g = Graph::new();
             let outputs = build_motion(&g, model, f);
             let assemble = |o: &[TokenStream]| {
@@ -590,6 +644,66 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         jacobian_fns.push(quote!(#fty::#v => Self::#jn(q, out)));
         jacobian_dot_fns.push(quote!(#fty::#v => Self::#dn(q, v, out)));
         motion_fns.push(quote!(#fty::#v => Self::#mn(q, v, a)));
+    }
+
+    // A large tree's Jacobians and their time variations, composed at run time of the
+    // axes of all coordinates and the placements of all frames (one function each).
+    let flat_output = |len: &proc_macro2::Literal| Output::InPlace {
+        place: Box::new(|k: usize| {
+            let k = emit::usize_lit(k);
+            quote!(out[#k])
+        }),
+        clear: quote!(*out = [<S as ::dyngen::Scalar>::ZERO; #len];),
+        views: TokenStream::new(),
+    };
+    let mut composed = None;
+    if large {
+        let g = Graph::new();
+        let (outputs, rotation) = build_axes(&g, model);
+        let axes_len = emit::usize_lit(outputs.len());
+        let spec = FnSpec {
+            name: "__frame_axes",
+            public: false,
+            doc: "Every coordinate's axis and origin and every frame's placement, in the world.".to_string(),
+            args: vec![q()],
+            ret: quote!([S; #axes_len]),
+            output: flat_output(&axes_len),
+            outputs,
+        };
+        let axes = emit_one(spec, &g, "frame_jacobian".to_string());
+        let g = Graph::new();
+        let (outputs, _) = build_axes_time_variation(&g, model);
+        let dot_len = emit::usize_lit(outputs.len());
+        let spec = FnSpec {
+            name: "__frame_axes_time_variation",
+            public: false,
+            doc: "`Self::__frame_axes` and the time variations of the axes, origins and frame origins.".to_string(),
+            args: vec![q(), arg(ARG_V, "v", n)],
+            ret: quote!([S; #dot_len]),
+            output: flat_output(&dot_len),
+            outputs,
+        };
+        let axes_dot = emit_one(spec, &g, "frame_jacobian_time_variation".to_string());
+        let columns = model.frames.iter().map(|frame| {
+            let c = path(model, frame.body)
+                .into_iter()
+                .flat_map(|k| crate::algo::dofs(model, k))
+                .map(emit::usize_lit);
+            quote!(&[#(#c),*])
+        });
+        composed = Some((
+            quote! {
+                /// Whether each velocity coordinate is a rotation (or a translation).
+                const __COORDINATE_ROTATES: [bool; #n_l] = [#(#rotation),*];
+                /// The columns of each frame's Jacobian that are not zero: the coordinates of
+                /// the joints between the base and the frame.
+                const __FRAME_COLUMNS: [&'static [usize]; #nf_l] = [#(#columns),*];
+                #axes
+                #axes_dot
+            },
+            axes_len,
+            dot_len,
+        ));
     }
 
     // All placements at once, and the centre of mass.
@@ -705,18 +819,46 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let dispatch_doc = doc_attrs(&format!(
         "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. {walks}"
     ));
+    let (jacobian_body, jacobian_dot_body, composed_items, composed_how) = match composed {
+        Some((items, axes_len, dot_len)) => (
+            quote! {
+                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #axes_len];
+                Self::__frame_axes(q, &mut axes);
+                ::dyngen::__private::frame_jacobian_from_axes(
+                    &axes, &Self::__COORDINATE_ROTATES, Self::__FRAME_COLUMNS[frame.index()], frame.index(), out,
+                );
+            },
+            quote! {
+                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #dot_len];
+                Self::__frame_axes_time_variation(q, v, &mut axes);
+                ::dyngen::__private::frame_jacobian_time_variation_from_axes(
+                    &axes, #nf_l, &Self::__COORDINATE_ROTATES, Self::__FRAME_COLUMNS[frame.index()], frame.index(), out,
+                );
+            },
+            items,
+            format!(
+                "\nComposed of the axes of all coordinates and the placements of all frames,\ncomputed together (a robot of more than {above} velocity coordinates carries no\nfunction per frame for it)."
+            ),
+        ),
+        None => (
+            quote!(match frame { #(#jacobian_fns,)* }),
+            quote!(match frame { #(#jacobian_dot_fns,)* }),
+            TokenStream::new(),
+            String::new(),
+        ),
+    };
     let jacobian_doc = doc_attrs(&format!(
-        "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`."
+        "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`.{composed_how}"
     ));
     let jacobian_dot_doc = doc_attrs(&format!(
-        "Frame `frame`'s placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × {n} each)\nin `reference` (Pinocchio's `getFrameJacobianTimeVariation`), written to `out`:\n`ẍ = J q̈ + J̇ q̇`. `J̇` is the time derivative of `J` along `q̇ = v`."
+        "Frame `frame`'s placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × {n} each)\nin `reference` (Pinocchio's `getFrameJacobianTimeVariation`), written to `out`:\n`ẍ = J q̈ + J̇ q̇`. `J̇` is the time derivative of `J` along `q̇ = v`.{composed_how}"
     ));
     let (motion_body, motion_how) = if large {
         (
             quote! {
                 let mut jacobians = ::dyngen::FrameJacobianTimeVariation::<S, #n_l>::default();
-                let out = &mut jacobians;
-                match frame { #(#jacobian_dot_fns,)* }
+                let reference = ::dyngen::ReferenceFrame::LocalWorldAligned;
+                Self::frame_jacobian_time_variation(q, v, frame, reference, &mut jacobians);
                 ::dyngen::__private::frame_motion(&jacobians, v, a)
             },
             format!(
@@ -752,7 +894,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             pub fn frame_jacobian<S: ::dyngen::Scalar>(
                 q: &[S; #nq_l], frame: #fty, reference: ::dyngen::ReferenceFrame, out: &mut ::dyngen::FrameJacobian<S, #n_l>,
             ) {
-                match frame { #(#jacobian_fns,)* }
+                #jacobian_body
                 ::dyngen::__private::express_jacobian(out, reference);
             }
             #jacobian_dot_doc
@@ -761,7 +903,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
                 q: &[S; #nq_l], v: &[S; #n_l], frame: #fty, reference: ::dyngen::ReferenceFrame,
                 out: &mut ::dyngen::FrameJacobianTimeVariation<S, #n_l>,
             ) {
-                match frame { #(#jacobian_dot_fns,)* }
+                #jacobian_dot_body
                 ::dyngen::__private::express_jacobian_time_variation(out, v, reference);
             }
             #motion_doc
@@ -788,6 +930,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             #com_jacobian
             #centroidal
             #centroidal_dot
+            #composed_items
             #(#per_frame)*
         },
     ));

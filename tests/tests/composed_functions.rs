@@ -1,11 +1,12 @@
 //! The functions a large tree composes of other generated functions (`aba_joints`,
-//! `nonlinear_effects`, the base regressors, `frame_placement`, `frame_motion`,
-//! `aba_derivatives`, `aba_joints_derivatives`) compute what their own graphs do: a
+//! `nonlinear_effects`, the base regressors, `frame_placement`, `frame_jacobian`,
+//! `frame_jacobian_time_variation`, `frame_motion`, `aba_derivatives`,
+//! `aba_joints_derivatives`) compute what their own graphs do: a
 //! UR5 generated with `compose_above(0)` against `robot_ur5::Ur5`. The UR5 is a
 //! chain, so the products by `−M⁻¹` take the dense path here; the humanoid's
 //! (`tests/floating.rs`) take the sparse one.
 
-use dyngen::{AbaDerivatives, Coulomb};
+use dyngen::{AbaDerivatives, Coulomb, FrameJacobianTimeVariation, ReferenceFrame};
 use dyngen_reference::{sample_states, Reference};
 use dyngen_tests::composed::{Ur5Composed, Ur5ComposedFrame};
 use dyngen_tests::rel_err;
@@ -37,9 +38,11 @@ fn composed_functions_are_composed() {
     }
     // `aba` keeps its own graph on every tree (zero rows along the joint axes).
     assert!(names.contains(&"aba"));
-    assert!(!names
-        .iter()
-        .any(|n| n.starts_with("frame_placement[") || n.starts_with("frame_motion[")));
+    // One function for the axes of all frames' Jacobians, one for their time variations.
+    assert!(!names.iter().any(|n| n.contains('[')), "{names:?}");
+    for n in ["frame_jacobian", "frame_jacobian_time_variation"] {
+        assert!(names.contains(&n), "{n}");
+    }
     assert!(!names.contains(&"aba_derivatives"));
 }
 
@@ -90,6 +93,32 @@ fn composed_functions_agree_with_their_own_graphs() {
             );
             for (x, y) in [(m.velocity, mw.velocity), (m.acceleration, mw.acceleration)] {
                 check(&x.to_array(), &y.to_array());
+            }
+            for reference in [
+                ReferenceFrame::Local,
+                ReferenceFrame::World,
+                ReferenceFrame::LocalWorldAligned,
+            ] {
+                let (mut j, mut jw) = (
+                    FrameJacobianTimeVariation::default(),
+                    FrameJacobianTimeVariation::default(),
+                );
+                Ur5Composed::frame_jacobian_time_variation(&q, &v, f, reference, &mut j);
+                Ur5::frame_jacobian_time_variation(&q, &v, g, reference, &mut jw);
+                check(
+                    &dyngen_tests::pose_vec(&j.placement),
+                    &dyngen_tests::pose_vec(&jw.placement),
+                );
+                check(&flat(&j.jacobian), &flat(&jw.jacobian));
+                check(&flat(&j.jacobian_dot), &flat(&jw.jacobian_dot));
+                let (mut j, mut jw) = (Default::default(), Default::default());
+                Ur5Composed::frame_jacobian(&q, f, reference, &mut j);
+                Ur5::frame_jacobian(&q, g, reference, &mut jw);
+                check(
+                    &dyngen_tests::pose_vec(&j.placement),
+                    &dyngen_tests::pose_vec(&jw.placement),
+                );
+                check(&flat(&j.jacobian), &flat(&jw.jacobian));
             }
         }
         let (mut d, mut dw) = (AbaDerivatives::default(), AbaDerivatives::default());

@@ -3,7 +3,11 @@
 //! and a classical acceleration, and the robot gets its centre of mass, the centre of
 //! mass's Jacobian and the centroidal momentum matrix with its time variation. Each frame's functions walk only the bodies between the
 //! base and the frame, so only the Jacobian columns of the joints on that path are
-//! computed; the others are exact zeros.
+//! computed; the others are exact zeros. A large tree (more than
+//! [`crate::Options::compose_above_nv`] coordinates) carries no function per frame: its
+//! placements come from [`build_placements`], its Jacobians and their time variations
+//! from the world axes of all coordinates ([`build_axes`],
+//! [`build_axes_time_variation`]), each frame's columns put together at run time.
 //!
 //! Everything is built in world axes at the frame origin (Pinocchio's
 //! `LOCAL_WORLD_ALIGNED`): joint `k`'s column is `[z_k × (p − o_k); z_k]` for a

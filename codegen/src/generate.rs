@@ -970,8 +970,9 @@ struct DerivativeFns {
 /// of other generated functions wherever a graph of their own would repeat another
 /// one's code ([`Options::compose_above_nv`], `Config::compose_above`):
 /// `nonlinear_effects` and the base regressors (see `composed`), `aba_joints` (see
-/// `crate::joints`), `aba_derivatives` and `aba_joints_derivatives`, `frame_placement`
-/// and `frame_motion`. On large trees
+/// `crate::joints`), `aba_derivatives` and `aba_joints_derivatives`, `frame_placement`,
+/// `frame_jacobian`, `frame_jacobian_time_variation` and `frame_motion` (see
+/// `crate::frames`). On large trees
 /// what they save in build time matters more than the speed they give up.
 ///
 /// `aba_derivatives`, measured on the 37-coordinate floating humanoid (release, 2

@@ -839,7 +839,7 @@ impl Algorithm {
 /// independent columns of the full ones (which is what their graphs compute). `aba`
 /// always has its own graph: without rotor inertias the articulated inertia passed to
 /// the parent has zero rows along the joint axes, which the one with them lacks.
-fn composed(algorithm: &Algorithm, sizes: &Sizes, above: usize) -> Option<TokenStream> {
+fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -> Option<TokenStream> {
     if sizes.nv <= above {
         return None;
     }
@@ -872,6 +872,30 @@ fn composed(algorithm: &Algorithm, sizes: &Sizes, above: usize) -> Option<TokenS
         ),
         "base_regressor" => columns("joint_torque_regressor", 10 * sizes.n, "BASE_INDEX", sizes.nb),
         "principal_base_regressor" => columns("principal_regressor", 4 * sizes.n, "PRINCIPAL_BASE_INDEX", sizes.nbt),
+        "principal_regressor" => {
+            let [b_l, t_l] = [sizes.n, 4 * sizes.n].map(emit::usize_lit);
+            let frames = dyngen_model::principal_frames(model);
+            let maps = frames.iter().map(|f| {
+                let rows = f.p_matrix().map(|row| {
+                    let row = row.map(emit::f64_lit);
+                    quote!([#(#row),*])
+                });
+                quote!([#(#rows),*])
+            });
+            (
+                quote!(q: &[S; #nq_l], v: &[S; #n_l], a: &[S; #n_l], out: &mut [[S; #t_l]; #n_l]),
+                quote!(),
+                quote! {
+                    /// Each body's `P_i` (10 × 4): its standard parameters are `P_i θ_i`.
+                    const PRINCIPAL_MAPS: [[[f64; 4]; 10]; #b_l] = [#(#maps),*];
+                    let mut y = [[#zero; #np_l]; #n_l];
+                    Self::joint_torque_regressor(q, v, a, &mut y);
+                    ::dyngen::__private::principal_columns(&y, &PRINCIPAL_MAPS, out);
+                },
+                "[`Self::joint_torque_regressor`] times each body's constant `P_i` (10 × 4),\n`π_i = P_i θ_i`"
+                    .to_string(),
+            )
+        }
         _ => return None,
     };
     let fname = format_ident!("{}", algorithm.name);
@@ -907,7 +931,7 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     let mut bodies = Vec::new();
     let mut methods = Vec::new();
     for algorithm in ALGORITHMS {
-        if let Some(item) = composed(algorithm, &sizes, options.compose_above_nv) {
+        if let Some(item) = composed(algorithm, model, &sizes, options.compose_above_nv) {
             items.push((algorithm.name.to_string(), item));
             methods.push(algorithm.trait_method(&ty, &sizes));
             continue;

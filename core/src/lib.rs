@@ -55,6 +55,31 @@ pub mod __private {
     pub use crate::frames::__frame_motion as frame_motion;
     pub use crate::joints::__tree_ldl_solve as tree_ldl_solve;
 
+    /// `Y_θ = Y · blkdiag(P_i)`: the principal regressor (4 columns per body) from the
+    /// standard one (10 per body), `maps[i]` body `i`'s `P_i` (`π_i = P_i θ_i`). A body
+    /// whose 10 columns are zero in a row (a joint that does not carry it) gives zeros
+    /// without products; the others take a row of `P_i` at a time, four independent
+    /// products that vectorise.
+    pub fn principal_columns<S: crate::Scalar, const P: usize, const T: usize, const N: usize>(
+        y: &[[S; P]; N],
+        maps: &[[[f64; 4]; 10]],
+        out: &mut [[S; T]; N],
+    ) {
+        for (row, full) in out.iter_mut().zip(y) {
+            for ((theta, pi), map) in row.chunks_exact_mut(4).zip(full.chunks_exact(10)).zip(maps) {
+                let mut t = [S::ZERO; 4];
+                if pi.iter().any(|&x| x != S::ZERO) {
+                    for (&x, m) in pi.iter().zip(map) {
+                        for c in 0..4 {
+                            t[c] = S::mul_add(x, S::from_f64(m[c]), t[c]);
+                        }
+                    }
+                }
+                theta.copy_from_slice(&t);
+            }
+        }
+    }
+
     /// A slice as a fixed-size array, with a message naming the argument when the
     /// length is wrong.
     #[inline(always)]

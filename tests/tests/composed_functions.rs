@@ -1,5 +1,5 @@
 //! The functions a large tree composes of other generated functions (`aba_joints`,
-//! `nonlinear_effects`, the base regressors, `frame_placement`, `frame_jacobian`,
+//! `nonlinear_effects`, the principal and base regressors, `frame_placement`, `frame_jacobian`,
 //! `frame_jacobian_time_variation`, `frame_motion`, `aba_derivatives`,
 //! `aba_joints_derivatives`) compute what their own graphs do: a
 //! UR5 generated with `compose_above(0)` against `robot_ur5::Ur5`. The UR5 is a
@@ -31,6 +31,7 @@ fn composed_functions_are_composed() {
         "aba_joints",
         "nonlinear_effects",
         "base_regressor",
+        "principal_regressor",
         "principal_base_regressor",
     ] {
         assert!(!names.contains(&composed), "{composed} has a graph of its own");
@@ -79,6 +80,10 @@ fn composed_functions_agree_with_their_own_graphs() {
         let (mut y, mut want) = ([[0.0; Ur5::NBASE]; 6], [[0.0; Ur5::NBASE]; 6]);
         Ur5Composed::base_regressor(&q, &v, &a, &mut y);
         Ur5::base_regressor(&q, &v, &a, &mut want);
+        check(&flat(&y), &flat(&want));
+        let (mut y, mut want) = ([[0.0; Ur5::NTHETA]; 6], [[0.0; Ur5::NTHETA]; 6]);
+        Ur5Composed::principal_regressor(&q, &v, &a, &mut y);
+        Ur5::principal_regressor(&q, &v, &a, &mut want);
         check(&flat(&y), &flat(&want));
         let (mut y, mut want) = ([[0.0; Ur5::NBASE_PRINCIPAL]; 6], [[0.0; Ur5::NBASE_PRINCIPAL]; 6]);
         Ur5Composed::principal_base_regressor(&q, &v, &a, &mut y);

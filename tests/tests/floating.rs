@@ -482,10 +482,11 @@ fn humanoid31_aba_joints_derivatives_match_finite_differences() {
     assert_eq!(dj, da);
 }
 
-/// `Y_b β = τ` and `Y_pb β_p = τ` on states the base analysis never saw, worst
-/// relative error over both parameterisations. The humanoid's base regressors are
-/// composed (the independent columns of the full ones), the quadruped's generated
-/// on their own.
+/// `Y_b β = τ`, `Y_pb β_p = τ` and `Y_θ θ = τ` on states the base analysis never saw,
+/// worst relative error over the three. The humanoid's base regressors are composed
+/// (the independent columns of the full ones), and so is its principal regressor
+/// (the standard one times each body's `P_i`); the quadruped's are generated on their
+/// own.
 fn base_regressors_reproduce_rnea<R: Robot>() -> f64 {
     let model = dyngen_reference::model_from_static(&R::MODEL);
     let nv = R::NV;
@@ -508,6 +509,9 @@ fn base_regressors_reproduce_rnea<R: Robot>() -> f64 {
         let mut y = vec![0.0; nv * R::NBASE_PRINCIPAL];
         R::principal_base_regressor(&s.q, &s.v, &s.a, &mut y);
         worst = worst.max(rel_err(&times(&y, &beta_p), &tau, 1.0));
+        let mut y = vec![0.0; nv * R::NTHETA];
+        R::principal_regressor(&s.q, &s.v, &s.a, &mut y);
+        worst = worst.max(rel_err(&times(&y, theta), &tau, 1.0));
     }
     worst
 }

@@ -101,6 +101,22 @@ fn split_module(formatted: &str) -> Option<(&str, &str)> {
     (formatted[close..].trim_end() == "}" && close >= inside).then(|| (&formatted[..inside], &formatted[inside..close]))
 }
 
+/// One module from its pieces, each formatted as the module holding some of its
+/// items: the first piece's attributes and opening line, every piece's inside, the
+/// closing brace.
+fn join_module(pieces: &[String]) -> Option<String> {
+    let mut out = String::new();
+    for (k, piece) in pieces.iter().enumerate() {
+        let (opening, inside) = split_module(piece)?;
+        if k == 0 {
+            out.push_str(opening);
+        }
+        out.push_str(inside);
+    }
+    out.push_str("}\n");
+    Some(out)
+}
+
 impl GeneratedCode {
     /// The code formatted with prettyplease, as written to files and snapshots, with
     /// a comment where each section (e.g. a body's step of a recursion) starts.
@@ -112,49 +128,27 @@ impl GeneratedCode {
     /// them), and put together: the same file as the whole formatted at once.
     pub fn pretty(&self) -> String {
         const PIECES: usize = 8;
-        let total: usize = self.bodies.iter().map(|(_, b)| b.to_string().len()).sum();
+        let sizes: Vec<usize> = self.bodies.iter().map(|(_, b)| b.to_string().len()).collect();
+        let total: usize = sizes.iter().sum();
         let mut texts = vec![self.head.to_string(), self.tail.to_string()];
-        let mut chunk: Vec<&TokenStream> = Vec::new();
-        let mut size = 0;
+        let (mut chunk, mut size) = (Vec::new(), 0);
         for (k, (_, body)) in self.bodies.iter().enumerate() {
-            size += body.to_string().len();
             chunk.push(body);
+            size += sizes[k];
             if size * PIECES >= total || k + 1 == self.bodies.len() {
                 texts.push(home_module(&self.home, chunk.drain(..)).to_string());
                 size = 0;
             }
         }
-        if self.bodies.is_empty() {
-            texts.push(home_module(&self.home, std::iter::empty()).to_string());
-        }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let formatted = format_pieces(&texts, threads);
-        let assembled = (|| {
-            let [head, tail, modules @ ..] = &formatted[..] else {
-                return None;
+        let formatted: Option<Vec<String>> = format_pieces(&texts, threads).into_iter().collect();
+        let assembled = formatted.and_then(|f| {
+            let module = match &f[2..] {
+                [] => format_piece(&home_module(&self.home, std::iter::empty()).to_string())?,
+                pieces => join_module(pieces)?,
             };
-            let (head, tail) = (head.as_deref()?, tail.as_deref()?);
-            let mut out = String::from(head);
-            let mut first = true;
-            for m in modules {
-                let m = m.as_deref()?;
-                if self.bodies.is_empty() {
-                    out.push_str(m);
-                    continue;
-                }
-                let (opening, inside) = split_module(m)?;
-                if first {
-                    out.push_str(opening);
-                    first = false;
-                }
-                out.push_str(inside);
-            }
-            if !self.bodies.is_empty() {
-                out.push_str("}\n");
-            }
-            out.push_str(tail);
-            Some(out)
-        })();
+            Some(format!("{}{module}{}", f[0], f[1]))
+        });
         assembled.unwrap_or_else(|| self.tokens.to_string())
     }
 
@@ -1616,6 +1610,30 @@ fn robot_type(
             fn op_counts() -> &'static [(&'static str, ::dyngen::OpCount)] { &Self::OP_COUNTS }
 
             #(#methods)*
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `pretty` formats the robot type, the frame enum and the bodies' module in pieces
+    /// on threads of their own: the result is the file formatted whole, byte for byte,
+    /// with every function of its own and with every composable one composed.
+    #[test]
+    fn pieces_formatted_apart_make_the_file_formatted_whole() {
+        let model = dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap();
+        let bases = crate::analyse_model(&model);
+        for compose_above_nv in [usize::MAX, 0] {
+            let options = Options {
+                compose_above_nv,
+                ..Options::default()
+            };
+            let g = generate(&model, "Ur5", &bases, &options);
+            let whole = emit::comment_markers(&prettyplease::unparse(&syn::parse2(g.tokens.clone()).unwrap()));
+            assert!(g.bodies.len() > 8, "{} bodies: too few to be split", g.bodies.len());
+            assert_eq!(g.pretty(), whole);
         }
     }
 }

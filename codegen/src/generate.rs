@@ -829,8 +829,10 @@ impl Algorithm {
 
 /// The inherent function of `algorithm` composed of other generated functions, on a
 /// robot of more than `above` velocity coordinates (`None`: emit its own graph):
-/// `nonlinear_effects` is `rnea` at zero acceleration, and the base regressors are the
-/// independent columns of the full ones (which is what their graphs compute). `aba`
+/// `nonlinear_effects` is `rnea` at zero acceleration, the principal regressor is the
+/// standard one times each body's constant `P_i` (`π_i = P_i θ_i`), and the base
+/// regressors are the independent columns of the full ones (which is what their graphs
+/// compute). `aba`
 /// always has its own graph: without rotor inertias the articulated inertia passed to
 /// the parent has zero rows along the joint axes, which the one with them lacks.
 fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -> Option<TokenStream> {
@@ -987,7 +989,7 @@ struct DerivativeFns {
 /// By default, robots with more velocity coordinates than this get functions composed
 /// of other generated functions wherever a graph of their own would repeat another
 /// one's code ([`Options::compose_above_nv`], `Config::compose_above`):
-/// `nonlinear_effects` and the base regressors (see `composed`), `aba_joints` (see
+/// `nonlinear_effects`, the principal and base regressors (see `composed`), `aba_joints` (see
 /// `crate::joints`), `aba_derivatives` and `aba_joints_derivatives`, `frame_placement`,
 /// `frame_jacobian`, `frame_jacobian_time_variation` and `frame_motion` (see
 /// `crate::frames`). On large trees

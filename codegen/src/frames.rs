@@ -4,10 +4,10 @@
 //! mass's Jacobian and the centroidal momentum matrix with its time variation. Each frame's functions walk only the bodies between the
 //! base and the frame, so only the Jacobian columns of the joints on that path are
 //! computed; the others are exact zeros. A large tree (more than
-//! [`crate::Options::compose_above_nv`] coordinates) carries no function per frame: its
-//! placements come from [`build_placements`], its Jacobians and their time variations
-//! from the world axes of all coordinates ([`build_axes`],
-//! [`build_axes_time_variation`]), each frame's columns put together at run time.
+//! [`crate::Options::compose_above_nv`] coordinates) carries one function per frame, the
+//! Jacobian: its placements come from [`build_placements`], its Jacobians' time variations from the
+//! world axes of all coordinates and their time derivatives
+//! ([`build_axes_time_variation`]), each frame's columns put together at run time.
 //!
 //! Everything is built in world axes at the frame origin (Pinocchio's
 //! `LOCAL_WORLD_ALIGNED`): joint `k`'s column is `[z_k × (p − o_k); z_k]` for a
@@ -264,8 +264,8 @@ pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<
     out
 }
 
-/// What a large tree composes every frame's Jacobian of
-/// (`dyngen::__private::frame_jacobian_from_axes`): each velocity coordinate's axis
+/// The first half of what a large tree composes every frame's `J̇` of (see
+/// [`build_axes_time_variation`]): each velocity coordinate's axis
 /// `z` and origin `o` in the world, 6 per coordinate (the origin of a translation
 /// unused), then each frame's placement, 12 per frame; and whether each coordinate
 /// is a rotation (`true`) or a translation.
@@ -532,6 +532,13 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             format!("__frame_jacobian_dot_{f}"),
             format!("__frame_motion_{f}"),
         );
+        // The enum's dispatch to them (a large tree's functions use only the Jacobian's).
+        let variant = &variants[f];
+        let [pi, ji, di, mi] = [&pn, &jn, &dn, &mn].map(|name| format_ident!("{}", name));
+        placement_fns.push(quote!(#fty::#variant => Self::#pi(q)));
+        jacobian_fns.push(quote!(#fty::#variant => Self::#ji(q, out)));
+        jacobian_dot_fns.push(quote!(#fty::#variant => Self::#di(q, v, out)));
+        motion_fns.push(quote!(#fty::#variant => Self::#mi(q, v, a)));
         // A large tree takes one frame's placement from all of them (`frame_placements`,
         // below) rather than carry a function per frame.
         let mut t = TokenStream::new();
@@ -550,11 +557,6 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             t.extend(emit_one(spec, &g, format!("frame_placement[{label}]")));
         }
 
-        // A large tree composes every frame's Jacobian and its time variation of the
-        // axes of all coordinates (`__frame_axes`, below).
-        if large {
-            continue;
-        }
         let g = Graph::new();
         let outputs = build_jacobian(&g, model, f);
         let place = move |k: usize| {
@@ -588,6 +590,13 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         };
         t.extend(emit_one(spec, &g, format!("frame_jacobian[{label}]")));
 
+        // A large tree composes every frame's `J̇` of the axes of all coordinates
+        // (`__frame_axes_time_variation`, below) and takes the motion from it, rather
+        // than carry two more functions per frame.
+        if large {
+            per_frame.push(t);
+            continue;
+        }
         let g = Graph::new();
         let outputs = build_jacobian_time_variation(&g, model, f);
         let spec = FnSpec {
@@ -637,57 +646,32 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
         }
         per_frame.push(t);
-        let v = &variants[f];
-        let (pn, jn, dn, mn) = (
-            format_ident!("{}", pn),
-            format_ident!("{}", jn),
-            format_ident!("{}", dn),
-            format_ident!("{}", mn),
-        );
-        placement_fns.push(quote!(#fty::#v => Self::#pn(q)));
-        jacobian_fns.push(quote!(#fty::#v => Self::#jn(q, out)));
-        jacobian_dot_fns.push(quote!(#fty::#v => Self::#dn(q, v, out)));
-        motion_fns.push(quote!(#fty::#v => Self::#mn(q, v, a)));
     }
 
-    // A large tree's Jacobians and their time variations, composed at run time of the
-    // axes of all coordinates and the placements of all frames (one function each).
-    let flat_output = |len: &proc_macro2::Literal| Output::InPlace {
-        place: Box::new(|k: usize| {
-            let k = emit::usize_lit(k);
-            quote!(out[#k])
-        }),
-        clear: quote!(*out = [<S as ::dyngen::Scalar>::ZERO; #len];),
-        views: TokenStream::new(),
-    };
+    // A large tree's Jacobian time variations, composed at run time of the axes of all
+    // coordinates, the placements of all frames and their time derivatives.
     let mut composed = None;
     if large {
         let g = Graph::new();
-        let (outputs, rotation) = build_axes(&g, model);
-        let axes_len = emit::usize_lit(outputs.len());
-        let spec = FnSpec {
-            name: "__frame_axes",
-            public: false,
-            doc: "Every coordinate's axis and origin and every frame's placement, in the world.".to_string(),
-            args: vec![q()],
-            ret: quote!([S; #axes_len]),
-            output: flat_output(&axes_len),
-            outputs,
-        };
-        let axes = emit_one(spec, &g, "frame_jacobian".to_string());
-        let g = Graph::new();
-        let (outputs, _) = build_axes_time_variation(&g, model);
-        let dot_len = emit::usize_lit(outputs.len());
+        let (outputs, rotation) = build_axes_time_variation(&g, model);
+        let len = emit::usize_lit(outputs.len());
         let spec = FnSpec {
             name: "__frame_axes_time_variation",
             public: false,
-            doc: "`Self::__frame_axes` and the time variations of the axes, origins and frame origins.".to_string(),
+            doc: "Every coordinate's axis and origin and every frame's placement in the world, then\nthe time variations of the axes, origins and frame origins.".to_string(),
             args: vec![q(), arg(ARG_V, "v", n)],
-            ret: quote!([S; #dot_len]),
-            output: flat_output(&dot_len),
+            ret: quote!([S; #len]),
+            output: Output::InPlace {
+                place: Box::new(|k: usize| {
+                    let k = emit::usize_lit(k);
+                    quote!(out[#k])
+                }),
+                clear: quote!(*out = [<S as ::dyngen::Scalar>::ZERO; #len];),
+                views: TokenStream::new(),
+            },
             outputs,
         };
-        let axes_dot = emit_one(spec, &g, "frame_jacobian_time_variation".to_string());
+        let axes = emit_one(spec, &g, "frame_jacobian_time_variation".to_string());
         let columns = model.frames.iter().map(|frame| {
             let c = path(model, frame.body)
                 .into_iter()
@@ -703,10 +687,8 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
                 /// the joints between the base and the frame.
                 const __FRAME_COLUMNS: [&'static [usize]; #nf_l] = [#(#columns),*];
                 #axes
-                #axes_dot
             },
-            axes_len,
-            dot_len,
+            len,
         ));
     }
 
@@ -823,17 +805,10 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let dispatch_doc = doc_attrs(&format!(
         "Frame `frame`'s placement in the world at `q` ({n} joint positions):\n`x_world = rotation · x_frame + translation`. {walks}"
     ));
-    let (jacobian_body, jacobian_dot_body, composed_items, composed_how) = match composed {
-        Some((items, axes_len, dot_len)) => (
+    let (jacobian_dot_body, composed_items, composed_how) = match composed {
+        Some((items, len)) => (
             quote! {
-                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #axes_len];
-                Self::__frame_axes(q, &mut axes);
-                ::dyngen::__private::frame_jacobian_from_axes(
-                    &axes, &Self::__COORDINATE_ROTATES, Self::__FRAME_COLUMNS[frame.index()], frame.index(), out,
-                );
-            },
-            quote! {
-                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #dot_len];
+                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #len];
                 Self::__frame_axes_time_variation(q, v, &mut axes);
                 ::dyngen::__private::frame_jacobian_time_variation_from_axes(
                     &axes, #nf_l, &Self::__COORDINATE_ROTATES, Self::__FRAME_COLUMNS[frame.index()], frame.index(), out,
@@ -841,18 +816,13 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             },
             items,
             format!(
-                "\nComposed of the axes of all coordinates and the placements of all frames,\ncomputed together (a robot of more than {above} velocity coordinates carries no\nfunction per frame for it)."
+                "\nComposed of the axes of all coordinates, the placements of all frames and their\ntime variations, computed together (a robot of more than {above} velocity coordinates\ncarries no function per frame for it)."
             ),
         ),
-        None => (
-            quote!(match frame { #(#jacobian_fns,)* }),
-            quote!(match frame { #(#jacobian_dot_fns,)* }),
-            TokenStream::new(),
-            String::new(),
-        ),
+        None => (quote!(match frame { #(#jacobian_dot_fns,)* }), TokenStream::new(), String::new()),
     };
     let jacobian_doc = doc_attrs(&format!(
-        "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`.{composed_how}"
+        "Frame `frame`'s placement and Jacobian (6 × {n}, rows `[linear; angular]`) at `q`, in\n`reference` (Pinocchio's `computeFrameJacobian`). Only the columns of the joints\nbetween the base and the frame are computed; the others are zero. Written to `out`."
     ));
     let jacobian_dot_doc = doc_attrs(&format!(
         "Frame `frame`'s placement, Jacobian `J` and its time variation `J̇(q, v)` (6 × {n} each)\nin `reference` (Pinocchio's `getFrameJacobianTimeVariation`), written to `out`:\n`ẍ = J q̈ + J̇ q̇`. `J̇` is the time derivative of `J` along `q̇ = v`.{composed_how}"
@@ -898,7 +868,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             pub fn frame_jacobian<S: ::dyngen::Scalar>(
                 q: &[S; #nq_l], frame: #fty, reference: ::dyngen::ReferenceFrame, out: &mut ::dyngen::FrameJacobian<S, #n_l>,
             ) {
-                #jacobian_body
+                match frame { #(#jacobian_fns,)* }
                 ::dyngen::__private::express_jacobian(out, reference);
             }
             #jacobian_dot_doc

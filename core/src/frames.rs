@@ -373,14 +373,12 @@ fn three<S: Scalar>(x: &[S], k: usize) -> [S; 3] {
     [x[k], x[k + 1], x[k + 2]]
 }
 
-/// Support for generated code (trees composing their frame Jacobians): frame
-/// `frame`'s placement and `LOCAL_WORLD_ALIGNED` Jacobian from `axes`, which holds
-/// each velocity coordinate's axis `z` and origin `o` in the world (6 per coordinate),
-/// then each frame's placement (12 per frame, the rotation row-major). Column `c`
-/// is `[z × (p − o); z]` where `rotates[c]`, `[z; 0]` otherwise, `p` the frame's
-/// origin; only the columns `support` are, the others are zero.
-#[doc(hidden)]
-pub fn __frame_jacobian_from_axes<S: Scalar, const N: usize>(
+/// Frame `frame`'s placement and `LOCAL_WORLD_ALIGNED` Jacobian from `axes`, which
+/// holds each velocity coordinate's axis `z` and origin `o` in the world (6 per
+/// coordinate), then each frame's placement (12 per frame, the rotation row-major).
+/// Column `c` is `[z × (p − o); z]` where `rotates[c]`, `[z; 0]` otherwise, `p` the
+/// frame's origin; only the columns `support` are, the others are zero.
+fn frame_jacobian_from_axes<S: Scalar, const N: usize>(
     axes: &[S],
     rotates: &[bool; N],
     support: &[usize],
@@ -408,9 +406,9 @@ pub fn __frame_jacobian_from_axes<S: Scalar, const N: usize>(
     }
 }
 
-/// Support for generated code (trees composing their frame Jacobians): frame
-/// `frame`'s placement, `LOCAL_WORLD_ALIGNED` Jacobian and its time variation from
-/// `axes`, which holds what [`__frame_jacobian_from_axes`] reads (for `nframes`
+/// Support for generated code (trees composing their frames' `J̇`): frame `frame`'s
+/// placement, `LOCAL_WORLD_ALIGNED` Jacobian and its time variation from `axes`,
+/// which holds what [`frame_jacobian_from_axes`] reads (for `nframes`
 /// frames), then the time derivatives `ż, ȯ` of each coordinate's axis and origin (6
 /// per coordinate) and `ṗ` of each frame's origin (3 per frame). Column `c` of `J̇` is
 /// the time derivative of `J`'s: `[ż × (p − o) + z × (ṗ − ȯ); ż]` for a rotation,
@@ -425,7 +423,7 @@ pub fn __frame_jacobian_time_variation_from_axes<S: Scalar, const N: usize>(
     out: &mut FrameJacobianTimeVariation<S, N>,
 ) {
     let mut j = FrameJacobian::default();
-    __frame_jacobian_from_axes(axes, rotates, support, frame, &mut j);
+    frame_jacobian_from_axes(axes, rotates, support, frame, &mut j);
     (out.placement, out.jacobian) = (j.placement, j.jacobian);
     out.jacobian_dot = [[S::ZERO; N]; 6];
     let dots = 6 * N + 12 * nframes;

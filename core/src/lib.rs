@@ -50,7 +50,6 @@ pub mod __private {
     pub use crate::derivatives::__times_minus_minv_sparse as times_minus_minv_sparse;
     pub use crate::frames::__express_jacobian as express_jacobian;
     pub use crate::frames::__express_jacobian_time_variation as express_jacobian_time_variation;
-    pub use crate::frames::__frame_jacobian_from_axes as frame_jacobian_from_axes;
     pub use crate::frames::__frame_jacobian_time_variation_from_axes as frame_jacobian_time_variation_from_axes;
     pub use crate::frames::__frame_motion as frame_motion;
     pub use crate::joints::__tree_ldl_solve as tree_ldl_solve;

@@ -617,34 +617,32 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         };
         t.extend(emit_one(spec, &g, format!("frame_jacobian_time_variation[{label}]")));
 
-        {
-            let g = Graph::new();
-            let outputs = build_motion(&g, model, f);
-            let assemble = |o: &[TokenStream]| {
-                let pose = Record::Pose.build(&o[..12]);
-                let m = |s: &[TokenStream]| {
-                    let (l, a) = (&s[..3], &s[3..]);
-                    quote!(::dyngen::Motion {
-                        linear: ::dyngen::nalgebra::Vector3::new(#(#l),*),
-                        angular: ::dyngen::nalgebra::Vector3::new(#(#a),*),
-                    })
-                };
-                let (v, a) = (m(&o[12..18]), m(&o[18..24]));
-                quote!(::dyngen::FrameMotion { placement: #pose, velocity: #v, acceleration: #a })
+        let g = Graph::new();
+        let outputs = build_motion(&g, model, f);
+        let assemble = |o: &[TokenStream]| {
+            let pose = Record::Pose.build(&o[..12]);
+            let m = |s: &[TokenStream]| {
+                let (l, a) = (&s[..3], &s[3..]);
+                quote!(::dyngen::Motion {
+                    linear: ::dyngen::nalgebra::Vector3::new(#(#l),*),
+                    angular: ::dyngen::nalgebra::Vector3::new(#(#a),*),
+                })
             };
-            let spec = FnSpec {
-                name: &mn,
-                public: false,
-                doc: format!(
-                    "The placement, velocity and classical acceleration of frame `{label}`,\n`LOCAL_WORLD_ALIGNED`."
-                ),
-                args: vec![q(), arg(ARG_V, "v", n), arg(ARG_A, "a", n)],
-                ret: quote!(::dyngen::FrameMotion<S>),
-                output: Output::Return(Box::new(assemble)),
-                outputs,
-            };
-            t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
-        }
+            let (v, a) = (m(&o[12..18]), m(&o[18..24]));
+            quote!(::dyngen::FrameMotion { placement: #pose, velocity: #v, acceleration: #a })
+        };
+        let spec = FnSpec {
+            name: &mn,
+            public: false,
+            doc: format!(
+                "The placement, velocity and classical acceleration of frame `{label}`,\n`LOCAL_WORLD_ALIGNED`."
+            ),
+            args: vec![q(), arg(ARG_V, "v", n), arg(ARG_A, "a", n)],
+            ret: quote!(::dyngen::FrameMotion<S>),
+            output: Output::Return(Box::new(assemble)),
+            outputs,
+        };
+        t.extend(emit_one(spec, &g, format!("frame_motion[{label}]")));
         per_frame.push(t);
     }
 

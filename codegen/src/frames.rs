@@ -264,51 +264,47 @@ pub fn build_jacobian_time_variation(g: &Graph, model: &Model, f: usize) -> Vec<
     out
 }
 
-/// The first half of what a large tree composes every frame's `J̇` of (see
-/// [`build_axes_time_variation`]): each velocity coordinate's axis
-/// `z` and origin `o` in the world, 6 per coordinate (the origin of a translation
-/// unused), then each frame's placement, 12 per frame; and whether each coordinate
-/// is a rotation (`true`) or a translation.
-pub fn build_axes(g: &Graph, model: &Model) -> (Vec<NodeId>, Vec<bool>) {
+/// What a large tree composes every frame's `J̇` of
+/// (`dyngen::__private::frame_jacobian_time_variation_from_axes`), from one walk over
+/// all bodies with their velocities: each velocity coordinate's axis `z` and origin
+/// `o` in the world (6 per coordinate; the origin of a translation unused), each
+/// frame's placement (12 per frame), then the time derivatives along `q̇ = v` of the
+/// axes and origins (6 per coordinate) and of the frame origins (3 per frame); and
+/// whether each coordinate is a rotation (`true`) or a translation. Every axis is
+/// fixed in the body its joint moves (or, for a rotation, unmoved by it), so
+/// `ż = ω × z` with that body's angular velocity `ω`; the origin moves with the
+/// body's origin, `ȯ = v`; a frame's origin at `e` from its body's, `ṗ = v + ω × e`.
+pub fn build_axes_time_variation(g: &Graph, model: &Model) -> (Vec<NodeId>, Vec<bool>) {
     let n = model.dof();
     let all: Vec<usize> = (1..=n).collect();
-    let (world, joints) = walk(g, model, &all, Walk::Placement);
-    let mut out = vec![g.zero().id(); 6 * model.nv()];
-    let mut rotation = vec![false; model.nv()];
+    let (world, joints) = walk(g, model, &all, Walk::Motion);
+    let nv = model.nv();
+    let mut axes = vec![V3::zero(g); 2 * nv];
+    let mut rates = vec![V3::zero(g); 2 * nv];
+    let mut rotation = vec![false; nv];
     for k in 1..=n {
-        let j = walked(&joints, k);
+        let (j, b) = (walked(&joints, k), walked(&world, k));
         for (dof, c) in j.dofs().iter().zip(crate::algo::dofs(model, k)) {
             let z = match dof {
                 WorldDof::Rotation(z) => {
                     rotation[c] = true;
-                    z
+                    *z
                 }
-                WorldDof::Translation(z) => z,
+                WorldDof::Translation(z) => *z,
             };
-            for (r, x) in v3_ids(z).chain(v3_ids(&j.o)).enumerate() {
-                out[6 * c + r] = x;
-            }
+            (axes[2 * c], axes[2 * c + 1]) = (z, j.o);
+            (rates[2 * c], rates[2 * c + 1]) = (b.w.cross(z), b.v);
         }
     }
+    let mut out: Vec<NodeId> = axes.iter().flat_map(v3_ids).collect();
+    let mut frame_rates = Vec::new();
     for f in 0..model.frames.len() {
-        let (r, t, _) = frame_pose(g, model, f, &walked(&world, model.frames[f].body));
+        let b = walked(&world, model.frames[f].body);
+        let (r, t, e) = frame_pose(g, model, f, &b);
         out.extend(pose_ids(&r, &t));
+        frame_rates.push(b.v + b.w.cross(e));
     }
-    (out, rotation)
-}
-
-/// [`build_axes`] followed by the time derivatives along `q̇ = v` of the axes and
-/// origins (6 per coordinate) and of the frame origins (3 per frame): what a large
-/// tree composes every frame's `J̇` of.
-pub fn build_axes_time_variation(g: &Graph, model: &Model) -> (Vec<NodeId>, Vec<bool>) {
-    let (mut out, rotation) = build_axes(g, model);
-    let axes = 6 * model.nv();
-    let mut moving = out[..axes].to_vec();
-    for f in 0..model.frames.len() {
-        moving.extend(&out[axes + 12 * f + 9..axes + 12 * f + 12]);
-    }
-    let dot = time_derivatives(g, model, &moving);
-    out.extend(dot.iter().map(|x| x.id()));
+    out.extend(rates.iter().chain(&frame_rates).flat_map(v3_ids));
     (out, rotation)
 }
 

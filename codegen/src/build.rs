@@ -59,8 +59,7 @@ pub struct Config {
     out_dir: Option<PathBuf>,
     file_name: Option<String>,
     gravity: Option<[f64; 3]>,
-    strict: bool,
-    free_flyer: bool,
+    load: dyngen_model::LoadOptions,
     options: Options,
 }
 
@@ -87,12 +86,21 @@ impl Config {
         self
     }
 
-    /// Refuse inertias that break positive definiteness or the triangle inequality
-    /// within the tolerance for CAD rounding
-    /// ([`INERTIA_TOLERANCE`](dyngen_model::INERTIA_TOLERANCE)); by default they are
-    /// accepted as written and each printed as a `cargo:warning`.
+    /// Refuse what is otherwise accepted with a `cargo:warning`: body inertias that
+    /// break positive definiteness or the triangle inequality (within the tolerance
+    /// for CAD rounding, [`INERTIA_TOLERANCE`](dyngen_model::INERTIA_TOLERANCE), or
+    /// beyond it), a joint along which nothing with mass moves (a singular mass
+    /// matrix). By default they are accepted as written, as Pinocchio reads them.
     pub fn strict(&mut self, strict: bool) -> &mut Config {
-        self.strict = strict;
+        self.load.strict = strict;
+        self
+    }
+
+    /// Replace every non-physical body inertia by the nearest physical one (MuJoCo's
+    /// `balanceinertia`; each printed as a `cargo:warning` with the moments before
+    /// and after) instead of keeping it as written.
+    pub fn balance_inertia(&mut self, balance: bool) -> &mut Config {
+        self.load.balance_inertia = balance;
         self
     }
 
@@ -100,7 +108,7 @@ impl Config {
     /// Pinocchio's `buildModel(urdf, JointModelFreeFlyer())` (joint 1 `root_joint`,
     /// `q = [p; x, y, z, w; joints]`, `v = [v; ω; joints]` in the base frame).
     pub fn free_flyer(&mut self, free_flyer: bool) -> &mut Config {
-        self.free_flyer = free_flyer;
+        self.load.free_flyer = free_flyer;
         self
     }
 
@@ -134,11 +142,7 @@ impl Config {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
         }
-        let options = dyngen_model::LoadOptions {
-            strict: self.strict,
-            free_flyer: self.free_flyer,
-        };
-        let model = dyngen_model::load_robot_options(&urdf, options).map_err(Error::Model)?;
+        let model = dyngen_model::load_robot_options(&urdf, self.load).map_err(Error::Model)?;
         for w in &model.warnings {
             println!("cargo:warning={}: {}", urdf.display(), w.warning_message());
         }

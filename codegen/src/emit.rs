@@ -1,5 +1,5 @@
 //! Emitters: symbolic outputs in, straight-line Rust out (`quote!`, no strings).
-//! A long body is written in blocks of statements ([`grouped`]), because rustc's
+//! A long body is written in blocks of statements (`grouped`), because rustc's
 //! debug-info emitter overflows on a few thousand nested `let` scopes. A body longer
 //! than the statement budget is split into `#[inline(never)]` parts that pass
 //! intermediate values through a stack array, which bounds the optimiser's work
@@ -61,7 +61,7 @@ pub fn matrix_output() -> Output<'static> {
             let k = usize_lit(k);
             quote!(out[#k])
         }),
-        clear: quote!(out.as_flattened_mut().fill(<S as ::dyngen::Scalar>::ZERO);),
+        clear: quote!(out.as_flattened_mut().fill(S::ZERO);),
         views: quote!(let out = out.as_flattened_mut();),
     }
 }
@@ -479,7 +479,7 @@ pub fn emit_fn(graph: &Graph, spec: &FnSpec<'_>, max_statements: usize, home: &I
     };
     let body = quote! {
         pub fn #fname<S: ::dyngen::Scalar>(#(#params,)* #out_param) #ret_ty {
-            let mut w = [<S as ::dyngen::Scalar>::ZERO; #width];
+            let mut w = [S::ZERO; #width];
             { #(#early_stores)* }
             #(#calls)*
             #value
@@ -717,11 +717,11 @@ impl Names<'_> {
             }
             Node::Sin(a) => {
                 let a = op(a, SUM);
-                (quote!(::dyngen::Scalar::sin(#a)), ATOM)
+                (quote!(S::sin(#a)), ATOM)
             }
             Node::Cos(a) => {
                 let a = op(a, SUM);
-                (quote!(::dyngen::Scalar::cos(#a)), ATOM)
+                (quote!(S::cos(#a)), ATOM)
             }
             Node::Const(_) | Node::Input { .. } => (TokenStream::new(), ATOM),
         }
@@ -746,8 +746,7 @@ impl Names<'_> {
                 quote!(-#e)
             }
         };
-        let mul_add =
-            |x: TokenStream, y: TokenStream, z: TokenStream| quote!(<S as ::dyngen::Scalar>::mul_add(#x, #y, #z));
+        let mul_add = |x: TokenStream, y: TokenStream, z: TokenStream| quote!(S::mul_add(#x, #y, #z));
         match node {
             Node::Add(a, b) => match (product(a), product(b)) {
                 (_, Some((x, y))) => Some(mul_add(arg(x), arg(y), arg(a))),
@@ -803,13 +802,13 @@ impl Names<'_> {
 /// A constant as the scalar type: `S::from_f64(0.425)`.
 pub fn constant(x: f64) -> TokenStream {
     if x == 0.0 {
-        return quote!(<S as ::dyngen::Scalar>::ZERO);
+        return quote!(S::ZERO);
     }
     let lit = float_literal(x.abs());
     if x.is_sign_negative() && x != 0.0 {
-        quote!(<S as ::dyngen::Scalar>::from_f64(-#lit))
+        quote!(S::from_f64(-#lit))
     } else {
-        quote!(<S as ::dyngen::Scalar>::from_f64(#lit))
+        quote!(S::from_f64(#lit))
     }
 }
 
@@ -819,7 +818,7 @@ fn emit_stmt(graph: &Graph, s: &Stmt, names: &Names<'_>) -> TokenStream {
         Node::Sin(a) if s.defines.len() == 2 => {
             let c = var(s.defines[1]);
             let a = names.operand(graph, a);
-            quote!(let (#x, #c) = ::dyngen::Scalar::sin_cos(#a);)
+            quote!(let (#x, #c) = S::sin_cos(#a);)
         }
         Node::Const(_) | Node::Input { .. } => TokenStream::new(),
         node => {

@@ -435,7 +435,9 @@ pub fn build_centroidal_map_time_variation(g: &Graph, model: &Model) -> Vec<Node
 }
 
 /// A Rust identifier for frame names: `wrist_3_link` → `Wrist3Link`, unique among
-/// the frames (a numeric suffix where two names would meet).
+/// the frames: where two names would meet (`a`, `A`, `a.`), the later frame's index
+/// `k` is appended, and should that be taken too (by a frame `a3`), `_1`, `_2`, …
+/// after it, so the names depend only on the frames and their order.
 fn variant_names(model: &Model) -> Vec<syn::Ident> {
     let mut taken = std::collections::HashSet::new();
     model
@@ -458,8 +460,13 @@ fn variant_names(model: &Model) -> Vec<syn::Ident> {
                 s = format!("Frame{s}");
             }
             if !taken.insert(s.clone()) {
-                s = format!("{s}{k}");
-                taken.insert(s.clone());
+                let base = format!("{s}{k}");
+                s = base.clone();
+                let mut j = 0;
+                while !taken.insert(s.clone()) {
+                    j += 1;
+                    s = format!("{base}_{j}");
+                }
             }
             format_ident!("{}", s)
         })
@@ -660,7 +667,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
                     let k = emit::usize_lit(k);
                     quote!(out[#k])
                 }),
-                clear: quote!(*out = [<S as ::dyngen::Scalar>::ZERO; #len];),
+                clear: quote!(*out = [S::ZERO; #len];),
                 views: TokenStream::new(),
             },
             outputs,
@@ -774,7 +781,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
                     quote!(map_dot[#i])
                 }
             }),
-            clear: quote!(*out = ([[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6], [[<S as ::dyngen::Scalar>::ZERO; #n_l]; 6]);),
+            clear: quote!(*out = ([[S::ZERO; #n_l]; 6], [[S::ZERO; #n_l]; 6]);),
             views: quote! {
                 let map = out.0.as_flattened_mut();
                 let map_dot = out.1.as_flattened_mut();
@@ -784,7 +791,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     };
     let centroidal_dot = emit_one(spec, &g, "centroidal_map_time_variation".to_string());
 
-    let zero_a = quote!(&[<S as ::dyngen::Scalar>::ZERO; #n_l]);
+    let zero_a = quote!(&[S::ZERO; #n_l]);
     let (placement_body, walks) = if large {
         (
             quote!(Self::frame_placements(q)[frame.index()]),
@@ -802,7 +809,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let (jacobian_dot_body, composed_items, composed_how) = match composed {
         Some((items, len)) => (
             quote! {
-                let mut axes = [<S as ::dyngen::Scalar>::ZERO; #len];
+                let mut axes = [S::ZERO; #len];
                 Self::__frame_axes_time_variation(q, v, &mut axes);
                 ::dyngen::__private::frame_jacobian_time_variation_from_axes(
                     &axes, #nf_l, &Self::__COORDINATE_ROTATES, Self::__FRAME_COLUMNS[frame.index()], frame.index(), out,
@@ -1005,7 +1012,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         }
         fn centroidal_map_time_variation<S: ::dyngen::Scalar>(q: &[S], v: &[S], params: &[S], a_g: &mut [S], a_g_dot: &mut [S]) {
             use ::dyngen::__private::{as_array, as_rows_mut};
-            let zero = [<S as ::dyngen::Scalar>::ZERO; #n_l];
+            let zero = [S::ZERO; #n_l];
             let mut both = ([zero; 6], [zero; 6]);
             Self::centroidal_map_time_variation(as_array(q, "q"), as_array(v, "v"), as_array(params, "params"), &mut both);
             *as_rows_mut::<S, #n_l, 6>(a_g, "a_g") = both.0;
@@ -1070,5 +1077,87 @@ mod tests {
         unique.sort();
         unique.dedup();
         assert_eq!(unique.len(), names.len());
+    }
+
+    /// A name with a carriage return or a text-direction control would make the
+    /// generated documentation lie or not compile: the front end refuses it, naming
+    /// the file and line, and nothing is generated.
+    #[test]
+    fn control_characters_in_names_stop_generation() {
+        let dir = std::env::temp_dir().join(format!("dyngen-frames-names-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (k, bad) in ["a&#13;b", "a\u{202e}b", "a\rb"].iter().enumerate() {
+            let urdf = dir.join(format!("bad{k}.urdf"));
+            let text = format!(
+                "<robot name=\"r\">\n<link name=\"base\"/>\n<link name=\"{bad}\"><inertial><mass value=\"1\"/>\
+                 <inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n\
+                 <joint name=\"j\" type=\"continuous\"><parent link=\"base\"/><child link=\"{bad}\"/></joint>\n\
+                 </robot>"
+            );
+            std::fs::write(&urdf, text).unwrap();
+            let err = crate::Config::new()
+                .out_dir(&dir)
+                .compile_urdf(&urdf, "Bad")
+                .unwrap_err();
+            let message = err.to_string();
+            assert!(message.starts_with(&format!("{}:3: ", urdf.display())), "{message}");
+            assert!(
+                message.contains("a name must be printable text on one line"),
+                "{message}"
+            );
+            assert!(!dir.join(format!("bad{k}.rs")).exists());
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Names that differ only in case or punctuation, where the numeric suffix of one
+    /// would meet another's name (`a3` → `A3`, then `a.` → `A` + 3), still give
+    /// distinct identifiers, and the generated code parses.
+    #[test]
+    fn colliding_frame_names_get_distinct_identifiers() {
+        let link = |name: &str| {
+            format!(
+                "<link name=\"{name}\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\" \
+                 ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>"
+            )
+        };
+        let names = ["a3", "a", "A", "a.", "A3", "a_3", "A3_1"];
+        let mut urdf = String::from("<robot name=\"r\"><link name=\"base\"/>");
+        let mut parent = "base";
+        for (k, name) in names.iter().enumerate() {
+            urdf += &link(name);
+            // One moving joint, so that generation is quick; fixed links are frames too.
+            let kind = if k == 0 { "continuous" } else { "fixed" };
+            urdf += &format!(
+                "<joint name=\"j{k}\" type=\"{kind}\"><parent link=\"{parent}\"/><child link=\"{name}\"/>\
+                 <axis xyz=\"0 0 1\"/><origin xyz=\"0 0 0.1\"/></joint>"
+            );
+            parent = name;
+        }
+        urdf += "</robot>";
+        let model = dyngen_model::parse_urdf(&urdf).expect("valid URDF");
+        let variants: Vec<String> = variant_names(&model).iter().map(|i| i.to_string()).collect();
+        let mut unique = variants.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), variants.len(), "{variants:?}");
+        assert_eq!(&variants[..5], ["Base", "A3", "A", "A3_1", "A4"], "{variants:?}");
+
+        let bases = crate::base::analyse_model(&model);
+        let code = crate::generate(&model, "Colliding", &bases, &crate::Options::default()).file("colliding.urdf");
+        let file = syn::parse_file(&code).expect("the generated code parses");
+        let frame_enum = file
+            .items
+            .iter()
+            .find_map(|item| match item {
+                syn::Item::Enum(e) if e.ident == "CollidingFrame" => Some(e),
+                _ => None,
+            })
+            .expect("the frame enum");
+        let mut found: Vec<String> = frame_enum.variants.iter().map(|v| v.ident.to_string()).collect();
+        assert_eq!(found, variants);
+        found.sort();
+        found.dedup();
+        assert_eq!(found.len(), model.frames.len());
     }
 }

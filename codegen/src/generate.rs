@@ -128,23 +128,25 @@ impl GeneratedCode {
     /// them), and put together: the same file as the whole formatted at once.
     pub fn pretty(&self) -> String {
         const PIECES: usize = 8;
-        let sizes: Vec<usize> = self.bodies.iter().map(|(_, b)| b.to_string().len()).collect();
-        let total: usize = sizes.iter().sum();
+        let bodies: Vec<String> = self.bodies.iter().map(|(_, b)| b.to_string()).collect();
+        let total: usize = bodies.iter().map(String::len).sum();
+        // The module's text up to its closing brace, which each piece puts after its bodies.
+        let empty = home_module(&self.home, std::iter::empty()).to_string();
+        let opening = empty.trim_end().strip_suffix('}').unwrap_or(&empty);
         let mut texts = vec![self.head.to_string(), self.tail.to_string()];
-        let (mut chunk, mut size) = (Vec::new(), 0);
-        for (k, (_, body)) in self.bodies.iter().enumerate() {
-            chunk.push(body);
-            size += sizes[k];
-            if size * PIECES >= total || k + 1 == self.bodies.len() {
-                texts.push(home_module(&self.home, chunk.drain(..)).to_string());
-                size = 0;
+        let mut piece = String::from(opening);
+        for (k, body) in bodies.iter().enumerate() {
+            piece.push_str(body);
+            if (piece.len() - opening.len()) * PIECES >= total || k + 1 == bodies.len() {
+                piece.push('}');
+                texts.push(std::mem::replace(&mut piece, String::from(opening)));
             }
         }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let formatted: Option<Vec<String>> = format_pieces(&texts, threads).into_iter().collect();
         let assembled = formatted.and_then(|f| {
             let module = match &f[2..] {
-                [] => format_piece(&home_module(&self.home, std::iter::empty()).to_string())?,
+                [] => format_piece(&empty)?,
                 pieces => join_module(pieces)?,
             };
             Some(format!("{}{module}{}", f[0], f[1]))
@@ -840,7 +842,7 @@ fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -
         return None;
     }
     let [n_l, nq_l, np_l] = [sizes.nv, sizes.nq, 10 * sizes.n].map(emit::usize_lit);
-    let zero = quote!(<S as ::dyngen::Scalar>::ZERO);
+    let zero = quote!(S::ZERO);
     let columns = |full: &str, cols: usize, index: &str, base: usize| {
         let (full, index) = (format_ident!("{}", full), format_ident!("{}", index));
         let (c_l, b_l) = (emit::usize_lit(cols), emit::usize_lit(base));
@@ -1123,7 +1125,7 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
             #inverse_doc
             #[inline]
             pub fn inverse_inertia<S: ::dyngen::Scalar>(q: &[S; #nq_l], params: &[S; #np_l], out: &mut [[S; #n_l]; #n_l]) {
-                Self::__inverse_inertia(q, params, &[<S as ::dyngen::Scalar>::ZERO; #nj_l], out);
+                Self::__inverse_inertia(q, params, &[S::ZERO; #nj_l], out);
             }
             #inverse
         },
@@ -1190,7 +1192,7 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
             }
         })
     };
-    let zeros = quote!(&[<S as ::dyngen::Scalar>::ZERO; #nj_l]);
+    let zeros = quote!(&[S::ZERO; #nj_l]);
     let plain = forward(zeros, TokenStream::new());
     let aba_doc = doc_attrs(&format!(
         "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. {}; the products with `M⁻¹` run as\nloops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
@@ -1354,6 +1356,7 @@ fn model_expr(model: &Model) -> TokenStream {
             }
             None => quote!(::core::option::Option::None),
         };
+        let armature = emit::f64_lit(j.dynamics.armature);
         let damping = emit::f64_lit(j.dynamics.damping);
         let friction = emit::f64_lit(j.dynamics.friction);
         quote!(::dyngen::JointModel {
@@ -1364,6 +1367,7 @@ fn model_expr(model: &Model) -> TokenStream {
             translation: #translation,
             axis: #axis,
             limits: #limits,
+            armature: #armature,
             damping: #damping,
             friction: #friction,
         })
@@ -1548,8 +1552,9 @@ fn robot_type(
             pub const NOMINAL_PARAMS: [f64; #np_lit] = #nominal;
             /// The description's principal parameters `theta = (m, J1, J2, J3)`, 4 per body.
             pub const NOMINAL_THETA: [f64; #nt_lit] = #theta;
-            /// The description's joint parameters, 4 per velocity coordinate `[Ia, Fv, Fc, F0]`: viscous and
-            /// Coulomb friction from URDF `<dynamics damping friction>`, rotor inertia and offset 0.
+            /// The description's joint parameters, 4 per velocity coordinate `[Ia, Fv, Fc, F0]`: rotor inertia
+            /// from MJCF `armature` (0 from a URDF), viscous and Coulomb friction from URDF `<dynamics damping
+            /// friction>` (MJCF `damping frictionloss`), offset 0.
             pub const NOMINAL_JOINT_PARAMS: [f64; #nj_lit] = #nominal_joints;
             #base_doc
             pub const BASE_GROUPINGS: [&'static str; #nb_lit] = [#(#groupings),*];

@@ -52,7 +52,7 @@ pub(crate) fn generate(
     let n = sizes.nv;
     let (np, nj, nb, nbj) = (10 * sizes.n, 4 * n, sizes.nb, sizes.nbj);
     let [n_l, nq_l, np_l, nj_l, nb_l, nbj_l, nw_l] = [n, sizes.nq, np, nj, nb, nbj, np + nj].map(emit::usize_lit);
-    let s = quote!(<S as ::dyngen::Scalar>);
+    let s = quote!(S);
     let jp = quote!(::dyngen::__private::joint_at(joint_params, j));
     let coulomb_doc = "`coulomb`: `Coulomb::Sign` or `Coulomb::smooth(ε)`";
 

@@ -66,6 +66,14 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
     let bases = base::analyse_model(&model);
     let generated = generate(&model, &name, &bases, &Options::default());
     let tokens = generated.tokens;
+    let span = match &input.source {
+        RobotSource::Urdf(lit) => lit.span(),
+        RobotSource::Dsl(_) => input.name.span(),
+    };
+    let warnings = model
+        .warnings
+        .iter()
+        .map(|w| compile_warning(span, &w.warning_message()));
     // Make the crate rebuild when the URDF changes.
     let watch = rebuild_on.map(|p| {
         let p = p.to_string_lossy().into_owned();
@@ -73,7 +81,21 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
             const _: &[u8] = include_bytes!(#p);
         )
     });
-    Ok(quote!(#tokens #watch))
+    Ok(quote!(#tokens #watch #(#warnings)*))
+}
+
+/// A compiler warning at `span` saying `message`, from a procedural macro on stable
+/// Rust: the use of a deprecated constant, whose note is the message (rustc prints
+/// "use of deprecated constant …: message"). What `build.rs` prints as
+/// `cargo:warning`, the macro says so; a crate built with `-D warnings` refuses it.
+fn compile_warning(span: proc_macro2::Span, message: &str) -> TokenStream {
+    quote::quote_spanned!(span=>
+        const _: () = {
+            #[deprecated(note = #message)]
+            const DYNGEN_WARNING: () = ();
+            DYNGEN_WARNING
+        };
+    )
 }
 
 fn manifest_path(path: &str) -> std::path::PathBuf {

@@ -70,7 +70,7 @@ fn model_errors_print_as_file_line_message() {
         .unwrap_err();
     let text = format!("{err:?}");
     assert!(
-        text.starts_with(&format!("{}:3: link `arm`: mass -1 is not positive", urdf.display())),
+        text.starts_with(&format!("{}:3: link `arm`: mass -1 is negative", urdf.display())),
         "{text}"
     );
     assert!(!dir.join("bad.rs").exists(), "nothing is written on error");
@@ -99,5 +99,76 @@ fn bad_type_name_and_missing_out_dir_are_errors() {
         .compile_urdf(dir.join("missing.urdf"), "Missing")
         .unwrap_err();
     assert!(err.to_string().contains("missing.urdf"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn non_physical_inertias_load_as_written_balanced_or_refused() {
+    let dir = scratch("balance");
+    let urdf = dir.join("pendulum.urdf");
+    // izz = 0.3 > ixx + iyy = 0.2: a third of the largest moment beyond physical.
+    std::fs::write(&urdf, PENDULUM.replace(r#"izz="0.01""#, r#"izz="0.3""#)).unwrap();
+    let generate = |config: &mut dyngen_codegen::Config, name: &str| {
+        config.out_dir(&dir).file_name(name).compile_urdf(&urdf, "Pendulum")
+    };
+    let written =
+        std::fs::read_to_string(generate(&mut dyngen_codegen::Config::new(), "as_written.rs").unwrap()).unwrap();
+    let balanced =
+        std::fs::read_to_string(generate(dyngen_codegen::Config::new().balance_inertia(true), "balanced.rs").unwrap())
+            .unwrap();
+    // As written, izz is the URDF's; balanced, the moments move by a third of the
+    // excess 0.1 toward J3 = J1 + J2: izz 0.3 -> 0.2666…
+    // The last standard parameter of the only body: Izz about its origin.
+    let izz = |text: &str| -> f64 {
+        let at = text.find("pub const NOMINAL_PARAMS").unwrap();
+        let list = &text[at..at + text[at..].find("];").unwrap()];
+        list.rsplit(',')
+            .map(str::trim)
+            .find(|x| !x.is_empty())
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(izz(&written), 0.3);
+    assert!((izz(&balanced) - 0.8 / 3.0).abs() < 1e-15, "{}", izz(&balanced));
+    let err = generate(dyngen_codegen::Config::new().strict(true), "strict.rs").unwrap_err();
+    assert!(format!("{err:?}").contains("break the triangle inequality"), "{err:?}");
+    assert!(!dir.join("strict.rs").exists(), "nothing is written on error");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_macro_turns_load_warnings_into_compiler_warnings() {
+    let dir = scratch("macro");
+    let urdf = dir.join("pendulum.urdf");
+    std::fs::write(&urdf, PENDULUM.replace(r#"izz="0.01""#, r#"izz="0.3""#)).unwrap();
+    let input: proc_macro2::TokenStream = format!("name: Pendulum, urdf: {:?}", urdf.display().to_string())
+        .parse()
+        .unwrap();
+    let out = dyngen_codegen::expand_robot_macro(input).unwrap().to_string();
+    // One deprecated constant per warning, its note the warning's message: rustc
+    // prints "use of deprecated constant …: line 3: link `arm`: …".
+    assert_eq!(
+        out.matches("deprecated").count(),
+        1,
+        "{}",
+        &out[out.len().saturating_sub(600)..]
+    );
+    let at = out.find("deprecated").unwrap();
+    assert!(
+        out[at..].contains("line 3: link `arm`: principal moments")
+            && out[at..].contains("break the triangle inequality"),
+        "{}",
+        &out[at..]
+    );
+    // A physical robot: no warning.
+    std::fs::write(&urdf, PENDULUM).unwrap();
+    let input: proc_macro2::TokenStream = format!("name: Pendulum, urdf: {:?}", urdf.display().to_string())
+        .parse()
+        .unwrap();
+    assert!(!dyngen_codegen::expand_robot_macro(input)
+        .unwrap()
+        .to_string()
+        .contains("deprecated"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

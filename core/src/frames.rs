@@ -359,60 +359,15 @@ fn velocity_from_lwa<S: Scalar>(placement: &Pose<S>, m: &Motion<S>, reference: R
     }
 }
 
-/// `a × b`.
-fn cross<S: Scalar>(a: [S; 3], b: [S; 3]) -> [S; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// Three consecutive entries of `x` from `k` on.
-fn three<S: Scalar>(x: &[S], k: usize) -> [S; 3] {
-    [x[k], x[k + 1], x[k + 2]]
-}
-
-/// Frame `frame`'s placement and `LOCAL_WORLD_ALIGNED` Jacobian from `axes`, which
-/// holds each velocity coordinate's axis `z` and origin `o` in the world (6 per
-/// coordinate), then each frame's placement (12 per frame, the rotation row-major).
-/// Column `c` is `[z × (p − o); z]` where `rotates[c]`, `[z; 0]` otherwise, `p` the
-/// frame's origin; only the columns `support` are, the others are zero.
-fn frame_jacobian_from_axes<S: Scalar, const N: usize>(
-    axes: &[S],
-    rotates: &[bool; N],
-    support: &[usize],
-    frame: usize,
-    out: &mut FrameJacobian<S, N>,
-) {
-    let f = &axes[6 * N + 12 * frame..6 * N + 12 * frame + 12];
-    out.placement = Pose {
-        rotation: Matrix3::new(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8]),
-        translation: Vector3::new(f[9], f[10], f[11]),
-    };
-    out.jacobian = [[S::ZERO; N]; 6];
-    let p = [f[9], f[10], f[11]];
-    for &c in support {
-        let (z, o) = (three(axes, 6 * c), three(axes, 6 * c + 3));
-        let (linear, angular) = if rotates[c] {
-            (cross(z, [p[0] - o[0], p[1] - o[1], p[2] - o[2]]), z)
-        } else {
-            (z, [S::ZERO; 3])
-        };
-        for r in 0..3 {
-            out.jacobian[r][c] = linear[r];
-            out.jacobian[3 + r][c] = angular[r];
-        }
-    }
-}
-
 /// Support for generated code (trees composing their frames' `J̇`): frame `frame`'s
-/// placement, `LOCAL_WORLD_ALIGNED` Jacobian and its time variation from `axes`,
-/// which holds what [`frame_jacobian_from_axes`] reads (for `nframes`
-/// frames), then the time derivatives `ż, ȯ` of each coordinate's axis and origin (6
-/// per coordinate) and `ṗ` of each frame's origin (3 per frame). Column `c` of `J̇` is
-/// the time derivative of `J`'s: `[ż × (p − o) + z × (ṗ − ȯ); ż]` for a rotation,
-/// `[ż; 0]` for a translation.
+/// placement, `LOCAL_WORLD_ALIGNED` Jacobian and its time variation from `axes`, which
+/// holds each velocity coordinate's axis `z` and origin `o` in the world (6 per
+/// coordinate), each of the `nframes` frames' placements (12 per frame, the rotation
+/// row-major), then the time derivatives `ż, ȯ` of each coordinate's axis and origin
+/// (6 per coordinate) and `ṗ` of each frame's origin (3 per frame). Column `c` of `J`
+/// is `[z × (p − o); z]` where `rotates[c]`, `[z; 0]` otherwise, `p` the frame's
+/// origin, and of `J̇` its time derivative, `[ż × (p − o) + z × (ṗ − ȯ); ż]` or
+/// `[ż; 0]`; only the columns `support` are, the others are zero.
 #[doc(hidden)]
 pub fn __frame_jacobian_time_variation_from_axes<S: Scalar, const N: usize>(
     axes: &[S],
@@ -422,32 +377,31 @@ pub fn __frame_jacobian_time_variation_from_axes<S: Scalar, const N: usize>(
     frame: usize,
     out: &mut FrameJacobianTimeVariation<S, N>,
 ) {
-    let mut j = FrameJacobian::default();
-    frame_jacobian_from_axes(axes, rotates, support, frame, &mut j);
-    (out.placement, out.jacobian) = (j.placement, j.jacobian);
+    let at = |k: usize| Vector3::new(axes[k], axes[k + 1], axes[k + 2]);
+    let f = &axes[6 * N + 12 * frame..6 * N + 12 * frame + 12];
+    out.placement = Pose {
+        rotation: Matrix3::new(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8]),
+        translation: Vector3::new(f[9], f[10], f[11]),
+    };
+    out.jacobian = [[S::ZERO; N]; 6];
     out.jacobian_dot = [[S::ZERO; N]; 6];
     let dots = 6 * N + 12 * nframes;
-    let p = three(axes, 6 * N + 12 * frame + 9);
-    let p_dot = three(axes, dots + 6 * N + 3 * frame);
+    let (p, p_dot) = (out.placement.translation, at(dots + 6 * N + 3 * frame));
     for &c in support {
-        let z_dot = three(axes, dots + 6 * c);
-        let (linear, angular) = if rotates[c] {
-            let (z, o, o_dot) = (
-                three(axes, 6 * c),
-                three(axes, 6 * c + 3),
-                three(axes, dots + 6 * c + 3),
-            );
-            let (a, b) = (
-                cross(z_dot, [p[0] - o[0], p[1] - o[1], p[2] - o[2]]),
-                cross(z, [p_dot[0] - o_dot[0], p_dot[1] - o_dot[1], p_dot[2] - o_dot[2]]),
-            );
-            ([a[0] + b[0], a[1] + b[1], a[2] + b[2]], z_dot)
+        let (z, z_dot) = (at(6 * c), at(dots + 6 * c));
+        let zero = Vector3::from_element(S::ZERO);
+        let [(linear, angular), (linear_dot, angular_dot)] = if rotates[c] {
+            let (o, o_dot) = (at(6 * c + 3), at(dots + 6 * c + 3));
+            [
+                (z.cross(&(p - o)), z),
+                (z_dot.cross(&(p - o)) + z.cross(&(p_dot - o_dot)), z_dot),
+            ]
         } else {
-            (z_dot, [S::ZERO; 3])
+            [(z, zero), (z_dot, zero)]
         };
         for r in 0..3 {
-            out.jacobian_dot[r][c] = linear[r];
-            out.jacobian_dot[3 + r][c] = angular[r];
+            (out.jacobian[r][c], out.jacobian[3 + r][c]) = (linear[r], angular[r]);
+            (out.jacobian_dot[r][c], out.jacobian_dot[3 + r][c]) = (linear_dot[r], angular_dot[r]);
         }
     }
 }

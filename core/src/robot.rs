@@ -118,8 +118,8 @@ pub trait Robot {
     fn principal_base_index() -> &'static [usize];
     /// `K_θ` (`NBASE_PRINCIPAL × NTHETA`, row-major): `β_θ = K_θ θ`.
     fn principal_base_k() -> &'static [f64];
-    /// The nominal joint parameters, length `NJOINT_PARAMS`: `Fv`, `Fc` from the
-    /// description (URDF `<dynamics damping friction>`), `Ia` and `F0` zero.
+    /// The nominal joint parameters, length `NJOINT_PARAMS`: `Ia` (MJCF `armature`),
+    /// `Fv`, `Fc` from the description (URDF `<dynamics damping friction>`), `F0` zero.
     fn nominal_joint_params() -> &'static [f64];
     /// Readable formulas of the base parameters of `[params; joint_params]`.
     fn base_joints_groupings() -> &'static [&'static str];

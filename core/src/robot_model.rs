@@ -69,6 +69,9 @@ pub struct JointModel {
     /// zero for a ball joint and a free flyer.
     pub axis: [f64; 3],
     pub limits: Option<JointLimits>,
+    /// Nominal rotor inertia `Ia` (MJCF `armature`; 0 from a URDF): `τ += Ia·q̈` on
+    /// each velocity coordinate of the joint.
+    pub armature: f64,
     /// Nominal viscous friction `Fv` (URDF `<dynamics damping>`): `τ += Fv·q̇`.
     pub damping: f64,
     /// Nominal Coulomb friction `Fc` (URDF `<dynamics friction>`): `τ += Fc·sign(q̇)`.

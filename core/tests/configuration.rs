@@ -31,6 +31,7 @@ const fn joint(name: &'static str, kind: JointType, parent: usize) -> JointModel
             _ => [0.0, 0.0, 1.0],
         },
         limits: None,
+        armature: 0.0,
         damping: 0.0,
         friction: 0.0,
     }

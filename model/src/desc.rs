@@ -109,17 +109,6 @@ pub fn nearest_physical_moments(ev: [f64; 3]) -> [f64; 3] {
     j
 }
 
-/// Whether a failed inertia check is within [`INERTIA_TOLERANCE`]: only a not
-/// positive definite or triangle-breaking inertia can be, never a bad mass.
-fn within_tolerance(kind: &ErrorKind) -> bool {
-    match kind {
-        ErrorKind::NotPositiveDefinite(ev) | ErrorKind::TriangleInequality(ev) => {
-            inertia_violation(*ev) <= INERTIA_TOLERANCE
-        }
-        _ => false,
-    }
-}
-
 /// Checks one body's inertial: finite, mass > 0, inertia about the centre of mass
 /// positive definite and satisfying the triangle inequalities.
 pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
@@ -201,11 +190,17 @@ pub const FREE_FLYER_JOINT: &str = "root_joint";
 /// Options every front end's loader takes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LoadOptions {
-    /// Refuse what would be accepted with a warning (CAD-rounded inertias).
+    /// Refuse what would be accepted with a warning (non-physical inertias, a singular
+    /// mass matrix).
     pub strict: bool,
     /// Put the description's root link on a free flyer ([`Description::with_free_flyer`]):
     /// a floating base, as Pinocchio's `buildModel(urdf, JointModelFreeFlyer())`.
     pub free_flyer: bool,
+    /// Replace every non-physical body inertia by the nearest physical one
+    /// ([`Inertial::nearest_physical`], as MuJoCo's `balanceinertia`), each with a
+    /// warning naming the link and the moments before and after. Without it the
+    /// inertia is kept as written, as Pinocchio reads it, with a warning.
+    pub balance_inertia: bool,
 }
 
 impl Description {
@@ -256,13 +251,25 @@ impl Description {
 
     /// [`Description::build`] with siblings numbered in the given order.
     pub fn build_with(&self, order: SiblingOrder) -> Result<Model, Vec<ModelError>> {
-        self.build_checked(order, false)
+        self.build_checked(order, LoadOptions::default())
     }
 
-    /// [`Description::build_with`]; `strict` refuses inertias that break physical
-    /// consistency within [`INERTIA_TOLERANCE`] instead of accepting them with a
-    /// warning in [`Model::warnings`].
-    pub fn build_checked(&self, order: SiblingOrder, strict: bool) -> Result<Model, Vec<ModelError>> {
+    /// [`Description::build_with`] with the checks `options` asks for (its
+    /// `free_flyer` is the front end's to apply, by [`Description::with_free_flyer`]).
+    ///
+    /// Inertias are checked on the merged bodies (each link with the fixed links
+    /// lumped into it), not link by link: a dummy link with a rounding-noise inertia
+    /// on a fixed joint is part of a physical body. A link's own values must be finite
+    /// and its mass ≥ 0. A merged body that is not physical (mass 0 with a rotational
+    /// inertia, a moment ≤ 0, a broken triangle inequality) is kept as written with a
+    /// warning in [`Model::warnings`] (within [`INERTIA_TOLERANCE`] it is CAD rounding,
+    /// beyond it the warning says so), replaced by the nearest physical one with
+    /// `options.balance_inertia`, refused with `options.strict`. A moving body with no
+    /// mass at all (no `<inertial>`, or mass 0) loads, as in Pinocchio; where nothing
+    /// with mass moves along some coordinate, the mass matrix is singular and a warning
+    /// ([`ErrorKind::SingularMassMatrix`]) names the joints (an error when strict).
+    pub fn build_checked(&self, order: SiblingOrder, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
+        let strict = options.strict;
         let mut errors = Vec::new();
         let err = |element: Element, line: Option<usize>, kind: ErrorKind| ModelError { element, line, kind };
 
@@ -465,23 +472,21 @@ impl Description {
                 placement,
             });
             // Lump this link's inertial into its owning body (the base's is ignored).
+            // Its values are checked here, its physics on the merged body below.
             if body > 0 {
                 if let Some(inertial) = &self.links[link].inertial {
-                    let moved = inertial.transformed(&placement);
-                    let slot = &mut body_inertial[body - 1];
-                    *slot = Some(match slot {
-                        Some(prev) => prev.combined(&moved),
-                        None => moved,
-                    });
-                    if !is_massless_marker(inertial) {
-                        if let Err(kind) = check_physical(inertial) {
+                    match check_link_values(inertial) {
+                        Ok(()) => {
+                            let moved = inertial.transformed(&placement);
+                            let slot = &mut body_inertial[body - 1];
+                            *slot = Some(match slot {
+                                Some(prev) => prev.combined(&moved),
+                                None => moved,
+                            });
+                        }
+                        Err(kind) => {
                             let l = &self.links[link];
-                            let e = err(Element::Link(l.name.clone()), l.line, kind);
-                            if !strict && within_tolerance(&e.kind) {
-                                warnings.push(e);
-                            } else {
-                                errors.push(e);
-                            }
+                            errors.push(err(Element::Link(l.name.clone()), l.line, kind));
                         }
                     }
                 }
@@ -500,31 +505,42 @@ impl Description {
         if model.joints.is_empty() && errors.is_empty() {
             errors.push(err(Element::Robot, None, ErrorKind::NoMovingJoint));
         }
-        for (b, inertial) in body_inertial.iter().enumerate() {
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        for (b, inertial) in body_inertial.into_iter().enumerate() {
             let body = &mut model.bodies[b];
-            let line = self.links.iter().find(|l| l.name == body.name).and_then(|l| l.line);
-            match inertial {
-                Some(i) if !is_massless_marker(i) => {
-                    if let Err(kind) = check_inertial(i) {
-                        // Per-link value errors were reported above; report the
-                        // combined body only when each part was fine on its own.
-                        let reported = |n: &String| *n == body.name || body.merged.contains(n);
-                        let reported_in = |list: &[ModelError]| {
-                            list.iter()
-                                .any(|e| matches!(&e.element, Element::Link(n) if reported(n)))
-                        };
-                        let e = err(Element::Link(body.name.clone()), line, kind);
-                        if !reported_in(&errors) {
-                            if strict || !within_tolerance(&e.kind) {
-                                errors.push(e);
-                            } else if !reported_in(&warnings) {
-                                warnings.push(e);
-                            }
-                        }
-                    }
-                    body.inertial = *i;
+            body.inertial = inertial.unwrap_or(Inertial::principal(0.0, [0.0; 3]));
+            if is_massless_marker(&body.inertial) {
+                continue;
+            }
+            if let Err(kind) = check_inertial(&body.inertial) {
+                let line = self.links.iter().find(|l| l.name == body.name).and_then(|l| l.line);
+                let e = err(Element::Link(body.name.clone()), line, kind);
+                if strict {
+                    errors.push(e);
+                } else if options.balance_inertia
+                    && matches!(
+                        e.kind,
+                        ErrorKind::NotPositiveDefinite(_) | ErrorKind::TriangleInequality(_)
+                    )
+                {
+                    let balanced = body.inertial.nearest_physical();
+                    warnings.push(balanced_warning(e, &balanced));
+                    body.inertial = balanced;
+                } else {
+                    warnings.push(e);
                 }
-                _ => errors.push(err(Element::Link(body.name.clone()), line, ErrorKind::MissingInertial)),
+            }
+        }
+        for k in singular_joints(&model) {
+            let name = &model.joints[k].name;
+            let line = self.joints.iter().find(|j| j.name == *name).and_then(|j| j.line);
+            let e = err(Element::Joint(name.clone()), line, ErrorKind::SingularMassMatrix);
+            if strict {
+                errors.push(e);
+            } else {
+                warnings.push(e);
             }
         }
         if !errors.is_empty() {
@@ -557,4 +573,82 @@ impl Description {
 /// markers: treated as no inertial at all.
 fn is_massless_marker(inertial: &Inertial) -> bool {
     inertial.mass == 0.0 && inertial.inertia.iter().flatten().all(|&x| x == 0.0)
+}
+
+/// One link's own inertial values, before it is merged into its body: finite, within
+/// [`MAX_MAGNITUDE`], mass ≥ 0.
+fn check_link_values(inertial: &Inertial) -> Result<(), ErrorKind> {
+    check_finite(inertial)?;
+    if inertial.mass < 0.0 {
+        return Err(ErrorKind::NonPositiveMass(inertial.mass));
+    }
+    Ok(())
+}
+
+/// The warning for a non-physical body inertia replaced by `balanced`.
+fn balanced_warning(e: ModelError, balanced: &Inertial) -> ModelError {
+    let (after, _) = balanced.principal_axes();
+    ModelError {
+        kind: ErrorKind::Ignored(format!(
+            "{}; replaced by the nearest physical inertia (principal moments {:.6e}, {:.6e}, {:.6e}; mass and \
+             centre of mass kept), as balance_inertia asks",
+            e.kind, after[0], after[1], after[2]
+        )),
+        ..e
+    }
+}
+
+/// The joints along whose coordinates nothing with mass moves: where the LDLᵀ
+/// factorisation of the mass matrix at a generic configuration (a fixed draw) meets
+/// a pivot below `1e-12` of the largest diagonal entry. Only a body whose spatial
+/// inertia is not positive definite (no mass, or a principal moment ≤ 0) can cause
+/// that, so for every other model nothing is computed; otherwise `M` comes column
+/// by column from the joint torque regressor with `a = eₖ`, `v = 0`, no gravity.
+fn singular_joints(model: &Model) -> Vec<usize> {
+    let degenerate = model.bodies.iter().any(|b| {
+        let (ev, _) = b.inertial.principal_axes();
+        b.inertial.mass <= 0.0 || ev[0] <= 0.0
+    });
+    if !degenerate {
+        return Vec::new();
+    }
+    let free = Model {
+        gravity: [0.0; 3],
+        ..model.clone()
+    };
+    let n = model.nv();
+    let params = model.standard_params();
+    let q = crate::sample::structure_states(model, 1, 0x5eed).remove(0).q;
+    let zero = vec![0.0; n];
+    let mut m = vec![vec![0.0; n]; n];
+    for k in 0..n {
+        let mut a = zero.clone();
+        a[k] = 1.0;
+        let Ok(y) = crate::regressor::joint_torque_regressor(&free, &q, &zero, &a) else {
+            return Vec::new();
+        };
+        for (r, row) in y.iter().enumerate() {
+            m[r][k] = row.iter().zip(&params).map(|(y, p)| y * p).sum();
+        }
+    }
+    let scale = (0..n).fold(0.0f64, |s, k| s.max(m[k][k].abs()));
+    // LDLᵀ without pivoting; a collapsed pivot's row and column are left out.
+    let mut l = vec![vec![0.0; n]; n];
+    let mut d = vec![0.0; n];
+    let mut joints = Vec::new();
+    for k in 0..n {
+        d[k] = m[k][k] - (0..k).map(|j| l[k][j] * l[k][j] * d[j]).sum::<f64>();
+        if d[k] <= 1e-12 * scale {
+            d[k] = 0.0;
+            let joint = model.joint_of_v(k) - 1;
+            if joints.last() != Some(&joint) {
+                joints.push(joint);
+            }
+            continue;
+        }
+        for r in k + 1..n {
+            l[r][k] = (m[r][k] - (0..k).map(|j| l[r][j] * l[k][j] * d[j]).sum::<f64>()) / d[k];
+        }
+    }
+    joints
 }

@@ -97,16 +97,22 @@ pub enum ErrorKind {
         friction: f64,
     },
     NoMovingJoint,
-    /// An MJCF construct the MJCF front end does not read yet (several joints in one
-    /// body, `<include>`, `<frame>`, a free body aligned with its inertia): what it is
-    /// and what to do.
+    /// Nothing with mass moves along this joint's coordinates (its body and all it
+    /// carries are massless, or the mass sits on its axis): the mass matrix is
+    /// singular there, and forward dynamics has no solution. Only ever a warning, or
+    /// an error in a strict build.
+    SingularMassMatrix,
+    /// An MJCF construct the MJCF front end does not read yet (`<include>`,
+    /// `<frame>`, a free body aligned with its inertia, a mesh geom giving a body its
+    /// inertia): what it is and what to do.
     NotSupported(String),
     /// An MJCF `class` or `childclass` naming no `<default class>`.
     UnknownClass(String),
     /// An MJCF element or attribute that is not valid MJCF: what is wrong.
     InvalidMjcf(String),
     /// Something the description says that the model cannot hold and leaves out
-    /// (an MJCF joint's `armature`, a ball joint's `range`): only ever a warning.
+    /// (an MJCF joint's `stiffness`, a ball joint's `range`, `<equality>`): only ever
+    /// a warning.
     Ignored(String),
 }
 
@@ -199,7 +205,14 @@ impl fmt::Display for ErrorKind {
                 f,
                 "this moving body has no <inertial> (nor any fixed-attached link with one); give it a mass and inertia"
             ),
-            ErrorKind::NonPositiveMass(m) => write!(f, "mass {m} is not positive; a moving body needs a mass > 0 kg"),
+            ErrorKind::NonPositiveMass(m) if *m < 0.0 => {
+                write!(f, "mass {m} is negative; a mass is ≥ 0 kg (0 for a massless link)")
+            }
+            ErrorKind::NonPositiveMass(m) => write!(
+                f,
+                "mass {m} with a nonzero rotational inertia is not a rigid body; give the mass, or zero the inertia \
+                 for a massless link"
+            ),
             ErrorKind::NotPositiveDefinite(ev) => write!(
                 f,
                 "inertia is not positive definite (principal moments {:.6e}, {:.6e}, {:.6e}); all must be > 0",
@@ -218,6 +231,13 @@ impl fmt::Display for ErrorKind {
                 "<dynamics damping=\"{damping}\" friction=\"{friction}\"> is negative; friction only dissipates, \
                  give values ≥ 0"
             ),
+            ErrorKind::SingularMassMatrix => write!(
+                f,
+                "the mass matrix is singular along this joint: nothing with mass moves with it that the joints \
+                 before it do not already move (its link and every link it carries are massless, or their mass \
+                 sits on its axis), so forward dynamics (aba) has no solution; give the link an <inertial> with a \
+                 mass and inertia, or make the joint fixed"
+            ),
             ErrorKind::NoMovingJoint => write!(f, "has no moving joint (revolute, continuous, prismatic, spherical or floating); nothing moves"),
             ErrorKind::NotSupported(m) | ErrorKind::InvalidMjcf(m) | ErrorKind::Ignored(m) => write!(f, "{m}"),
             ErrorKind::UnknownClass(c) => write!(
@@ -232,14 +252,35 @@ impl ModelError {
     /// The message of a problem accepted with a warning ([`Model::warnings`](crate::Model)):
     /// what is wrong, and why it was let through.
     pub fn warning_message(&self) -> String {
-        if let ErrorKind::Ignored(_) = self.kind {
-            return self.to_string();
+        let tolerance = crate::desc::INERTIA_TOLERANCE;
+        let remedy = "balance_inertia (`--balance-inertia`) replaces it by the nearest physical inertia; a strict \
+                      build refuses it";
+        match &self.kind {
+            ErrorKind::NotPositiveDefinite(ev) | ErrorKind::TriangleInequality(ev) => {
+                let violation = crate::desc::inertia_violation(*ev);
+                if violation <= tolerance {
+                    format!(
+                        "{self}; accepted as written: within the relative tolerance of {tolerance:e} for CAD \
+                         rounding (the nearest physical inertia is used where consistency is needed; a strict \
+                         build refuses it)"
+                    )
+                } else {
+                    format!(
+                        "{self}; accepted as written, as Pinocchio reads it, although it is {:.3} % of its largest \
+                         moment away from physical, beyond the relative tolerance of {tolerance:e} for CAD \
+                         rounding: check the file; {remedy}",
+                        100.0 * violation
+                    )
+                }
+            }
+            ErrorKind::NonPositiveMass(_) => {
+                format!("{self}; accepted as written, as Pinocchio reads it (a strict build refuses it)")
+            }
+            ErrorKind::SingularMassMatrix => {
+                format!("{self}; loaded as Pinocchio loads it (a strict build refuses it)")
+            }
+            _ => self.to_string(),
         }
-        format!(
-            "{self}; accepted as written: within the relative tolerance of {:e} for CAD rounding (the nearest \
-             physical inertia is used where consistency is needed; a strict build refuses it)",
-            crate::desc::INERTIA_TOLERANCE
-        )
     }
 }
 

@@ -196,7 +196,11 @@ impl Inertial {
     pub fn combined(&self, other: &Inertial) -> Inertial {
         let m = self.mass + other.mass;
         if m == 0.0 {
-            return *self;
+            // Massless parts: their rotational inertias add, wherever they are.
+            return Inertial {
+                inertia: math::mat_add(&self.inertia, &other.inertia),
+                ..*self
+            };
         }
         let com = math::scale(
             1.0 / m,
@@ -240,10 +244,15 @@ impl Inertial {
 }
 
 /// What a joint does besides moving its body, as the description gives it (URDF
-/// `<dynamics damping friction>`): the nominal viscous and Coulomb friction of the
-/// joint parameters `[Ia, Fv, Fc, F0]` ([`crate::joint_params`]).
+/// `<dynamics damping friction>`, MJCF `damping frictionloss armature`): the nominal
+/// rotor inertia, viscous and Coulomb friction of the joint parameters
+/// `[Ia, Fv, Fc, F0]` ([`crate::joint_params`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct JointDynamics {
+    /// Rotor inertia `Ia` (kg·m² or kg), MJCF `armature` (Pinocchio's `armature`):
+    /// `τ += Ia·q̈` on each velocity coordinate of the joint, so the joint-space mass
+    /// matrix gains `Ia` on its diagonal (MuJoCo's `qM`). Zero from a URDF.
+    pub armature: f64,
     /// Viscous friction `Fv` (N·m·s/rad or N·s/m): `τ += Fv·q̇`.
     pub damping: f64,
     /// Coulomb friction `Fc` (N·m or N): `τ += Fc·sign(q̇)`.
@@ -305,9 +314,12 @@ pub struct Model {
     /// depth-first numbering reaches them (each body's own link before the links
     /// merged into it). Names are unique.
     pub frames: Vec<Frame>,
-    /// What the front end accepted but the user should know: inertias that break
-    /// physical consistency within [`INERTIA_TOLERANCE`](crate::desc::INERTIA_TOLERANCE)
-    /// (CAD rounding), kept as written. Empty for a strict build.
+    /// What the front end accepted but the user should know, each printed by
+    /// [`ModelError::warning_message`](crate::ModelError::warning_message): body
+    /// inertias that break physical consistency (kept as written, or replaced when
+    /// [`LoadOptions::balance_inertia`](crate::LoadOptions) asks), joints along which
+    /// nothing with mass moves, what the description says that the model leaves out.
+    /// A strict build refuses the first two.
     pub warnings: Vec<crate::ModelError>,
 }
 
@@ -315,13 +327,19 @@ impl Model {
     /// The model with every body's inertial replaced by its
     /// [`Inertial::nearest_physical`]: for what needs physical consistency (draws of
     /// consistent parameters around the nominal ones) when the description was
-    /// accepted with [`Model::warnings`] about CAD rounding. Identical otherwise.
+    /// accepted with [`Model::warnings`] about non-physical inertias (which it drops).
+    /// Identical otherwise.
     pub fn nearest_physical(&self) -> Model {
         let mut model = self.clone();
         for body in &mut model.bodies {
             body.inertial = body.inertial.nearest_physical();
         }
-        model.warnings.clear();
+        model.warnings.retain(|w| {
+            !matches!(
+                w.kind,
+                crate::ErrorKind::NotPositiveDefinite(_) | crate::ErrorKind::TriangleInequality(_)
+            )
+        });
         model
     }
 

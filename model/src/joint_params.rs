@@ -79,13 +79,20 @@ pub fn joint_torque(p: &[f64; PER_JOINT], v: f64, a: f64, coulomb: Coulomb) -> f
 
 /// The description's nominal joint parameters, 4 per velocity coordinate (`4 nv`;
 /// one coordinate per joint with an axis, 3 per ball joint, 6 per free flyer): rotor
-/// inertia and offset 0 (a URDF does not give them), viscous and Coulomb friction
-/// from `<dynamics damping friction>`, the same on each coordinate of a joint.
+/// inertia from [`JointDynamics::armature`](crate::ir::JointDynamics) (MJCF
+/// `armature`; 0 from a URDF), viscous and Coulomb friction from `<dynamics damping
+/// friction>` (MJCF `damping frictionloss`), offset 0, the same on each coordinate of
+/// a joint.
 pub fn nominal_joint_params(model: &Model) -> Vec<f64> {
     model
         .joints
         .iter()
-        .flat_map(|j| std::iter::repeat_n([0.0, j.dynamics.damping, j.dynamics.friction, 0.0], j.kind.nv()))
+        .flat_map(|j| {
+            std::iter::repeat_n(
+                [j.dynamics.armature, j.dynamics.damping, j.dynamics.friction, 0.0],
+                j.kind.nv(),
+            )
+        })
         .flatten()
         .collect()
 }

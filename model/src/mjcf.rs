@@ -3,20 +3,71 @@
 //! [`Description`] as the URDF front end, so checking, merging and numbering are
 //! shared.
 //!
-//! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree>` (MuJoCo's
-//! default angle unit is the degree), `<option gravity>`, `<default>` classes (nested,
-//! `class` on joints, `childclass` on bodies) for joint attributes, `<worldbody>` with
-//! nested `<body name pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass
-//! diaginertia (with an orientation) | fullinertia>` and at most one `<joint
-//! type="hinge|slide|ball|free" pos axis range limited damping frictionloss armature
-//! actuatorfrcrange>` or `<freejoint name align>` per body. A body without a joint is
-//! a fixed link, merged as a URDF fixed joint. MuJoCo's worldbody is the base, the
-//! link `world`.
+//! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree
+//! inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia
+//! settotalmass>` (MuJoCo's default angle unit is the degree), `<option gravity>`,
+//! `<default>` classes (nested, `class` on joints, geoms and sites, `childclass` on
+//! bodies) for joint, geom and site attributes, `<worldbody>` with nested `<body name
+//! pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass diaginertia (with an
+//! orientation) | fullinertia (without one)>`, any number of `<joint
+//! type="hinge|slide|ball|free" pos axis range limited ref damping frictionloss
+//! armature actuatorfrcrange>` and `<freejoint name align>` per body, `<geom>` for
+//! the inertia (below) and `<site name pos quat|euler|axisangle|xyaxes|zaxis|fromto>`.
+//! A body without a joint is a fixed link, merged as a URDF fixed joint. MuJoCo's
+//! worldbody is the base, the link `world`.
 //!
 //! A joint's `pos` (a point on its axis, in the body frame) moves the link frame onto
 //! the joint, as URDF has it: the joint origin is the body placement followed by a
 //! translation by `pos`, and the body's inertial and its children's placements are
 //! re-expressed in that frame (`pos` subtracted).
+//!
+//! A joint's `ref` is its position in the placement the XML writes (MuJoCo's
+//! `qpos0`): the joint origin is that placement turned back by `ref` about the axis
+//! (hinge, in the file's angle unit) or moved back by `ref` along it (slide), so the
+//! model's `q` is MuJoCo's `qpos`. MuJoCo ignores `ref` on ball and free joints, and
+//! so does this reader.
+//!
+//! Several joints in one body compose in order, as MuJoCo composes them, each about
+//! its own `pos` in the body frame: every joint but the last moves a massless link
+//! named `BODY (JOINT)` (its frame at that joint's `pos`, with the body's axes before
+//! the later joints move it), the last carries the body itself, whose link frame is
+//! at the last joint's `pos`. A free joint must be its body's only joint.
+//!
+//! `armature` is the rotor inertia `Ia` of [`JointDynamics::armature`], on each of the
+//! joint's coordinates (MuJoCo's `dof_armature`: `M + diag(Ia)` is MuJoCo's `qM`).
+//! On a free joint MuJoCo's armature acts on the linear acceleration in world axes
+//! and dyngen's on the one in body axes: the mass matrices agree, the bias forces do
+//! not, which a warning says. A negative armature is refused. `stiffness` (and its
+//! `springref`) is left out with a warning: the model has no joint springs.
+//!
+//! # Inertia
+//!
+//! A body's inertial is its `<inertial>`, or, as MuJoCo's compiler makes it with
+//! `inertiafromgeom="auto"` (the default) for a body without `<inertial>` and with
+//! `"true"` for every body, the sum of its geoms': each geom of a group in
+//! `inertiagrouprange` (default `0 5`) with mass (its `mass`, or `density` (default
+//! 1000) times its volume; `mass="0"` or `density="0"` give none) is a solid sphere
+//! (`size` r), capsule or cylinder (`size` r, half length; or `fromto` and r), box
+//! (half sizes; with `fromto`, `size[0]` for x and y and half the length for z) or
+//! ellipsoid (semi-axes, `fromto` as the box), at its `pos` and orientation (or
+//! `fromto`'s middle, `z` along it), combined about their common centre of mass.
+//! Mesh, sdf, plane and hfield geoms that would give a body its inertia, and
+//! `shellinertia="true"`, are refused naming the geom and line. Then each body's
+//! mass is raised to `boundmass` and its principal moments to `boundinertia`
+//! (MuJoCo leaves a body without mass of its own with its inertial frame at the
+//! numbers of its `pos`, so the mass `boundmass` gives it sits there too); with
+//! `balanceinertia`, moments that break the triangle inequality are all set to their
+//! mean; last, `settotalmass` scales every body's mass and inertia so that they add
+//! up to it. A moving body with no mass at all is left to the checks of
+//! [`Description::build_checked`].
+//!
+//! # Sites
+//!
+//! A named `<site>` is a frame of the model ([`crate::ir::Frame`]), a link without
+//! inertial fixed to its body (or to the base, in `<worldbody>`), at its `pos` and
+//! orientation (or `fromto`) in the body frame. An unnamed site (MuJoCo allows them)
+//! is skipped: no frame. A site named as a body is refused, since frames and bodies
+//! share one namespace.
 //!
 //! # Joints and their coordinates
 //!
@@ -57,12 +108,15 @@
 //!   is refused.
 //!
 //! Refused, each naming the element and its line: a free joint not directly in
-//! `<worldbody>`, several joints in one body, a nonzero `ref` on a hinge or slide
-//! joint, `<include>`, `<frame>`, `<replicate>`, `<attach>`, `<composite>`,
-//! `<flexcomp>`, unknown classes. A moving body without `<inertial>` is an error
-//! (MuJoCo would infer the inertia from its geoms; dyngen does not). Geometry, sites,
-//! cameras, lights, assets, actuators, sensors and the rest are skipped. A nonzero
-//! `armature` or `stiffness` has no place in the model and is left out with a warning.
+//! `<worldbody>` or with other joints in its body, `<include>`, `<frame>`,
+//! `<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, unknown classes,
+//! `fullinertia` with an orientation on the `<inertial>` (MuJoCo refuses it too),
+//! `<compiler coordinate="global">`, the geoms above. Left out with a warning naming
+//! the element and its line: each element of `<equality>` and `<tendon>` (the
+//! dynamics treat the joints as independent), a joint's `stiffness`, a ball joint's
+//! `range`, and every `<compiler>` attribute not read that is not known to leave the
+//! dynamics alone. Cameras, lights, assets, actuators, sensors, geoms of bodies with
+//! an `<inertial>` and the rest are skipped.
 //!
 //! Siblings are numbered in declaration order, as MuJoCo numbers its bodies.
 
@@ -185,7 +239,6 @@ fn read_file(path: &Path) -> Result<String, Vec<ModelError>> {
 }
 
 fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
-    let strict = options.strict;
     let mut read = read(text)?;
     if options.free_flyer {
         let free = DeclaredJointType::Moving(JointKind::FreeFlyer);
@@ -204,7 +257,7 @@ fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
             None => read.desc = read.desc.with_free_flyer(),
         }
     }
-    let built = read.desc.build_checked(SiblingOrder::Declaration, strict);
+    let built = read.desc.build_checked(SiblingOrder::Declaration, options);
     if read.errors.is_empty() {
         match built {
             Ok(mut model) => {
@@ -307,8 +360,21 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
         bodies: 0,
         joint_ids: 0,
         gravity: DEFAULT_GRAVITY,
+        from_geom: FromGeom::Auto,
+        group_range: [0, 5],
+        mass_rules: MassRules {
+            bound_mass: 0.0,
+            bound_inertia: 0.0,
+            balance: false,
+            total: None,
+        },
+        records: Vec::new(),
+        sites: Vec::new(),
+        uncounted: Vec::new(),
     };
     reader.read_document(root);
+    reader.apply_mass_rules();
+    reader.check_site_names();
     let name = tags[root].attr("model").unwrap_or("MuJoCo Model").to_string();
     Ok(Read {
         desc: Description {
@@ -323,10 +389,49 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
     })
 }
 
-/// A `<default>` class: its parent class and the joint attributes it sets.
+/// A `<default>` class: its parent class and the attributes it sets, by element
+/// (`joint`, `geom`, `site`).
 struct Class {
     parent: Option<String>,
-    joint: Vec<(String, String)>,
+    attrs: HashMap<String, Vec<(String, String)>>,
+}
+
+/// Elements whose attributes `<default>` classes give here.
+const CLASS_ELEMENTS: [&str; 3] = ["joint", "geom", "site"];
+
+/// `<compiler inertiafromgeom>`: whether a body's inertial comes from its geoms.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum FromGeom {
+    /// Never: a body without `<inertial>` has no mass.
+    False,
+    /// Always, ignoring `<inertial>`.
+    True,
+    /// For bodies without `<inertial>` (MuJoCo's default).
+    Auto,
+}
+
+/// What MuJoCo's compiler does to every body's mass properties (`<compiler
+/// boundmass boundinertia balanceinertia settotalmass>`).
+struct MassRules {
+    bound_mass: f64,
+    bound_inertia: f64,
+    balance: bool,
+    /// `settotalmass` when positive.
+    total: Option<f64>,
+}
+
+/// A body read, for the compiler's mass rules applied once all are read.
+struct BodyRecord {
+    /// Its link in [`Reader::links`].
+    link: usize,
+    /// Where the link frame sits in the body frame (the last joint's `pos`).
+    shift: Vec3,
+    /// Its inertial in the body frame, as written or from its geoms.
+    inertial: Option<Inertial>,
+    /// The body's `pos` as written (in its parent's frame): where MuJoCo leaves the
+    /// inertial frame of a body without mass of its own, so where `boundmass` puts
+    /// the mass it gives such a body.
+    pos: Vec3,
 }
 
 /// Elements that build or move bodies in ways this front end does not follow.
@@ -370,6 +475,16 @@ struct Reader<'t> {
     /// Joints met so far: MuJoCo's joint id of the next one.
     joint_ids: usize,
     gravity: Vec3,
+    from_geom: FromGeom,
+    /// `<compiler inertiagrouprange>`: geoms of these groups give the inertia.
+    group_range: [i64; 2],
+    mass_rules: MassRules,
+    records: Vec<BodyRecord>,
+    /// Named sites with their lines, to tell a site named as a body.
+    sites: Vec<(String, usize)>,
+    /// Bodies welded to the world whose geoms' inertia could not be computed (a
+    /// mesh): harmless unless `settotalmass` counts them.
+    uncounted: Vec<(String, usize)>,
 }
 
 impl<'t> Reader<'t> {
@@ -413,7 +528,7 @@ impl<'t> Reader<'t> {
             "main".into(),
             Class {
                 parent: None,
-                joint: Vec::new(),
+                attrs: HashMap::new(),
             },
         );
         for d in self.children_named(root, "default") {
@@ -429,7 +544,7 @@ impl<'t> Reader<'t> {
         for w in self.children_named(root, "worldbody") {
             for &c in &self.children[w].clone() {
                 match tags[c].name.as_str() {
-                    "body" => self.read_body(c, WORLD, [0.0; 3], "main"),
+                    "body" => self.read_body(c, WORLD, [0.0; 3], "main", false),
                     "joint" | "freejoint" => self.error(
                         Element::Robot,
                         tags[c].line,
@@ -439,7 +554,31 @@ impl<'t> Reader<'t> {
                         )),
                     ),
                     name if TREE_ELEMENTS.contains(&name) => self.refuse_tree_element(c, Element::Robot),
+                    "site" => self.read_site(c, WORLD, [0.0; 3], "main"),
                     _ => {}
+                }
+            }
+        }
+        // Constraints between joints: the model's joints are independent.
+        for section in ["equality", "tendon"] {
+            for s in self.children_named(root, section) {
+                for c in self.children[s].clone() {
+                    let t = &tags[c];
+                    let name = t.attr("name").map_or_else(String::new, |n| format!(" name=\"{n}\""));
+                    let what = if section == "equality" {
+                        "an equality constraint"
+                    } else {
+                        "a tendon (its length, limits, stiffness, damping and any constraint or actuator on it)"
+                    };
+                    self.warnings.push(ModelError {
+                        element: Element::Robot,
+                        line: Some(t.line),
+                        kind: ErrorKind::Ignored(format!(
+                            "<{section}> <{}{name}> is left out: {what} is not in the model, whose dynamics treat \
+                             the joints as independent",
+                            t.name
+                        )),
+                    });
                 }
             }
         }
@@ -471,7 +610,12 @@ impl<'t> Reader<'t> {
                 );
             }
         }
-        for (attr, flag) in [("autolimits", &mut self.autolimits), ("alignfree", &mut self.alignfree)] {
+        let mut balance = self.mass_rules.balance;
+        for (attr, flag) in [
+            ("autolimits", &mut self.autolimits),
+            ("alignfree", &mut self.alignfree),
+            ("balanceinertia", &mut balance),
+        ] {
             match t.attr(attr) {
                 None => {}
                 Some("true") => *flag = true,
@@ -483,6 +627,101 @@ impl<'t> Reader<'t> {
                         "<compiler {attr}=\"{other}\"> is neither `true` nor `false`"
                     )),
                 }),
+            }
+        }
+        self.mass_rules.balance = balance;
+        match t.attr("inertiafromgeom") {
+            None => {}
+            Some("true") => self.from_geom = FromGeom::True,
+            Some("false") => self.from_geom = FromGeom::False,
+            Some("auto") => self.from_geom = FromGeom::Auto,
+            Some(other) => self.error(
+                Element::Robot,
+                t.line,
+                ErrorKind::InvalidMjcf(format!(
+                    "<compiler inertiafromgeom=\"{other}\"> is not `true`, `false` or `auto`"
+                )),
+            ),
+        }
+        if let Some(v) = t.attr("inertiagrouprange") {
+            let words: Vec<Option<i64>> = v.split_whitespace().map(|w| w.parse().ok()).collect();
+            match words[..] {
+                [Some(lo), Some(hi)] => self.group_range = [lo, hi],
+                _ => self.error(
+                    Element::Robot,
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "<compiler inertiagrouprange=\"{v}\"> is not two integers (the first and last geom group \
+                         whose geoms give the inertia, such as `0 5`)"
+                    )),
+                ),
+            }
+        }
+        for attr in ["boundmass", "boundinertia", "settotalmass"] {
+            let Some(x) = self.numbers(t, attr, 1, &Element::Robot).map(|v| v[0]) else {
+                continue;
+            };
+            if !x.is_finite() {
+                self.error(
+                    Element::Robot,
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!("<compiler {attr}=\"{x}\"> is not a finite number")),
+                );
+                continue;
+            }
+            match attr {
+                "boundmass" => self.mass_rules.bound_mass = x,
+                "boundinertia" => self.mass_rules.bound_inertia = x,
+                _ => self.mass_rules.total = (x > 0.0).then_some(x),
+            }
+        }
+        if let Some(c) = t.attr("coordinate").filter(|c| *c != "local") {
+            self.error(
+                Element::Robot,
+                t.line,
+                ErrorKind::NotSupported(format!(
+                    "<compiler coordinate=\"{c}\"> is not supported (MuJoCo itself only reads `local` now); write \
+                     body, joint and inertial positions in their parent's frame"
+                )),
+            );
+        }
+        // Attributes known not to change the dynamics of what is read here (meshes
+        // are refused where they would give an inertia).
+        const HARMLESS: [&str; 11] = [
+            "strippath",
+            "meshdir",
+            "texturedir",
+            "assetdir",
+            "discardvisual",
+            "usethread",
+            "fusestatic",
+            "saveinertial",
+            "exactmeshinertia",
+            "fitaabb",
+            "coordinate",
+        ];
+        const READ: [&str; 10] = [
+            "angle",
+            "eulerseq",
+            "autolimits",
+            "alignfree",
+            "balanceinertia",
+            "inertiafromgeom",
+            "inertiagrouprange",
+            "boundmass",
+            "boundinertia",
+            "settotalmass",
+        ];
+        for (attr, value) in &t.attrs {
+            if !HARMLESS.contains(&attr.as_str()) && !READ.contains(&attr.as_str()) {
+                self.warnings.push(ModelError {
+                    element: Element::Robot,
+                    line: Some(t.line),
+                    kind: ErrorKind::Ignored(format!(
+                        "<compiler {attr}=\"{value}\"> is not read; if it changes the masses, inertias or joints, \
+                         the model differs from MuJoCo's"
+                    )),
+                });
             }
         }
     }
@@ -501,11 +740,15 @@ impl<'t> Reader<'t> {
                 return;
             }
         };
-        let joint: Vec<(String, String)> = self
-            .children_named(k, "joint")
-            .iter()
-            .flat_map(|&j| self.tags[j].attrs.clone())
-            .collect();
+        let mut attrs: HashMap<String, Vec<(String, String)>> = HashMap::new();
+        for element in CLASS_ELEMENTS {
+            let set: Vec<(String, String)> = self
+                .children_named(k, element)
+                .iter()
+                .flat_map(|&j| self.tags[j].attrs.clone())
+                .collect();
+            attrs.insert(element.to_string(), set);
+        }
         if parent.is_some() && self.classes.contains_key(&name) {
             self.error(
                 Element::Robot,
@@ -516,9 +759,11 @@ impl<'t> Reader<'t> {
         }
         let entry = self.classes.entry(name.clone()).or_insert(Class {
             parent: parent.clone(),
-            joint: Vec::new(),
+            attrs: HashMap::new(),
         });
-        entry.joint.extend(joint);
+        for (element, set) in attrs {
+            entry.attrs.entry(element).or_default().extend(set);
+        }
         for d in self.children_named(k, "default") {
             self.read_default(d, Some(name.clone()));
         }
@@ -538,13 +783,20 @@ impl<'t> Reader<'t> {
 
     /// A joint attribute: the element's own, else its class's, else an ancestor class's.
     fn joint_attr(&self, t: &'t Tag, class: &str, name: &str) -> Option<String> {
+        self.class_attr(t, class, "joint", name)
+    }
+
+    /// An attribute of `t` (a `joint`, `geom` or `site` element): its own, else its
+    /// class's, else an ancestor class's.
+    fn class_attr(&self, t: &Tag, class: &str, element: &str, name: &str) -> Option<String> {
         if let Some(v) = t.attr(name) {
             return Some(v.to_string());
         }
         let mut c = Some(class);
         while let Some(name_c) = c {
             let class = self.classes.get(name_c)?;
-            if let Some((_, v)) = class.joint.iter().rev().find(|(n, _)| n == name) {
+            let set = class.attrs.get(element).map_or(&[][..], Vec::as_slice);
+            if let Some((_, v)) = set.iter().rev().find(|(n, _)| n == name) {
                 return Some(v.clone());
             }
             c = class.parent.as_deref();
@@ -679,9 +931,10 @@ impl<'t> Reader<'t> {
         }
     }
 
-    /// A `<body>` with its subtree. `shift` is the parent's joint `pos`: the parent
-    /// link frame sits there in the parent body frame.
-    fn read_body(&mut self, k: usize, parent: &str, shift: Vec3, childclass: &str) {
+    /// A `<body>` with its subtree. `shift` is the parent's last joint `pos`: the
+    /// parent link frame sits there in the parent body frame; `moving` whether a
+    /// joint moves the parent.
+    fn read_body(&mut self, k: usize, parent: &str, shift: Vec3, childclass: &str, moving_parent: bool) {
         let tags = self.tags;
         let t = &tags[k];
         let id = self.bodies;
@@ -695,53 +948,81 @@ impl<'t> Reader<'t> {
             translation: math::sub(&pos, &shift),
         };
 
-        // The joint, if any.
-        let mut joint: Option<(JointDesc, Vec3)> = None;
+        // The joints, in order: each after the first hangs from a massless link at
+        // the previous joint's `pos`, the body's own link on the last.
+        let mut joint_tags = Vec::new();
         for c in self.children[k].clone() {
-            let jt = &tags[c];
-            match jt.name.as_str() {
-                "joint" | "freejoint" => {}
-                name if TREE_ELEMENTS.contains(&name) => {
-                    self.refuse_tree_element(c, el.clone());
-                    continue;
-                }
-                _ => continue,
+            match tags[c].name.as_str() {
+                "joint" | "freejoint" => joint_tags.push(c),
+                name if TREE_ELEMENTS.contains(&name) => self.refuse_tree_element(c, el.clone()),
+                _ => {}
             }
+        }
+        let childless = self.children_named(k, "body").is_empty();
+        let mut link_parent = parent.to_string();
+        let mut link_placement = placement;
+        // The `pos` of the last joint read: where the current link frame sits in the body frame.
+        let mut joint_pos = [0.0; 3];
+        let mut moving = Vec::new();
+        for (n, &c) in joint_tags.iter().enumerate() {
+            let jt = &tags[c];
             let jid = self.joint_ids;
             self.joint_ids += 1;
             let jname = jt.attr("name").map_or_else(|| format!("joint_{jid}"), str::to_string);
             let jel = Element::Joint(jname.clone());
-            if joint.is_some() {
+            let class = self.class_of(jt, "class", &childclass, &jel);
+            let free = jt.name == "freejoint" || self.joint_attr(jt, &class, "type").as_deref() == Some("free");
+            if free && joint_tags.len() > 1 {
                 self.error(
                     jel,
                     jt.line,
                     ErrorKind::NotSupported(format!(
-                        "body `{name}` already has a joint; several joints in one body are not supported yet \
-                         (split the body into a chain of massless bodies with one joint each)"
+                        "body `{name}` has a free joint and other joints; a free joint must be the only joint of \
+                         its body (MuJoCo refuses it too): move the other joints into a child body"
                     )),
                 );
                 continue;
             }
-            let owner = Owner {
-                parent,
-                body: &name,
-                placement: &placement,
-                childless: self.children_named(k, "body").is_empty(),
+            let last = n + 1 == joint_tags.len();
+            let child = if last {
+                name.clone()
+            } else {
+                format!("{name} ({jname})")
             };
-            if jt.name == "freejoint" {
+            let owner = Owner {
+                parent: &link_parent,
+                body: &child,
+                placement: &link_placement,
+                childless,
+            };
+            let read = if jt.name == "freejoint" {
                 // MuJoCo's shorthand for a free joint without damping, friction,
                 // armature or stiffness; it takes no class.
-                joint = self.free_joint(jt, jname, &owner, JointDynamics::default());
+                self.free_joint(jt, jname, &owner, JointDynamics::default())
+            } else {
+                self.read_joint(jt, &class, jname, &owner)
+            };
+            let Some((desc, p)) = read else {
                 continue;
+            };
+            if !last {
+                self.links.push(LinkDesc {
+                    name: child.clone(),
+                    inertial: None,
+                    line: Some(jt.line),
+                });
             }
-            let class = self.class_of(jt, "class", &childclass, &jel);
-            if let Some(desc) = self.read_joint(jt, &class, jname, &owner) {
-                joint = Some(desc);
-            }
+            moving.push(desc);
+            link_parent = child;
+            // The next joint's frame, at its own pos, from this link's (at `p`).
+            link_placement = Placement {
+                rotation: math::IDENTITY,
+                translation: math::scale(-1.0, &p),
+            };
+            joint_pos = p;
         }
 
-        // The inertial, in the link frame (on the joint).
-        let joint_pos = joint.as_ref().map_or([0.0; 3], |(_, p)| *p);
+        // The inertial, in the body frame: as written, or from the geoms.
         let inertials = self.children_named(k, "inertial");
         if let Some(&extra) = inertials.get(1) {
             self.error(
@@ -750,18 +1031,41 @@ impl<'t> Reader<'t> {
                 ErrorKind::InvalidMjcf(format!("body `{name}` has more than one <inertial>")),
             );
         }
-        let inertial = inertials
-            .first()
-            .and_then(|&i| self.read_inertial(&tags[i], &el, &joint_pos));
+        let from_geom = match self.from_geom {
+            FromGeom::True => true,
+            FromGeom::False => false,
+            FromGeom::Auto => inertials.is_empty(),
+        };
+        let moves = moving_parent || !moving.is_empty();
+        let inertial = if from_geom && !moves {
+            // Welded to the world: its inertia does not enter the dynamics, so geoms
+            // that cannot give one (meshes) are no error; only `settotalmass` counts it.
+            let before = self.errors.len();
+            let inertial = self.geom_inertial(k, &el, &childclass);
+            if self.errors.len() > before {
+                self.errors.truncate(before);
+                self.uncounted.push((name.clone(), t.line));
+            }
+            inertial
+        } else if from_geom {
+            self.geom_inertial(k, &el, &childclass)
+        } else {
+            inertials.first().and_then(|&i| self.read_inertial(&tags[i], &el))
+        };
 
+        self.records.push(BodyRecord {
+            link: self.links.len(),
+            shift: joint_pos,
+            inertial,
+            pos,
+        });
         self.links.push(LinkDesc {
             name: name.clone(),
-            inertial,
+            inertial: None,
             line: Some(t.line),
         });
-        self.joints.push(match joint {
-            Some((j, _)) => j,
-            None => JointDesc {
+        if moving.is_empty() {
+            self.joints.push(JointDesc {
                 name: format!("{name} (fixed)"),
                 kind: DeclaredJointType::Fixed,
                 parent: parent.to_string(),
@@ -771,11 +1075,76 @@ impl<'t> Reader<'t> {
                 limits: None,
                 dynamics: JointDynamics::default(),
                 line: Some(t.line),
-            },
-        });
-        for c in self.children_named(k, "body") {
-            self.read_body(c, &name, joint_pos, &childclass);
+            });
         }
+        self.joints.extend(moving);
+        for c in self.children_named(k, "site") {
+            self.read_site(c, &name, joint_pos, &childclass);
+        }
+        for c in self.children_named(k, "body") {
+            self.read_body(c, &name, joint_pos, &childclass, moves);
+        }
+    }
+
+    /// A `<site>`: a frame of the link `link`, whose frame sits at `shift` in the
+    /// body frame; an unnamed site is skipped.
+    fn read_site(&mut self, k: usize, link: &str, shift: Vec3, childclass: &str) {
+        let t = &self.tags[k];
+        let Some(name) = t.attr("name") else {
+            return;
+        };
+        let el = Element::Link(name.to_string());
+        let class = self.class_of(t, "class", childclass, &el);
+        let (pos, rotation) = self.geom_frame(t, &class, "site", &el);
+        self.sites.push((name.to_string(), t.line));
+        self.links.push(LinkDesc {
+            name: name.to_string(),
+            inertial: None,
+            line: Some(t.line),
+        });
+        self.joints.push(JointDesc {
+            name: format!("{name} (site)"),
+            kind: DeclaredJointType::Fixed,
+            parent: link.to_string(),
+            child: name.to_string(),
+            origin: Placement {
+                rotation,
+                translation: math::sub(&pos, &shift),
+            },
+            axis: [0.0, 0.0, 1.0],
+            limits: None,
+            dynamics: JointDynamics::default(),
+            line: Some(t.line),
+        });
+    }
+
+    /// A site's or geom's frame in its body frame: `pos` and orientation, or the
+    /// middle of `fromto` with `z` along it (MuJoCo's rule).
+    fn geom_frame(&mut self, t: &Tag, class: &str, element: &str, el: &Element) -> (Vec3, Mat3) {
+        if let Some(v) = self.class_attr(t, class, element, "fromto") {
+            if let Some(f) = self.parse_numbers(t, "fromto", &v, 6, el) {
+                let (a, b) = ([f[0], f[1], f[2]], [f[3], f[4], f[5]]);
+                let d = math::sub(&b, &a);
+                let n = math::norm(&d);
+                if n < 1e-12 || !n.is_finite() {
+                    self.error(
+                        el.clone(),
+                        t.line,
+                        ErrorKind::InvalidMjcf(format!("<{} fromto=\"{v}\"> has its two ends at one point", t.name)),
+                    );
+                    return ([0.0; 3], math::IDENTITY);
+                }
+                return (math::scale(0.5, &math::add(&a, &b)), zaxis(&math::scale(1.0 / n, &d)));
+            }
+            return ([0.0; 3], math::IDENTITY);
+        }
+        let pos = match self.class_attr(t, class, element, "pos") {
+            Some(v) => self
+                .parse_numbers(t, "pos", &v, 3, el)
+                .map_or([0.0; 3], |v| [v[0], v[1], v[2]]),
+            None => [0.0; 3],
+        };
+        (pos, self.orientation(t, el))
     }
 
     fn refuse_tree_element(&mut self, k: usize, element: Element) {
@@ -818,21 +1187,42 @@ impl<'t> Reader<'t> {
         };
         let scalar = |this: &mut Self, a: &str| number(this, a, 1).map_or(0.0, |v| v[0]);
         let dynamics = JointDynamics {
+            armature: scalar(self, "armature"),
             damping: scalar(self, "damping"),
             friction: scalar(self, "frictionloss"),
         };
-        for what in ["armature", "stiffness"] {
-            let x = scalar(self, what);
-            if x != 0.0 {
-                self.warnings.push(ModelError {
-                    element: el.clone(),
-                    line: Some(t.line),
-                    kind: ErrorKind::Ignored(format!(
-                        "{what} = {x} is left out: the model has no place for it (the dynamics are the rigid \
-                         body's alone)"
-                    )),
-                });
-            }
+        if !(0.0..=crate::desc::MAX_MAGNITUDE).contains(&dynamics.armature) {
+            self.error(
+                el.clone(),
+                t.line,
+                ErrorKind::InvalidMjcf(format!(
+                    "armature = {} is not a rotor inertia; give a value >= 0 (and at most 1e9 in SI units)",
+                    dynamics.armature
+                )),
+            );
+        } else if dynamics.armature != 0.0 && kind == MjcfJoint::Free {
+            self.warnings.push(ModelError {
+                element: el.clone(),
+                line: Some(t.line),
+                kind: ErrorKind::Ignored(format!(
+                    "armature = {} on a free joint is kept as the rotor inertia Ia of its 6 coordinates: the mass \
+                     matrix is MuJoCo's, but MuJoCo's armature acts on the linear acceleration in world axes and \
+                     dyngen's on the one in body axes, so the bias forces differ by Ia (w x v) on the linear part",
+                    dynamics.armature
+                )),
+            });
+        }
+        let stiffness = scalar(self, "stiffness");
+        if stiffness != 0.0 {
+            let springref = scalar(self, "springref");
+            self.warnings.push(ModelError {
+                element: el.clone(),
+                line: Some(t.line),
+                kind: ErrorKind::Ignored(format!(
+                    "stiffness = {stiffness} (springref {springref}) is left out: the model has no joint springs \
+                     (the dynamics are the rigid body's, rotor inertia and friction)"
+                )),
+            });
         }
         if kind == MjcfJoint::Free {
             // MuJoCo ignores a free joint's pos, axis, range and ref.
@@ -857,7 +1247,7 @@ impl<'t> Reader<'t> {
             rotation: owner.placement.rotation,
             translation: owner.placement.transform_point(&pos),
         };
-        let desc = |kind: JointKind, axis: Vec3, limits: Option<Limits>| JointDesc {
+        let desc = |kind: JointKind, axis: Vec3, limits: Option<Limits>, origin: Placement| JointDesc {
             name: name.clone(),
             kind: DeclaredJointType::Moving(kind),
             parent: owner.parent.to_string(),
@@ -881,7 +1271,7 @@ impl<'t> Reader<'t> {
                     )),
                 });
             }
-            return Some((desc(JointKind::Spherical, [0.0; 3], None), pos));
+            return Some((desc(JointKind::Spherical, [0.0; 3], None, origin), pos));
         }
         let slide = kind == MjcfJoint::Slide;
         let axis = number(self, "axis", 3).map_or([0.0, 0.0, 1.0], |v| [v[0], v[1], v[2]]);
@@ -892,17 +1282,28 @@ impl<'t> Reader<'t> {
                 ErrorKind::InvalidMjcf("limited=\"true\" without a `range`; give range=\"lower upper\"".into()),
             );
         }
+        // MuJoCo's body placement is at q = ref (`qpos0`): the joint's zero is that
+        // placement moved back by `ref` about or along the axis.
         let reference = scalar(self, "ref");
-        if reference != 0.0 {
-            self.error(
-                el.clone(),
-                t.line,
-                ErrorKind::NotSupported(format!(
-                    "a joint `ref` ({reference}) is not supported yet: it moves the joint's zero; rotate or \
-                     move the body to the reference position instead"
-                )),
-            );
-        }
+        let n = math::norm(&axis);
+        let origin = if reference != 0.0 && n > 0.0 && n.is_finite() {
+            let unit = math::scale(1.0 / n, &axis);
+            if slide {
+                Placement {
+                    rotation: origin.rotation,
+                    translation: owner
+                        .placement
+                        .transform_point(&math::sub(&pos, &math::scale(reference, &unit))),
+                }
+            } else {
+                Placement {
+                    rotation: math::mat_mul(&origin.rotation, &axis_angle(&unit, -self.angle(reference))),
+                    translation: origin.translation,
+                }
+            }
+        } else {
+            origin
+        };
         let effort = number(self, "actuatorfrcrange", 2).map_or(UNLIMITED, |v| v[0].abs().max(v[1].abs()));
         let limits = match (limited, range) {
             (true, Some(r)) => {
@@ -925,7 +1326,7 @@ impl<'t> Reader<'t> {
             (false, true) => JointKind::Revolute,
             (false, false) => JointKind::Continuous,
         };
-        Some((desc(kind, axis, limits), pos))
+        Some((desc(kind, axis, limits, origin), pos))
     }
 
     /// A free joint (`<joint type="free">` or `<freejoint>`): a free flyer from the
@@ -988,9 +1389,24 @@ impl<'t> Reader<'t> {
         Some((desc, [0.0; 3]))
     }
 
-    /// An `<inertial>` in the link frame, which sits at `shift` in the body frame.
-    fn read_inertial(&mut self, t: &Tag, el: &Element, shift: &Vec3) -> Option<Inertial> {
+    /// An `<inertial>` in the body frame.
+    fn read_inertial(&mut self, t: &Tag, el: &Element) -> Option<Inertial> {
         let pos = self.vec3(t, "pos", el).unwrap_or([0.0; 3]);
+        const ORIENTATIONS: [&str; 5] = ["quat", "euler", "axisangle", "xyaxes", "zaxis"];
+        if t.attr("fullinertia").is_some() {
+            if let Some(o) = ORIENTATIONS.iter().find(|o| t.attr(o).is_some()) {
+                // MuJoCo: "fullinertia and inertial orientation cannot both be specified".
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "<inertial> gives both `fullinertia` and an orientation (`{o}`), which MuJoCo refuses: \
+                         give `fullinertia` in the body frame without an orientation, or `diaginertia` with `{o}`"
+                    )),
+                );
+                return None;
+            }
+        }
         let rotation = self.orientation(t, el);
         let mass = match t.attr("mass") {
             Some(_) => self.numbers(t, "mass", 1, el)?[0],
@@ -1030,19 +1446,308 @@ impl<'t> Reader<'t> {
             com: [0.0; 3],
             inertia,
         };
-        let mut inertial = local.transformed(&Placement {
+        Some(symmetric(local.transformed(&Placement {
             rotation,
-            translation: math::sub(&pos, shift),
-        });
-        // Rounding in the rotation can leave the tensor a few ulps off symmetric.
-        let m = inertial.inertia;
-        for (r, row) in inertial.inertia.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                *x = 0.5 * (m[r][c] + m[c][r]);
+            translation: pos,
+        })))
+    }
+
+    /// A body's inertial from its geoms, in the body frame, as MuJoCo's compiler
+    /// makes it: each geom of a group in `inertiagrouprange` a solid of density
+    /// `density` (1000) or of mass `mass`, combined about the common centre of mass.
+    /// `None` when no geom has mass.
+    fn geom_inertial(&mut self, k: usize, el: &Element, childclass: &str) -> Option<Inertial> {
+        let mut total: Option<Inertial> = None;
+        for g in self.children_named(k, "geom") {
+            let t = &self.tags[g];
+            let class = self.class_of(t, "class", childclass, el);
+            let attr = |this: &Self, a: &str| this.class_attr(t, &class, "geom", a);
+            let scalar = |this: &mut Self, a: &str| -> Option<f64> {
+                let v = attr(this, a)?;
+                this.parse_numbers(t, a, &v, 1, el).map(|v| v[0])
+            };
+            let group = match attr(self, "group") {
+                Some(v) => match v.trim().parse::<i64>() {
+                    Ok(g) => g,
+                    Err(_) => {
+                        self.error(
+                            el.clone(),
+                            t.line,
+                            ErrorKind::InvalidMjcf(format!("<geom group=\"{v}\"> is not an integer")),
+                        );
+                        continue;
+                    }
+                },
+                None => 0,
+            };
+            if group < self.group_range[0] || group > self.group_range[1] {
+                continue;
+            }
+            let mass = scalar(self, "mass");
+            let density = scalar(self, "density").unwrap_or(1000.0);
+            if mass == Some(0.0) || (mass.is_none() && density == 0.0) {
+                continue;
+            }
+            let kind = attr(self, "type").unwrap_or_else(|| "sphere".into());
+            let geom = t
+                .attr("name")
+                .map_or_else(|| format!("<geom type=\"{kind}\">"), |n| format!("geom `{n}`"));
+            if attr(self, "shellinertia").as_deref() == Some("true") {
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::NotSupported(format!(
+                        "{geom} asks for shellinertia=\"true\", which is not supported yet; give the body an \
+                         <inertial>"
+                    )),
+                );
+                continue;
+            }
+            let fromto = attr(self, "fromto").is_some();
+            let sizes = match attr(self, "size") {
+                Some(v) => {
+                    let words: Vec<Option<f64>> = v.split_whitespace().map(|w| w.parse().ok()).collect();
+                    if words.is_empty() || words.len() > 3 || words.iter().any(Option::is_none) {
+                        self.error(
+                            el.clone(),
+                            t.line,
+                            ErrorKind::BadNumber {
+                                attribute: "geom size".into(),
+                                value: v.clone(),
+                                expected: 3,
+                            },
+                        );
+                        continue;
+                    }
+                    let mut s = [0.0; 3];
+                    for (x, w) in s.iter_mut().zip(&words) {
+                        *x = w.unwrap_or(0.0);
+                    }
+                    s
+                }
+                None => [0.0; 3],
+            };
+            let (pos, rotation) = self.geom_frame(t, &class, "geom", el);
+            if fromto && !matches!(kind.as_str(), "capsule" | "cylinder" | "box" | "ellipsoid") {
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} has a `fromto`, which only a capsule, cylinder, box or ellipsoid may have"
+                    )),
+                );
+                continue;
+            }
+            // The half length along z given by fromto.
+            let half = if fromto {
+                let f = attr(self, "fromto").unwrap_or_default();
+                let f: Vec<f64> = f.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+                if f.len() == 6 {
+                    0.5 * math::norm(&[f[3] - f[0], f[4] - f[1], f[5] - f[2]])
+                } else {
+                    0.0
+                }
+            } else {
+                0.0
+            };
+            use std::f64::consts::PI;
+            // Volume and the moments of inertia per unit mass about the geom's axes.
+            let (needed, volume, unit) = match kind.as_str() {
+                "sphere" => {
+                    let r = sizes[0];
+                    (vec![r], 4.0 / 3.0 * PI * r.powi(3), [0.4 * r * r; 3])
+                }
+                "capsule" | "cylinder" => {
+                    let r = sizes[0];
+                    let hl = if fromto { half } else { sizes[1] };
+                    let h = 2.0 * hl;
+                    let vc = PI * r * r * h;
+                    if kind == "cylinder" {
+                        let ixx = (3.0 * r * r + h * h) / 12.0;
+                        (vec![r, hl], vc, [ixx, ixx, 0.5 * r * r])
+                    } else {
+                        let vs = 4.0 / 3.0 * PI * r.powi(3);
+                        let v = vc + vs;
+                        let ixx = (vc * (r * r / 4.0 + h * h / 12.0)
+                            + vs * (0.4 * r * r + h * h / 4.0 + 3.0 * h * r / 8.0))
+                            / v;
+                        let izz = (vc * 0.5 * r * r + vs * 0.4 * r * r) / v;
+                        (vec![r, hl], v, [ixx, ixx, izz])
+                    }
+                }
+                "box" | "ellipsoid" => {
+                    // With fromto, MuJoCo takes size[0] for both x and y.
+                    let s = if fromto { [sizes[0], sizes[0], half] } else { sizes };
+                    let [a, b, c] = s.map(|x| x * x);
+                    if kind == "box" {
+                        (
+                            s.to_vec(),
+                            8.0 * s[0] * s[1] * s[2],
+                            [(b + c) / 3.0, (a + c) / 3.0, (a + b) / 3.0],
+                        )
+                    } else {
+                        let v = 4.0 / 3.0 * PI * s[0] * s[1] * s[2];
+                        (s.to_vec(), v, [(b + c) / 5.0, (a + c) / 5.0, (a + b) / 5.0])
+                    }
+                }
+                other => {
+                    let why = match other {
+                        "mesh" | "sdf" => "a mesh's inertia is not computed here",
+                        "plane" | "hfield" => "it has no volume",
+                        _ => "it is not an MJCF geom type",
+                    };
+                    self.error(
+                        el.clone(),
+                        t.line,
+                        ErrorKind::NotSupported(format!(
+                            "{geom} of type `{other}` would give the body its inertia (<compiler \
+                             inertiafromgeom>), but {why}; give the body an <inertial> (or the geom mass=\"0\", or \
+                             a group outside inertiagrouprange)"
+                        )),
+                    );
+                    continue;
+                }
+            };
+            if needed.iter().any(|&x| x.is_nan() || x <= 0.0) {
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} needs a positive size for its inertia (size=\"{}\"{}); give its `size`",
+                        sizes.map(|x| x.to_string()).join(" "),
+                        if fromto { " with fromto" } else { "" }
+                    )),
+                );
+                continue;
+            }
+            let m = mass.unwrap_or(density * volume);
+            let part = Inertial {
+                mass: m,
+                com: [0.0; 3],
+                inertia: [
+                    [m * unit[0], 0.0, 0.0],
+                    [0.0, m * unit[1], 0.0],
+                    [0.0, 0.0, m * unit[2]],
+                ],
+            }
+            .transformed(&Placement {
+                rotation,
+                translation: pos,
+            });
+            total = Some(match total {
+                Some(prev) => prev.combined(&part),
+                None => part,
+            });
+        }
+        total.map(symmetric)
+    }
+
+    /// MuJoCo's `boundmass`, `boundinertia`, `balanceinertia` on each body's
+    /// principal moments, then `settotalmass` over all bodies; each inertial then
+    /// moved into its link frame.
+    fn apply_mass_rules(&mut self) {
+        let rules = &self.mass_rules;
+        for r in &mut self.records {
+            if rules.bound_mass > 0.0 || rules.bound_inertia > 0.0 || rules.balance {
+                // MuJoCo leaves a body without mass of its own with its inertial frame
+                // at the numbers of its `pos` (the rotation does not matter: its moments
+                // are all `boundinertia`).
+                let mut i = r.inertial.unwrap_or(Inertial {
+                    com: r.pos,
+                    ..Inertial::principal(0.0, [0.0; 3])
+                });
+                i.mass = i.mass.max(rules.bound_mass);
+                let (written, axes) = i.principal_axes();
+                let mut ev = written.map(|x| x.max(rules.bound_inertia));
+                let broken = ev[0] + ev[1] < ev[2] || ev[0] + ev[2] < ev[1] || ev[1] + ev[2] < ev[0];
+                if rules.balance && broken {
+                    let mean = (ev[0] + ev[1] + ev[2]) / 3.0;
+                    ev = [mean; 3];
+                }
+                if ev != written {
+                    i.inertia = from_principal(ev, &axes);
+                }
+                if i.mass > 0.0 || ev.iter().any(|&x| x > 0.0) {
+                    r.inertial = Some(i);
+                }
             }
         }
-        Some(inertial)
+        if let Some(target) = rules.total {
+            for (body, line) in &self.uncounted {
+                self.errors.push(ModelError {
+                    element: Element::Link(body.clone()),
+                    line: Some(*line),
+                    kind: ErrorKind::NotSupported(format!(
+                        "<compiler settotalmass> counts the mass of body `{body}`, whose geoms' inertia is not \
+                         computed here (a mesh); give the body an <inertial>"
+                    )),
+                });
+            }
+            let total: f64 = self.records.iter().filter_map(|r| r.inertial).map(|i| i.mass).sum();
+            if total > 0.0 {
+                let scale = target / total;
+                for i in self.records.iter_mut().filter_map(|r| r.inertial.as_mut()) {
+                    i.mass *= scale;
+                    i.inertia = i.inertia.map(|row| row.map(|x| x * scale));
+                }
+            }
+        }
+        for r in &self.records {
+            self.links[r.link].inertial = r.inertial.map(|i| Inertial {
+                com: math::sub(&i.com, &r.shift),
+                ..i
+            });
+        }
     }
+
+    /// Sites and bodies are frames of one model: a site named as a body is refused.
+    fn check_site_names(&mut self) {
+        let bodies: std::collections::HashSet<&str> = self
+            .records
+            .iter()
+            .map(|r| self.links[r.link].name.as_str())
+            .chain([WORLD])
+            .collect();
+        let clashes: Vec<(String, usize)> = self
+            .sites
+            .iter()
+            .filter(|(n, _)| bodies.contains(n.as_str()))
+            .cloned()
+            .collect();
+        for (name, line) in clashes {
+            self.error(
+                Element::Link(name.clone()),
+                line,
+                ErrorKind::InvalidMjcf(format!(
+                    "site `{name}` has the name of a body; sites become frames of the model, which share one \
+                     namespace with the bodies: rename the site"
+                )),
+            );
+        }
+    }
+}
+
+/// The inertial with its tensor made exactly symmetric (rotations leave it a few
+/// ulps off).
+fn symmetric(mut inertial: Inertial) -> Inertial {
+    let m = inertial.inertia;
+    for (r, row) in inertial.inertia.iter_mut().enumerate() {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x = 0.5 * (m[r][c] + m[c][r]);
+        }
+    }
+    inertial
+}
+
+/// `axes · diag(moments) · axesᵀ`.
+fn from_principal(moments: Vec3, axes: &Mat3) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for (r, row) in m.iter_mut().enumerate() {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x = (0..3).map(|k| axes[r][k] * moments[k] * axes[c][k]).sum();
+        }
+    }
+    m
 }
 
 fn cross(a: &Vec3, b: &Vec3) -> Vec3 {

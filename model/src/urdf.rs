@@ -94,7 +94,7 @@ fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
         desc = desc.with_free_flyer();
     }
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
-    let mut errors = match desc.build_checked(SiblingOrder::Name, strict) {
+    let mut errors = match desc.build_checked(SiblingOrder::Name, options) {
         Ok(mut model) if unsupported.is_empty() && (!strict || notes.is_empty()) => {
             model.warnings.extend(notes);
             return Ok(model);
@@ -145,40 +145,36 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
             },
         )]);
     }
-    let outline = scan(text);
-    let mut unsupported = Vec::new();
-    match &outline {
-        Ok(tags) => {
-            if let Some(line) = xacro_line(tags) {
-                return Err(vec![robot_error(Some(line), ErrorKind::Xacro)]);
-            }
-            // urdf-rs stops at the first unreadable number without a position.
-            let numbers = number_errors(tags);
-            if !numbers.is_empty() {
-                return Err(numbers);
-            }
-            unsupported = mimic_errors(tags);
-        }
+    let tags = match scan(text) {
+        Ok(tags) => tags,
         // Past the depth limit the text must not reach urdf-rs, whose recursive
         // descent would overflow the stack.
         Err(SyntaxError {
             line,
             too_deep: Some(tag),
             ..
-        }) => return Err(vec![robot_error(Some(*line), ErrorKind::TooDeep { tag: tag.clone() })]),
-        Err(_) => {}
+        }) => return Err(vec![robot_error(Some(line), ErrorKind::TooDeep { tag })]),
+        // Nor any text the scan cannot read: the scan is what holds the nesting limit
+        // (past a DOCTYPE it could not close, say) and refuses what urdf-rs would
+        // read wrongly (a second document element, a NUL).
+        Err(e) => return Err(vec![robot_error(Some(e.line), ErrorKind::Parse(e.message))]),
+    };
+    if let Some(line) = xacro_line(&tags) {
+        return Err(vec![robot_error(Some(line), ErrorKind::Xacro)]);
     }
-    let dynamics_only = match &outline {
-        Ok(tags) => without_geometry(text, tags),
-        Err(_) => text.to_string(),
-    };
-    let robot = match urdf_rs::read_from_string(&dynamics_only) {
+    // urdf-rs stops at the first unreadable number without a position; it also reads
+    // any document element as <robot>, a link named "", and an unusable `quat_xyzw`
+    // as no rotation (`crate::xml::urdf_errors`).
+    let numbers = [crate::xml::urdf_errors(&tags), number_errors(&tags)].concat();
+    if !numbers.is_empty() {
+        return Err(numbers);
+    }
+    let unsupported = mimic_errors(&tags);
+    let robot = match urdf_rs::read_from_string(&without_geometry(text, &tags)) {
         Ok(robot) => robot,
-        Err(e) => return Err(parse_errors(&outline, &e.to_string())),
+        Err(e) => return Err(parse_errors(&tags, &e.to_string())),
     };
-    // Without an outline (only if the scan disagrees with urdf-rs about the syntax)
-    // the model is still read, just without line numbers.
-    let outline = outline.as_deref().map(Outline::new).unwrap_or_default();
+    let outline = Outline::new(&tags);
 
     let links = robot
         .links
@@ -229,6 +225,7 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
                     .dynamics
                     .as_ref()
                     .map(|d| JointDynamics {
+                        armature: 0.0,
                         damping: d.damping,
                         friction: d.friction,
                     })
@@ -335,12 +332,13 @@ fn number_errors(tags: &[Tag]) -> Vec<ModelError> {
     errors
 }
 
-/// A `<mimic>` in a joint: reported rather than read as an independent joint.
+/// A `<mimic>` in a moving joint: reported rather than read as an independent joint.
+/// On a fixed joint it has nothing to follow with and is ignored, as urdfdom does.
 fn mimic_errors(tags: &[Tag]) -> Vec<ModelError> {
     tags.iter()
         .filter(|t| t.name == "mimic")
         .filter_map(|t| {
-            let owner = owner_of(tags, t).filter(|o| o.name == "joint")?;
+            let owner = owner_of(tags, t).filter(|o| o.name == "joint" && o.attr("type") != Some("fixed"))?;
             Some(ModelError {
                 element: element_of(owner),
                 line: Some(t.line),
@@ -352,30 +350,25 @@ fn mimic_errors(tags: &[Tag]) -> Vec<ModelError> {
 
 /// Turns a failure of urdf-rs into errors. urdf-rs stops at the first problem and
 /// gives no position, so the scan's own findings come first when it has any.
-fn parse_errors(outline: &Result<Vec<Tag>, SyntaxError>, message: &str) -> Vec<ModelError> {
-    match outline {
-        Err(e) => vec![robot_error(Some(e.line), ErrorKind::Parse(e.message.clone()))],
-        Ok(tags) => {
-            let unknown_types: Vec<ModelError> = Outline::new(tags)
-                .joints
-                .iter()
-                .filter_map(|j| {
-                    let t = j.tag.attr("type")?;
-                    (!KNOWN_JOINT_TYPES.contains(&t)).then(|| ModelError {
-                        element: Element::Joint(j.tag.attr("name").unwrap_or_default().to_string()),
-                        line: Some(j.tag.line),
-                        kind: ErrorKind::UnsupportedJointType(t.to_string()),
-                    })
-                })
-                .collect();
-            if unknown_types.is_empty() {
-                // serde's "custom: " prefix says nothing to a URDF author.
-                let message = message.strip_prefix("custom: ").unwrap_or(message);
-                vec![robot_error(None, ErrorKind::Parse(message.to_string()))]
-            } else {
-                unknown_types
-            }
-        }
+fn parse_errors(tags: &[Tag], message: &str) -> Vec<ModelError> {
+    let unknown_types: Vec<ModelError> = Outline::new(tags)
+        .joints
+        .iter()
+        .filter_map(|j| {
+            let t = j.tag.attr("type")?;
+            (!KNOWN_JOINT_TYPES.contains(&t)).then(|| ModelError {
+                element: Element::Joint(j.tag.attr("name").unwrap_or_default().to_string()),
+                line: Some(j.tag.line),
+                kind: ErrorKind::UnsupportedJointType(t.to_string()),
+            })
+        })
+        .collect();
+    if unknown_types.is_empty() {
+        // serde's "custom: " prefix says nothing to a URDF author.
+        let message = message.strip_prefix("custom: ").unwrap_or(message);
+        vec![robot_error(None, ErrorKind::Parse(message.to_string()))]
+    } else {
+        unknown_types
     }
 }
 

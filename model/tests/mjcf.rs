@@ -4,8 +4,11 @@
 //! `scripts/make_mjcf_fixtures.py`), the hand-written `small.xml` gives its documented
 //! numbers, the hand-written `floating.xml` (a free flyer and a ball joint) gives its
 //! documented model and MuJoCo's mass matrix and bias forces in dyngen's coordinates,
-//! and one test per refused construct checks the message names the element and its
-//! line.
+//! the hand-written `armature.xml`, `geoms.xml`, `compiler.xml` and `ref.xml` give
+//! MuJoCo's `qM` as `M + diag(Ia)`, its site poses, its geom-derived and
+//! compiler-adjusted inertias and its dynamics with joint `ref` and several joints in
+//! one body (`scripts/make_mjcf_armature_fixtures.py`), and one test per refused
+//! construct checks the message names the element and its line.
 
 use dyngen_model::regressor::joint_torque_regressor;
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
@@ -205,7 +208,15 @@ fn small_gives_its_documented_numbers() {
         &[0.05, 0.0, 0.0, 0.0, 0.04, 0.0, 0.0, 0.0, 0.02]
     ));
     let fore = &model.bodies[1];
-    assert_eq!(fore.merged, ["tip"]);
+    // The site `tool` in `tip` is a frame of `fore`, at tip's place, with no mass.
+    assert_eq!(fore.merged, ["tip", "tool"]);
+    let tool = model.frames.iter().find(|f| f.name == "tool").unwrap();
+    assert_eq!(tool.body, 2);
+    assert!(close(&tool.placement.translation, &[0.2, 0.0, 0.0]));
+    assert!(close(
+        &flat3(&tool.placement.rotation),
+        &flat3(&dyngen_model::math::IDENTITY)
+    ));
     assert_eq!(fore.inertial.mass, 1.5);
     assert!(close(&fore.inertial.com, &[0.4 / 3.0, 0.0, 0.0]));
     // 0.004 0.002 0.003 about fore's centre, 1e-4 each for the tip, plus the
@@ -214,7 +225,7 @@ fn small_gives_its_documented_numbers() {
     let expected = [0.0041, 0.0, 0.0, 0.0, 0.0021 + d, 0.0, 0.0, 0.0, 0.0031 + d];
     assert!(max_abs_diff(&flat3(&fore.inertial.inertia), &expected) < 1e-15);
     let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["world", "base", "upper", "fore", "tip"]);
+    assert_eq!(names, ["world", "base", "upper", "fore", "tip", "tool"]);
 }
 
 #[test]
@@ -260,33 +271,64 @@ fn only_error(text: &str, element: Element, line: usize, says: &str) -> ErrorKin
     err.kind.clone()
 }
 
+/// Two joints in one body: a chain through a massless link named after the body and
+/// its first joint, the body's inertial on the last, each joint at its own `pos`.
 #[test]
-fn two_joints_in_one_body_are_refused() {
+fn two_joints_in_one_body_are_a_chain() {
     let text = mjcf(&[
-        "<body name=\"a\">",
+        "<body name=\"a\" pos=\"0 0 1\">",
         INERTIAL,
-        "<joint name=\"j1\" axis=\"1 0 0\"/>",
-        "<joint name=\"j2\" axis=\"0 1 0\"/>",
+        "<joint name=\"j1\" axis=\"1 0 0\" pos=\"0.1 0 0\"/>",
+        "<joint name=\"j2\" axis=\"0 1 0\" pos=\"0 0.2 0\"/>",
         "</body>",
     ]);
-    only_error(
-        &text,
-        Element::Joint("j2".into()),
-        6,
-        "body `a` already has a joint; several joints in one body are not supported yet",
-    );
+    let model = parse_mjcf(&text).unwrap();
+    let names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(names, ["a (j1)", "a"]);
+    assert_eq!(model.bodies[0].inertial.mass, 0.0);
+    assert_eq!(model.joints[0].origin.translation, [0.1, 0.0, 1.0]);
+    assert_eq!(model.joints[1].origin.translation, [-0.1, 0.2, 0.0]);
+    assert_eq!(model.joints[1].parent, 1);
+    assert_eq!(model.joints[1].axis, [0.0, 1.0, 0.0]);
+    // The body's inertial in the last joint's frame.
+    assert_eq!(model.bodies[1].inertial.com, [0.0, -0.2, 0.0]);
 }
 
+/// MuJoCo's `inertiafromgeom="auto"` (its default): a body without <inertial> takes
+/// the inertia of its geoms (a sphere of radius 0.1 and density 1000 here).
 #[test]
-fn missing_inertial_is_refused() {
+fn a_body_without_inertial_takes_its_geoms() {
     let text = mjcf(&[
         "<body name=\"a\">",
         "<joint name=\"j\"/>",
-        "<geom type=\"sphere\" size=\"0.1\"/>",
+        "<geom type=\"sphere\" size=\"0.1\" pos=\"0 0 0.5\"/>",
         "</body>",
     ]);
-    let kind = only_error(&text, Element::Link("a".into()), 3, "has no <inertial>");
-    assert_eq!(kind, ErrorKind::MissingInertial);
+    let model = parse_mjcf(&text).unwrap();
+    let i = &model.bodies[0].inertial;
+    let m = 4.0 / 3.0 * std::f64::consts::PI * 1e-3 * 1000.0;
+    assert!((i.mass - m).abs() < 1e-15 * m);
+    assert_eq!(i.com, [0.0, 0.0, 0.5]);
+    assert!(
+        max_abs_diff(
+            &flat3(&i.inertia),
+            &[
+                0.4 * m * 0.01,
+                0.0,
+                0.0,
+                0.0,
+                0.4 * m * 0.01,
+                0.0,
+                0.0,
+                0.0,
+                0.4 * m * 0.01
+            ]
+        ) < 1e-16
+    );
+    // Not with inertiafromgeom="false": then the body has no mass.
+    let text = text.replace("<worldbody>", "<compiler inertiafromgeom=\"false\"/>\n<worldbody>");
+    let d = dyngen_model::mjcf::mjcf_description(&text).unwrap();
+    assert_eq!(d.links.iter().find(|l| l.name == "a").unwrap().inertial, None);
     // A massless marker at the end of a chain is fine.
     let text = mjcf(&[
         "<body name=\"a\">",
@@ -379,9 +421,9 @@ fn errors_are_all_collected_with_the_file_name() {
     let path = dir.join("bad.xml");
     let text = mjcf(&[
         "<body name=\"a\">",
-        "<joint name=\"b\" ref=\"0.5\"/>",
+        "<joint name=\"b\" damping=\"fast\"/>",
         INERTIAL,
-        "<body name=\"c\"><joint name=\"d\"/></body>",
+        "<body name=\"c\"><joint name=\"d\"/><inertial mass=\"1\" fullinertia=\"1 1 1 0 0 0\" quat=\"1 0 0 0\"/></body>",
         "</body>",
     ]);
     std::fs::write(&path, text).unwrap();
@@ -391,27 +433,60 @@ fn errors_are_all_collected_with_the_file_name() {
     let lines: Vec<&str> = message.lines().collect();
     assert_eq!(lines.len(), 2, "{message}");
     assert!(
-        lines[0].ends_with("bad.xml:4: joint `b`: a joint `ref` (0.5) is not supported yet: it moves the joint's zero; rotate or move the body to the reference position instead"),
+        lines[0].ends_with(
+            "bad.xml:4: joint `b`: <joint damping=\"fast\"> is not a number; write one number such as `0.5`"
+        ),
         "{message}"
     );
     assert!(
-        lines[1].contains("bad.xml:6: link `c`: this moving body has no <inertial>"),
+        lines[1].ends_with(
+            "bad.xml:6: link `c`: <inertial> gives both `fullinertia` and an orientation (`quat`), which MuJoCo \
+             refuses: give `fullinertia` in the body frame without an orientation, or `diaginertia` with `quat`"
+        ),
         "{message}"
     );
 }
 
+/// `armature` is the rotor inertia `Ia` of each of the joint's coordinates (a ball
+/// joint has 3); `stiffness` is left out with a warning naming its `springref`.
 #[test]
-fn armature_is_left_out_with_a_warning() {
+fn armature_is_the_rotor_inertia_and_stiffness_a_warning() {
     let text = mjcf(&[
         "<body name=\"a\">",
         INERTIAL,
-        "<joint name=\"j\" armature=\"0.1\"/>",
+        "<joint name=\"j\" armature=\"0.1\" stiffness=\"3\" springref=\"0.2\" damping=\"0.4\"/>",
+        "<body name=\"b\">",
+        INERTIAL,
+        "<joint name=\"k\" type=\"ball\" armature=\"0.25\"/>",
+        "</body>",
         "</body>",
     ]);
     let model = parse_mjcf(&text).unwrap();
-    assert_eq!(model.warnings.len(), 1);
+    assert_eq!(model.joints[0].dynamics.armature, 0.1);
+    assert_eq!(
+        dyngen_model::joint_params::nominal_joint_params(&model),
+        [
+            [0.1, 0.4, 0.0, 0.0],
+            [0.25, 0.0, 0.0, 0.0],
+            [0.25, 0.0, 0.0, 0.0],
+            [0.25, 0.0, 0.0, 0.0]
+        ]
+        .concat()
+    );
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     let w = model.warnings[0].warning_message();
-    assert!(w.starts_with("line 5: joint `j`: armature = 0.1 is left out"), "{w}");
+    assert!(
+        w.starts_with("line 5: joint `j`: stiffness = 3 (springref 0.2) is left out"),
+        "{w}"
+    );
+    // A negative armature is refused.
+    let text = text.replace("armature=\"0.25\"", "armature=\"-0.25\"");
+    only_error(
+        &text,
+        Element::Joint("k".into()),
+        8,
+        "armature = -0.25 is not a rotor inertia; give a value >= 0",
+    );
 }
 
 #[test]
@@ -632,7 +707,11 @@ fn floating_gives_its_documented_model() {
     assert_eq!(model.bodies[0].merged, ["head"]);
     assert!((model.bodies[0].inertial.mass - 7.6).abs() < 1e-15);
     let names: Vec<&str> = model.frames.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["world", "torso", "head", "upper_arm", "forearm", "hand"]);
+    // The site `palm` in `hand` is a frame too.
+    assert_eq!(
+        names,
+        ["world", "torso", "head", "upper_arm", "forearm", "hand", "palm"]
+    );
 }
 
 /// The largest magnitude in `x`.
@@ -921,9 +1000,9 @@ fn a_free_joint_with_another_joint_is_refused() {
     ]);
     only_error(
         &text,
-        Element::Joint("j".into()),
-        6,
-        "body `a` already has a joint; several joints in one body are not supported yet",
+        Element::Joint("f".into()),
+        5,
+        "body `a` has a free joint and other joints; a free joint must be the only joint of its body",
     );
 }
 
@@ -965,4 +1044,449 @@ fn floating_quadruped_reads_the_same_from_urdf_and_mjcf() {
     // MuJoCo prints 6 significant digits (the inertias' principal axes, the hips'
     // pitch); measured 1.8e-10.
     assert!(worst < 1e-8, "relative difference {worst:e}");
+}
+
+// ---------------------------------------------------------------------------------
+// Armature, sites, inertia from geoms, compiler mass rules, joint `ref`, several
+// joints in one body: against MuJoCo (`scripts/make_mjcf_armature_fixtures.py`).
+
+fn reference_json(name: &str) -> Value {
+    let text = std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// MuJoCo's `qpos` as dyngen's `q`: ball-joint quaternions `w x y z` to `x y z w`.
+fn dyngen_q(model: &Model, qpos: &[f64]) -> Vec<f64> {
+    let mut q = qpos.to_vec();
+    for j in 1..=model.dof() {
+        if model.joints[j - 1].kind == JointKind::Spherical {
+            q[model.q_offset(j)..model.q_offset(j) + 4].rotate_left(1);
+        }
+    }
+    q
+}
+
+/// Largest differences from MuJoCo over the fixture's states: of the rigid-body mass
+/// matrix (MuJoCo's with `dof_armature` zeroed), of `M + diag(Ia)` (Ia the nominal
+/// rotor inertias) from MuJoCo's `qM`, and of the bias forces.
+fn armature_against_mujoco(name: &str) -> [f64; 3] {
+    let model = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
+    let reference = reference_json(name);
+    let joints: Vec<&str> = reference["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
+    let ours: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(ours, joints, "{name}: joint order");
+    let nv = model.nv();
+    assert_eq!(nv as u64, reference["nv"].as_u64().unwrap());
+    let ia: Vec<f64> = dyngen_model::joint_params::nominal_joint_params(&model)
+        .chunks(4)
+        .map(|p| p[0])
+        .collect();
+    assert_eq!(
+        ia,
+        numbers(&reference["armature"]),
+        "{name}: Ia is MuJoCo's dof_armature"
+    );
+    let (mut dr, mut dm, mut db) = (0.0f64, 0.0f64, 0.0f64);
+    for s in reference["samples"].as_array().unwrap() {
+        let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        assert_eq!(q, dyngen_q(&model, &numbers(&s["mujoco_qpos"])));
+        let (m, bias) = floating_dynamics(&model, &q, &v);
+        let rigid: Vec<f64> = m.iter().flatten().copied().collect();
+        let with_rotors: Vec<f64> = (0..nv * nv)
+            .map(|k| rigid[k] + if k / nv == k % nv { ia[k / nv] } else { 0.0 })
+            .collect();
+        dr = dr.max(max_abs_diff(&rigid, &numbers(&s["M_rigid"])));
+        dm = dm.max(max_abs_diff(&with_rotors, &numbers(&s["M"])));
+        db = db.max(max_abs_diff(&bias, &numbers(&s["bias"])));
+    }
+    eprintln!(
+        "{name}: |M - M_rigid_mujoco| <= {dr:.2e}, |M + diag(Ia) - qM| <= {dm:.2e}, |bias - qfrc_bias| <= {db:.2e}"
+    );
+    [dr, dm, db]
+}
+
+/// Joint armature is the rotor inertia `Ia`: `M + diag(Ia)` is MuJoCo's `qM` on a
+/// hinge, slide and ball chain with armature from classes and joints.
+#[test]
+fn mass_matrix_with_armature_equals_mujocos_qm() {
+    let [dr, dm, db] = armature_against_mujoco("armature");
+    assert!(
+        dr <= 1e-12 && dm <= 1e-12 && db <= 1e-11,
+        "M_rigid {dr:e}, M {dm:e}, bias {db:e}"
+    );
+    // And the armature is in it: without it the difference is the armature.
+    let model = load_mjcf(&fixture("armature.xml")).unwrap();
+    let s = &reference_json("armature")["samples"][1];
+    let (m, _) = floating_dynamics(&model, &numbers(&s["q"]), &numbers(&s["v"]));
+    let qm = numbers(&s["M"]);
+    assert!((qm[8] - m[1][1] - 0.35).abs() < 1e-12);
+}
+
+/// Joint `ref` (on hinges in degrees and a slide, with joint `pos`) and several joints
+/// in one body (a hinge, a slide and a ball; two hinges): dyngen's q is MuJoCo's qpos
+/// and the dynamics are MuJoCo's, with armature.
+#[test]
+fn joint_ref_and_several_joints_in_a_body_are_mujocos() {
+    let [dr, dm, db] = armature_against_mujoco("ref");
+    assert!(
+        dr <= 1e-12 && dm <= 1e-12 && db <= 1e-11,
+        "M_rigid {dr:e}, M {dm:e}, bias {db:e}"
+    );
+    let model = load_mjcf(&fixture("ref.xml")).unwrap();
+    let names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["a", "b", "c", "multi (m1)", "multi (m2)", "multi", "pair (p1)", "pair"]
+    );
+}
+
+/// World pose of every body at `q` (index 0 the base), by composing joint origins and
+/// joint motions.
+fn body_poses(model: &Model, q: &[f64]) -> Vec<dyngen_model::Placement> {
+    use dyngen_model::math::{scale, IDENTITY};
+    use dyngen_model::Placement;
+    let mut poses = vec![Placement::IDENTITY];
+    for j in 1..=model.dof() {
+        let joint = &model.joints[j - 1];
+        let qa = model.q_offset(j);
+        let motion = match joint.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                let [x, y, z] = joint.axis;
+                let (s, c) = q[qa].sin_cos();
+                let t = 1.0 - c;
+                Placement {
+                    rotation: [
+                        [c + x * x * t, x * y * t - z * s, x * z * t + y * s],
+                        [y * x * t + z * s, c + y * y * t, y * z * t - x * s],
+                        [z * x * t - y * s, z * y * t + x * s, c + z * z * t],
+                    ],
+                    translation: [0.0; 3],
+                }
+            }
+            JointKind::Prismatic => Placement {
+                rotation: IDENTITY,
+                translation: scale(q[qa], &joint.axis),
+            },
+            JointKind::Spherical => Placement {
+                rotation: dyngen_model::regressor::quaternion_xyzw(&q[qa..qa + 4]),
+                translation: [0.0; 3],
+            },
+            other => panic!("{other:?} not in these fixtures"),
+        };
+        let pose = poses[joint.parent].compose(&joint.origin).compose(&motion);
+        poses.push(pose);
+    }
+    poses
+}
+
+/// Named sites are frames of their body, placed as MuJoCo places them (`site_xpos`,
+/// `site_xmat` at `qpos0`), in rotated bodies, bodies moved by their joint `pos` and
+/// `ref`, and a body with two joints; an unnamed site is no frame.
+#[test]
+fn sites_are_frames_where_mujoco_puts_them() {
+    let mut worst = 0.0f64;
+    for (name, sites) in [("armature", 3), ("ref", 1)] {
+        let model = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
+        let reference = reference_json(name);
+        let q = dyngen_q(&model, &numbers(&reference["qpos0"]));
+        let poses = body_poses(&model, &q);
+        let expected = reference["sites"].as_object().unwrap();
+        assert_eq!(expected.len(), sites);
+        for (site, want) in expected {
+            let frame = model.frames.iter().find(|f| f.name == *site).unwrap();
+            let pose = poses[frame.body].compose(&frame.placement);
+            worst = worst.max(max_abs_diff(&pose.translation, &numbers(&want["pos"])));
+            worst = worst.max(max_abs_diff(&flat3(&pose.rotation), &numbers(&want["rotation"])));
+        }
+        // Bodies, intermediate links of multi-joint bodies and named sites are the frames.
+        assert_eq!(model.frames.len(), 1 + model.dof() + sites, "{name}");
+    }
+    eprintln!("sites: |pose - MuJoCo's| <= {worst:.2e}");
+    assert!(worst <= 1e-14, "{worst:e}");
+}
+
+/// Each body's inertial as the MJCF reader gives it (in the link frame, which is the
+/// body frame when joints have no `pos`) against MuJoCo's compiled `body_mass`,
+/// `body_ipos` and `body_iquat`·diag(`body_inertia`): the largest difference in mass,
+/// centre of mass and tensor.
+fn bodies_against_mujoco(name: &str) -> [f64; 3] {
+    use dyngen_model::math::{mat_mul, quaternion_to_matrix, transpose};
+    let text = std::fs::read_to_string(fixture(&format!("{name}.xml"))).unwrap();
+    let desc = dyngen_model::mjcf::mjcf_description(&text).unwrap();
+    let reference = reference_json(name);
+    let (mut dm, mut dc, mut di) = (0.0f64, 0.0f64, 0.0f64);
+    for (body, want) in reference["bodies"].as_object().unwrap() {
+        let link = desc.links.iter().find(|l| l.name == *body).unwrap();
+        let mass = want["mass"].as_f64().unwrap();
+        let Some(i) = link.inertial else {
+            assert_eq!(mass, 0.0, "{name}: {body}");
+            continue;
+        };
+        let q = numbers(&want["iquat"]);
+        let r = quaternion_to_matrix([q[0], q[1], q[2], q[3]]);
+        let d = numbers(&want["inertia"]);
+        let diag = [[d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]];
+        let tensor = mat_mul(&mat_mul(&r, &diag), &transpose(&r));
+        dm = dm.max((i.mass - mass).abs() / mass);
+        dc = dc.max(max_abs_diff(&i.com, &numbers(&want["ipos"])));
+        di = di.max(max_abs_diff(&flat3(&i.inertia), &flat3(&tensor)) / d[2].max(d[1]).max(d[0]));
+    }
+    eprintln!("{name} bodies: mass rel {dm:.2e}, com {dc:.2e}, inertia rel {di:.2e}");
+    [dm, dc, di]
+}
+
+/// Inertia from geoms (every primitive, fromto, pos and orientation, density, mass,
+/// classes, inertiagrouprange, balanceinertia on a written inertial) is MuJoCo's, and
+/// so are the dynamics of the model built on it.
+#[test]
+fn inertia_from_geoms_is_mujocos() {
+    let [dm, dc, di] = bodies_against_mujoco("geoms");
+    assert!(
+        dm <= 1e-14 && dc <= 1e-15 && di <= 1e-13,
+        "mass {dm:e}, com {dc:e}, inertia {di:e}"
+    );
+    let [dr, dq, db] = armature_against_mujoco("geoms");
+    assert!(
+        dr <= 1e-12 && dq <= 1e-12 && db <= 1e-11,
+        "M_rigid {dr:e}, M {dq:e}, bias {db:e}"
+    );
+}
+
+/// `inertiafromgeom="true"` (a written inertial ignored), boundmass, boundinertia,
+/// balanceinertia and settotalmass are MuJoCo's.
+#[test]
+fn compiler_mass_rules_are_mujocos() {
+    let [dm, dc, di] = bodies_against_mujoco("compiler");
+    assert!(
+        dm <= 1e-14 && dc <= 1e-15 && di <= 1e-13,
+        "mass {dm:e}, com {dc:e}, inertia {di:e}"
+    );
+    let [dr, dq, db] = armature_against_mujoco("compiler");
+    assert!(
+        dr <= 1e-12 && dq <= 1e-12 && db <= 1e-11,
+        "M_rigid {dr:e}, M {dq:e}, bias {db:e}"
+    );
+    let total: f64 = reference_json("compiler")["bodies"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|b| b["mass"].as_f64().unwrap())
+        .sum();
+    assert!((total - 7.5).abs() < 1e-12, "{total}");
+}
+
+/// Warnings (the model loads): each names its element and line.
+fn warnings_of(text: &str) -> Vec<String> {
+    parse_mjcf(text)
+        .unwrap()
+        .warnings
+        .iter()
+        .map(|w| w.warning_message())
+        .collect()
+}
+
+#[test]
+fn equality_and_tendon_are_left_out_with_a_warning() {
+    let mut text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"j\"/>", "</body>"]);
+    text = text.replace(
+        "</mujoco>",
+        "<equality>\n<joint name=\"couple\" joint1=\"j\"/>\n<weld body1=\"a\"/>\n</equality>\n\
+         <tendon>\n<fixed name=\"t\"><joint joint=\"j\" coef=\"1\"/></fixed>\n</tendon>\n</mujoco>",
+    );
+    let w = warnings_of(&text);
+    assert_eq!(w.len(), 3, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "line 9: robot: <equality> <joint name=\"couple\"> is left out: an equality constraint is not in the \
+             model, whose dynamics treat the joints as independent"
+        ),
+        "{w:?}"
+    );
+    assert!(
+        w[1].starts_with("line 10: robot: <equality> <weld> is left out"),
+        "{w:?}"
+    );
+    assert!(
+        w[2].starts_with("line 13: robot: <tendon> <fixed name=\"t\"> is left out: a tendon"),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn compiler_attributes_not_read_are_warned() {
+    let text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"j\"/>", "</body>"]).replace(
+        "<worldbody>",
+        "<compiler fusestatic=\"true\" newthing=\"3\"/>\n<worldbody>",
+    );
+    let w = warnings_of(&text);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("line 2: robot: <compiler newthing=\"3\"> is not read"),
+        "{w:?}"
+    );
+    // Bad values are refused, naming the line.
+    let bad = |attrs: &str, says: &str| {
+        let text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"j\"/>", "</body>"])
+            .replace("<worldbody>", &format!("<compiler {attrs}/>\n<worldbody>"));
+        only_error(&text, Element::Robot, 2, says);
+    };
+    bad(
+        "inertiafromgeom=\"yes\"",
+        "<compiler inertiafromgeom=\"yes\"> is not `true`, `false` or `auto`",
+    );
+    bad(
+        "inertiagrouprange=\"0\"",
+        "<compiler inertiagrouprange=\"0\"> is not two integers",
+    );
+    bad(
+        "balanceinertia=\"1\"",
+        "<compiler balanceinertia=\"1\"> is neither `true` nor `false`",
+    );
+    bad("boundmass=\"x\"", "<compiler boundmass=\"x\"> is not a number");
+    bad(
+        "coordinate=\"global\"",
+        "<compiler coordinate=\"global\"> is not supported",
+    );
+}
+
+/// A body whose inertia would come from geoms that cannot give one: named with its
+/// line and what to do instead.
+#[test]
+fn geoms_that_cannot_give_an_inertia_are_refused() {
+    let body = |geom: &str| mjcf(&["<body name=\"a\">", "<joint name=\"j\"/>", geom, "</body>"]);
+    only_error(
+        &body("<geom name=\"shell\" type=\"mesh\" mesh=\"m\"/>"),
+        Element::Link("a".into()),
+        5,
+        "geom `shell` of type `mesh` would give the body its inertia (<compiler inertiafromgeom>), but a mesh's \
+         inertia is not computed here; give the body an <inertial>",
+    );
+    only_error(
+        &body("<geom type=\"box\" size=\"0.1 0.1 0.1\" shellinertia=\"true\"/>"),
+        Element::Link("a".into()),
+        5,
+        "<geom type=\"box\"> asks for shellinertia=\"true\", which is not supported yet",
+    );
+    only_error(
+        &body("<geom type=\"capsule\" size=\"0.1\"/>"),
+        Element::Link("a".into()),
+        5,
+        "<geom type=\"capsule\"> needs a positive size for its inertia (size=\"0.1 0 0\"); give its `size`",
+    );
+    only_error(
+        &body("<geom type=\"sphere\" size=\"0.1\" fromto=\"0 0 0 0 0 1\"/>"),
+        Element::Link("a".into()),
+        5,
+        "<geom type=\"sphere\"> has a `fromto`, which only a capsule, cylinder, box or ellipsoid may have",
+    );
+    // Not when the geom gives no mass, or the body has an <inertial>.
+    parse_mjcf(&body("<geom type=\"mesh\" mesh=\"m\" mass=\"0\"/>")).unwrap();
+    parse_mjcf(&body("<geom type=\"mesh\" mesh=\"m\" group=\"6\"/>")).unwrap();
+    parse_mjcf(&mjcf(&[
+        "<body name=\"a\">",
+        "<joint name=\"j\"/>",
+        INERTIAL,
+        "<geom type=\"mesh\" mesh=\"m\"/>",
+        "</body>",
+    ]))
+    .unwrap();
+}
+
+#[test]
+fn fullinertia_with_an_orientation_is_refused() {
+    for o in ["quat=\"1 0 0 0\"", "euler=\"0 0 10\""] {
+        let text = mjcf(&[
+            "<body name=\"a\">",
+            "<joint name=\"j\"/>",
+            &format!("<inertial mass=\"1\" fullinertia=\"0.1 0.1 0.1 0 0 0\" {o}/>"),
+            "</body>",
+        ]);
+        let key = o.split('=').next().unwrap();
+        only_error(
+            &text,
+            Element::Link("a".into()),
+            5,
+            &format!("<inertial> gives both `fullinertia` and an orientation (`{key}`), which MuJoCo refuses"),
+        );
+    }
+}
+
+#[test]
+fn a_site_named_as_a_body_is_refused() {
+    let text = mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\"/>",
+        "<body name=\"b\" pos=\"0 0 1\"><site name=\"a\"/></body>",
+        "</body>",
+    ]);
+    only_error(
+        &text,
+        Element::Link("a".into()),
+        6,
+        "site `a` has the name of a body; sites become frames of the model, which share one namespace with the \
+         bodies: rename the site",
+    );
+}
+
+/// A site in a body with a joint `pos` and a rotation: its frame is in the link frame
+/// (on the joint), so its translation loses the joint's `pos`; a site in
+/// `<worldbody>` is a frame of the base.
+#[test]
+fn a_site_is_placed_in_its_link_frame() {
+    let text = mjcf(&[
+        "<site name=\"fixed\" pos=\"1 2 3\" zaxis=\"1 0 0\"/>",
+        "<body name=\"a\" euler=\"0 0 90\">",
+        INERTIAL,
+        "<joint name=\"j\" pos=\"0.1 0 0\"/>",
+        "<site name=\"s\" pos=\"0.3 0.2 0\" axisangle=\"0 0 1 90\"/>",
+        "</body>",
+    ]);
+    let model = parse_mjcf(&text).unwrap();
+    let s = model.frames.iter().find(|f| f.name == "s").unwrap();
+    assert_eq!(s.body, 1);
+    assert!(max_abs_diff(&s.placement.translation, &[0.2, 0.2, 0.0]) < 1e-15);
+    assert!(
+        max_abs_diff(
+            &flat3(&s.placement.rotation),
+            &[0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+        ) < 1e-15
+    );
+    let f = model.frames.iter().find(|f| f.name == "fixed").unwrap();
+    assert_eq!((f.body, f.placement.translation), (0, [1.0, 2.0, 3.0]));
+    assert!(
+        max_abs_diff(
+            &flat3(&f.placement.rotation),
+            &[0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0]
+        ) < 1e-15
+    );
+}
+
+/// A body welded to the world does not enter the dynamics: its mesh geoms are no
+/// error, unless `settotalmass` would count their mass.
+#[test]
+fn mesh_geoms_of_a_body_welded_to_the_world_are_no_error() {
+    let text = mjcf(&[
+        "<body name=\"base\">",
+        "<geom type=\"mesh\" mesh=\"m\"/>",
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\"/>",
+        "</body>",
+        "</body>",
+    ]);
+    let model = parse_mjcf(&text).unwrap();
+    assert_eq!(model.bodies.len(), 1);
+    let text = text.replace("<worldbody>", "<compiler settotalmass=\"3\"/>\n<worldbody>");
+    only_error(
+        &text,
+        Element::Link("base".into()),
+        4,
+        "<compiler settotalmass> counts the mass of body `base`, whose geoms' inertia is not computed here",
+    );
 }

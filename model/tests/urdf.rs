@@ -458,34 +458,102 @@ fn one_body(link_line: &str) -> String {
     ])
 }
 
-#[test]
-fn moving_body_without_inertial() {
-    let e = single(&one_body(r#"<link name="a"/>"#), Element::Link("a".into()), 3);
-    assert_eq!(e.kind, ErrorKind::MissingInertial);
-    assert!(e.to_string().contains("has no <inertial>"), "{e}");
+/// The model of `text` with its warnings' elements and lines.
+fn load_warned(text: &str) -> (Model, Vec<(Element, Option<usize>)>) {
+    let model = parse_urdf(text).unwrap_or_else(|e| panic!("{e}"));
+    let warned = model.warnings.iter().map(|w| (w.element.clone(), w.line)).collect();
+    (model, warned)
+}
+
+fn strict_errors(text: &str) -> Vec<ModelError> {
+    parse_urdf_with(text, true).unwrap_err().errors
 }
 
 #[test]
-fn all_zero_inertial_counts_as_missing() {
-    let e = single(
-        &one_body(&link_with("a", "0", ["0", "0", "0"])),
-        Element::Link("a".into()),
-        3,
-    );
-    assert_eq!(e.kind, ErrorKind::MissingInertial);
+fn massless_moving_link_loads_with_a_singular_mass_matrix_warning() {
+    // No <inertial>, and an all-zero one: a massless body, as Pinocchio reads it.
+    for a in [r#"<link name="a"/>"#.to_string(), link_with("a", "0", ["0", "0", "0"])] {
+        let (model, warned) = load_warned(&one_body(&a));
+        assert_eq!(model.bodies[0].inertial.mass, 0.0);
+        assert_eq!(warned, [(Element::Joint("j".into()), Some(4))]);
+        assert_eq!(model.warnings[0].kind, ErrorKind::SingularMassMatrix);
+        let message = model.warnings[0].warning_message();
+        assert!(
+            message.starts_with("line 4: joint `j`: the mass matrix is singular along this joint")
+                && message.contains("forward dynamics (aba) has no solution")
+                && message.contains("a strict build refuses it"),
+            "{message}"
+        );
+        let errs = strict_errors(&one_body(&a));
+        assert_eq!(errs.len(), 1, "{errs:#?}");
+        assert_named(&errs[0], &Element::Joint("j".into()), 4);
+    }
+}
+
+#[test]
+fn massless_links_that_carry_mass_load_without_a_word() {
+    // A massless link between two joints (a finger's knuckle, a universal joint's
+    // cross): the mass matrix stays regular, so nothing to say.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        r#"<link name="cross"/>"#,
+        &link_with("a", "1", ["0.1", "0.2", "0.25"]),
+        &joint("jx", "continuous", "base", "cross", ""),
+        &joint("jy", "continuous", "cross", "a", r#"<axis xyz="0 1 0"/>"#),
+    ]);
+    let (model, warned) = load_warned(&text);
+    assert_eq!(model.dof(), 2);
+    assert!(warned.is_empty(), "{warned:?}");
+    assert!(parse_urdf_with(&text, true).is_ok());
+    // Two coaxial joints with only a massless link between them move the same
+    // mass: the second adds nothing, and it is named.
+    let coaxial = text.replace(r#"<axis xyz="0 1 0"/>"#, "");
+    let (_, warned) = load_warned(&coaxial);
+    assert_eq!(warned, [(Element::Joint("jy".into()), Some(6))]);
+}
+
+#[test]
+fn massless_parts_keep_their_rotational_inertia_when_merged() {
+    // An inertia-only rotor (mass 0) with an inertia-only cap fixed to it: the body
+    // turns with both moments (1e-3 + 2e-3 about z), as Pinocchio adds them.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link_with("rotor", "0", ["1e-3", "1e-3", "1e-3"]),
+        &link_with("cap", "0", ["2e-3", "2e-3", "2e-3"]),
+        &joint("spin", "continuous", "base", "rotor", r#"<axis xyz="0 0 1"/>"#),
+        &joint("fix", "fixed", "rotor", "cap", r#"<origin xyz="0 0 0.1"/>"#),
+    ]);
+    let (model, warned) = load_warned(&text);
+    assert_close(model.bodies[0].inertial.inertia[2][2], 3e-3, 1e-18, "merged moment");
+    assert_eq!(model.bodies[0].inertial.mass, 0.0);
+    // Not a rigid body (mass 0 with inertia), but the joint moves inertia: M is regular.
+    assert_eq!(warned, [(Element::Link("rotor".into()), Some(3))]);
 }
 
 #[test]
 fn zero_and_negative_mass() {
-    for (mass, value) in [("0", 0.0), ("-1.5", -1.5)] {
-        let e = single(
-            &one_body(&link_with("a", mass, ["1", "1", "1"])),
-            Element::Link("a".into()),
-            3,
-        );
-        assert_eq!(e.kind, ErrorKind::NonPositiveMass(value));
-        assert!(e.to_string().contains(&format!("mass {mass} is not positive")), "{e}");
-    }
+    // Mass 0 with a rotational inertia is not a rigid body: loaded, with a warning.
+    let (model, warned) = load_warned(&one_body(&link_with("a", "0", ["1", "1", "1"])));
+    assert_eq!(warned, [(Element::Link("a".into()), Some(3))]);
+    assert_eq!(model.warnings[0].kind, ErrorKind::NonPositiveMass(0.0));
+    let message = model.warnings[0].warning_message();
+    assert!(
+        message.contains("mass 0 with a nonzero rotational inertia is not a rigid body"),
+        "{message}"
+    );
+    assert!(
+        message.contains("accepted as written, as Pinocchio reads it"),
+        "{message}"
+    );
+    assert_eq!(strict_errors(&one_body(&link_with("a", "0", ["1", "1", "1"]))).len(), 1);
+    // A negative mass is a mistake in that link.
+    let e = single(
+        &one_body(&link_with("a", "-1.5", ["1", "1", "1"])),
+        Element::Link("a".into()),
+        3,
+    );
+    assert_eq!(e.kind, ErrorKind::NonPositiveMass(-1.5));
+    assert!(e.to_string().contains("mass -1.5 is negative"), "{e}");
 }
 
 #[test]
@@ -618,6 +686,24 @@ fn mimic_joint_is_reported() {
 }
 
 #[test]
+fn mimic_on_a_fixed_joint_is_ignored() {
+    // What the mimic error tells the user to do, done: the joint is locked, and its
+    // <mimic> has nothing to follow with.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("jb", "fixed", "a", "b", r#"<mimic joint="ja" multiplier="-1"/>"#),
+    ]);
+    let (model, warned) = load_warned(&text);
+    assert!(warned.is_empty(), "{warned:?}");
+    assert_eq!(model.dof(), 1);
+    assert_eq!(model.bodies[0].merged, ["b"]);
+    assert!(urdf_description(&text).is_ok());
+}
+
+#[test]
 fn nesting_beyond_the_limit_is_an_error_not_a_stack_overflow() {
     let depth = 20_000;
     let text = format!(
@@ -696,24 +782,68 @@ fn rpy_near_a_quarter_turn_is_taken_as_written() {
 
 #[test]
 fn inertia_not_positive_definite() {
-    let e = single(
-        &one_body(&link_with("a", "1", ["1", "1", "-0.01"])),
-        Element::Link("a".into()),
-        3,
+    let text = one_body(&link_with("a", "1", ["1", "1", "-0.01"]));
+    let (model, warned) = load_warned(&text);
+    assert_eq!(warned, [(Element::Link("a".into()), Some(3))]);
+    assert!(matches!(model.warnings[0].kind, ErrorKind::NotPositiveDefinite(_)));
+    let message = model.warnings[0].warning_message();
+    assert!(message.contains("inertia is not positive definite"), "{message}");
+    // 0.01 of the largest moment 1: 1 %, beyond CAD rounding.
+    assert!(
+        message.contains("although it is 1.000 % of its largest moment away from physical"),
+        "{message}"
     );
-    assert!(matches!(e.kind, ErrorKind::NotPositiveDefinite(_)), "{e:?}");
-    assert!(e.to_string().contains("inertia is not positive definite"), "{e}");
+    let errs = strict_errors(&text);
+    assert!(matches!(errs[0].kind, ErrorKind::NotPositiveDefinite(_)), "{errs:?}");
+    assert_named(&errs[0], &Element::Link("a".into()), 3);
 }
 
 #[test]
 fn triangle_inequality_violated() {
-    let e = single(
-        &one_body(&link_with("a", "1", ["1", "1", "3"])),
-        Element::Link("a".into()),
-        3,
+    let text = one_body(&link_with("a", "1", ["1", "1", "3"]));
+    let (model, warned) = load_warned(&text);
+    assert_eq!(warned, [(Element::Link("a".into()), Some(3))]);
+    assert!(matches!(model.warnings[0].kind, ErrorKind::TriangleInequality(_)));
+    let message = model.warnings[0].warning_message();
+    assert!(message.contains("break the triangle inequality"), "{message}");
+    assert!(message.contains("33.333 % of its largest moment"), "{message}");
+    assert!(message.contains("--balance-inertia"), "{message}");
+    // Kept as written, as Pinocchio keeps it.
+    assert_eq!(model.bodies[0].inertial.inertia[2][2], 3.0);
+    let errs = strict_errors(&text);
+    assert!(matches!(errs[0].kind, ErrorKind::TriangleInequality(_)), "{errs:?}");
+}
+
+#[test]
+fn balance_inertia_replaces_a_non_physical_inertia_by_the_nearest_physical_one() {
+    let text = one_body(&link_with("a", "2", ["1", "1", "3"]));
+    let options = dyngen_model::LoadOptions {
+        balance_inertia: true,
+        ..Default::default()
+    };
+    let model = dyngen_model::parse_urdf_options(&text, options).unwrap();
+    // Each moment moved by a third of the excess 1: 4/3, 4/3, 8/3.
+    let (ev, _) = model.bodies[0].inertial.principal_axes();
+    for (x, expected) in ev.iter().zip([4.0 / 3.0, 4.0 / 3.0, 8.0 / 3.0]) {
+        assert_close(*x, expected, 1e-12, "balanced moment");
+    }
+    assert_eq!(model.bodies[0].inertial.mass, 2.0);
+    assert!(dyngen_model::check_inertial(&model.bodies[0].inertial).is_ok());
+    assert_eq!(model.warnings.len(), 1);
+    let message = model.warnings[0].warning_message();
+    assert!(
+        message.starts_with("line 3: link `a`: principal moments")
+            && message.contains(
+                "replaced by the nearest physical inertia (principal moments 1.333333e0, 1.333333e0, 2.666667e0"
+            ),
+        "{message}"
     );
-    assert!(matches!(e.kind, ErrorKind::TriangleInequality(_)), "{e:?}");
-    assert!(e.to_string().contains("break the triangle inequality"), "{e}");
+    // Strict still refuses.
+    let strict = dyngen_model::LoadOptions {
+        strict: true,
+        ..options
+    };
+    assert!(dyngen_model::parse_urdf_options(&text, strict).is_err());
 }
 
 #[test]
@@ -746,6 +876,63 @@ fn point_masses_and_massless_frames_on_fixed_joints_are_merged() {
     // Siblings are walked by joint name (`ankle` before `cam`), as Pinocchio does.
     assert_eq!(m.bodies[0].merged, ["foot", "camera"]);
     assert_close(m.bodies[0].inertial.mass, 1.01, 1e-15, "mass");
+}
+
+/// A trunk as public quadruped descriptions have it: a dummy root link whose
+/// exported inertia is rounding noise (a moment of −1.2e-22), a fixed joint, and the
+/// real 5.6 kg trunk, with a leg.
+fn dummy_root_trunk() -> String {
+    robot(&[
+        r#"<link name="base"><inertial><mass value="0.001"/><inertia ixx="-1.2e-22" iyy="0" izz="3e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        r#"<link name="trunk"><inertial><mass value="5.6"/><inertia ixx="0.018" iyy="0.068" izz="0.077" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        &link("thigh"),
+        &joint("floating_base", "fixed", "base", "trunk", ""),
+        &joint("hip", "continuous", "trunk", "thigh", r#"<origin xyz="0.2 0.1 0"/>"#),
+    ])
+}
+
+#[test]
+fn inertias_are_checked_on_the_merged_bodies() {
+    let text = dummy_root_trunk();
+    // The dummy link alone breaks positive definiteness and the triangle inequality
+    // (3e-6 > 0 + 0), yet the body it is part of is physical: no word, fixed or floating.
+    let (fixed, warned) = load_warned(&text);
+    assert!(warned.is_empty(), "{warned:?}");
+    assert_eq!(fixed.dof(), 1);
+    let options = dyngen_model::LoadOptions {
+        free_flyer: true,
+        strict: true,
+        ..Default::default()
+    };
+    let floating = dyngen_model::parse_urdf_options(&text, options).unwrap();
+    assert!(floating.warnings.is_empty(), "{:?}", floating.warnings);
+    assert_eq!(floating.bodies[0].name, "base");
+    assert_eq!(floating.bodies[0].merged, ["trunk"]);
+    assert_close(floating.bodies[0].inertial.mass, 5.601, 1e-14, "merged mass");
+    assert!(dyngen_model::check_inertial(&floating.bodies[0].inertial).is_ok());
+    // A link's own values are still its own: a negative mass is named, merged or not.
+    let bad = text.replace(r#"<mass value="0.001"/>"#, r#"<mass value="-0.001"/>"#);
+    let e = dyngen_model::parse_urdf_options(&bad, options).unwrap_err();
+    assert_eq!(e.errors.len(), 1, "{e}");
+    assert_named(&e.errors[0], &Element::Link("base".into()), 2);
+}
+
+#[test]
+fn a_single_body_floats_on_a_free_flyer() {
+    // A quadrotor: one link, no joint.
+    let text = robot(&[&link_with("quadrotor", "1.5", ["0.03", "0.03", "0.05"])]);
+    let options = dyngen_model::LoadOptions {
+        free_flyer: true,
+        ..Default::default()
+    };
+    let model = dyngen_model::parse_urdf_options(&text, options).unwrap();
+    assert_eq!((model.dof(), model.nq(), model.nv()), (1, 7, 6));
+    assert_eq!(model.joints[0].kind, JointKind::FreeFlyer);
+    assert_eq!(model.bodies[0].name, "quadrotor");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    // Fixed, nothing moves: said so, at <robot>.
+    let e = single(&text, Element::Robot, 1);
+    assert_eq!(e.kind, ErrorKind::NoMovingJoint);
 }
 
 // ---------------------------------------------------------------------------------
@@ -828,10 +1015,10 @@ impl Drop for TempFile {
 
 #[test]
 fn display_prints_file_and_line() {
-    let file = TempFile::new("display.urdf", &one_body(r#"<link name="a"/>"#));
+    let file = TempFile::new("display.urdf", &one_body(&link_with("a", "-1", ["1", "1", "1"])));
     let e: ModelErrors = load_urdf(&file.0).unwrap_err();
     let shown = e.to_string();
-    let expected = format!("{}:3: link `a`: this moving body has no <inertial>", file.0.display());
+    let expected = format!("{}:3: link `a`: mass -1 is negative", file.0.display());
     assert!(shown.starts_with(&expected), "{shown}");
 }
 
@@ -866,9 +1053,9 @@ fn all_errors_of_a_file_are_reported_together() {
     // Value errors are collected across bodies too.
     let text = robot(&[
         r#"<link name="base"/>"#,
-        &link_with("a", "0", ["1", "1", "1"]),
-        &link_with("b", "1", ["1", "1", "5"]),
-        r#"<link name="c"/>"#,
+        &link_with("a", "-1", ["1", "1", "1"]),
+        &link_with("b", "1", ["1", "1", "inf"]),
+        r#"<link name="c"><inertial><origin xyz="nan 0 0"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
         &joint("ja", "continuous", "base", "a", ""),
         &joint("jb", "continuous", "a", "b", ""),
         &joint("jc", "continuous", "b", "c", ""),
@@ -882,9 +1069,9 @@ fn all_errors_of_a_file_are_reported_together() {
 
 #[test]
 fn lines_found_across_quote_and_whitespace_styles() {
-    let text = "<?xml version=\"1.0\"?>\n<!-- <link name=\"a\"/> is not here -->\n<robot name='t'>\n  <link name='base'/>\n  <link\n     name = \"a\" >\n  </link>\n  <joint name='j' type=\"continuous\">\n    <parent link=\"base\"/><child link='a'/>\n  </joint>\n</robot>\n";
+    let text = "<?xml version=\"1.0\"?>\n<!-- <link name=\"a\"/> is not here -->\n<robot name='t'>\n  <link name='base'/>\n  <link\n     name = \"a\" ><inertial><mass value='-1'/><inertia ixx='1' iyy='1' izz='1' ixy='0' ixz='0' iyz='0'/></inertial>\n  </link>\n  <joint name='j' type=\"continuous\">\n    <parent link=\"base\"/><child link='a'/>\n  </joint>\n</robot>\n";
     let e = single(text, Element::Link("a".into()), 5);
-    assert_eq!(e.kind, ErrorKind::MissingInertial);
+    assert_eq!(e.kind, ErrorKind::NonPositiveMass(-1.0));
 }
 
 #[test]
@@ -895,7 +1082,8 @@ fn transmission_joints_are_not_joints() {
         r#"<link name="a"/>"#,
         &joint("j", "continuous", "base", "a", ""),
     ]);
-    assert_eq!(errors(&text)[0].line, Some(4));
+    // The massless link's joint is named at its own line, not the transmission's.
+    assert_eq!(load_warned(&text).1, [(Element::Joint("j".into()), Some(5))]);
 }
 
 #[test]
@@ -906,11 +1094,11 @@ fn geometry_is_ignored_and_lines_still_hold() {
         r#"<link name="base"><visual><geometry><capsule radius="-1"/></geometry>"#,
         r#"  <material name="m"><color rgba="1 0 0 1"/></material></visual>"#,
         r#"  <collision><geometry><mesh/></geometry></collision></link>"#,
-        r#"<link name="a"/>"#,
+        &link_with("a", "-2", ["1", "1", "1"]),
         &joint("j", "continuous", "base", "a", ""),
     ]);
     let e = single(&text, Element::Link("a".into()), 6);
-    assert_eq!(e.kind, ErrorKind::MissingInertial);
+    assert_eq!(e.kind, ErrorKind::NonPositiveMass(-2.0));
 }
 
 #[test]
@@ -1323,11 +1511,15 @@ fn cad_rounding_within_the_tolerance_is_accepted_with_warnings() {
             (&Element::Link("f1".into()), Some(3)),
             (&Element::Link("f2".into()), Some(4)),
             (&Element::Link("f3".into()), Some(5)),
+            // f3's near-zero moment is about j3's axis (URDF's default x): turning it
+            // moves (almost) no inertia.
+            (&Element::Joint("j3".into()), Some(8)),
         ]
     );
     let violations: Vec<f64> = model
         .warnings
         .iter()
+        .take(3)
         .map(|w| match w.kind {
             ErrorKind::TriangleInequality(ev) | ErrorKind::NotPositiveDefinite(ev) => inertia_violation(ev),
             ref k => panic!("{k:?}"),
@@ -1350,7 +1542,7 @@ fn cad_rounding_within_the_tolerance_is_accepted_with_warnings() {
     // each moment by at most the violation.
     assert_eq!(model.bodies[0].inertial.inertia[0][0], 9.137e-7);
     let physical = model.nearest_physical();
-    assert!(physical.warnings.is_empty());
+    assert_eq!(physical.warnings, model.warnings[3..]);
     for (body, fixed) in model.bodies.iter().zip(&physical.bodies) {
         let (ev, _) = fixed.inertial.principal_axes();
         assert!(inertia_violation(ev) < 1e-12, "{ev:?}");
@@ -1367,20 +1559,31 @@ fn cad_rounding_within_the_tolerance_is_accepted_with_warnings() {
     // A strict read refuses every one of them, as errors with their lines.
     let e = dyngen_model::parse_urdf_with(&text, true).unwrap_err();
     let lines: Vec<Option<usize>> = e.errors.iter().map(|e| e.line).collect();
-    assert_eq!(lines, [Some(3), Some(4), Some(5)]);
+    assert_eq!(lines, [Some(3), Some(4), Some(5), Some(8)]);
 }
 
 #[test]
-fn violations_beyond_the_tolerance_stay_errors() {
+fn violations_beyond_the_tolerance_load_with_a_warning_that_says_so() {
     // The same 7.3e-6 link with a moment off by 4 %: a mistake, not rounding.
     let text = cad_finger(["3.000e-6", "4.000e-6", "7.300e-6"]);
-    let errs = errors(&text);
-    assert_eq!(errs.len(), 1, "{errs:#?}");
-    assert_named(&errs[0], &Element::Link("f3".into()), 5);
-    assert!(matches!(errs[0].kind, ErrorKind::TriangleInequality(_)), "{errs:?}");
+    let (model, warned) = load_warned(&text);
+    assert_eq!(warned[2], (Element::Link("f3".into()), Some(5)));
+    assert!(matches!(model.warnings[2].kind, ErrorKind::TriangleInequality(_)));
+    let message = model.warnings[2].warning_message();
+    assert!(
+        message.contains("4.110 % of its largest moment away from physical"),
+        "{message}"
+    );
+    assert!(
+        message.contains("beyond the relative tolerance of 1e-3 for CAD rounding: check the file"),
+        "{message}"
+    );
+    let errs = strict_errors(&text);
+    assert_eq!(errs.len(), 3, "{errs:#?}");
+    assert_named(&errs[2], &Element::Link("f3".into()), 5);
     // A clearly negative moment too.
-    let errs = errors(&cad_finger(["-1e-7", "7.300e-6", "7.300e-6"]));
-    assert!(matches!(errs[0].kind, ErrorKind::NotPositiveDefinite(_)), "{errs:?}");
+    let (model, _) = load_warned(&cad_finger(["-1e-7", "7.300e-6", "7.300e-6"]));
+    assert!(matches!(model.warnings[2].kind, ErrorKind::NotPositiveDefinite(_)));
 }
 
 #[test]

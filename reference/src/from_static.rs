@@ -38,6 +38,7 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     effort: l.effort,
                 }),
                 dynamics: JointDynamics {
+                    armature: j.armature,
                     damping: j.damping,
                     friction: j.friction,
                 },

@@ -109,7 +109,7 @@ impl Reference {
     /// joint wrenches instead of the RNEA's: `wrenches[j]` is joint `j + 1`'s
     /// reaction on its outboard body in that body's frame, moment about the joint
     /// origin (the convention of [`Reference::joint_wrenches`] and of the CSV
-    /// wrench columns, [`crate::data`]). Only `q` enters (the geometry). Panics if a
+    /// wrench columns, `dyngen_identify::data`). Only `q` enters (the geometry). Panics if a
     /// length differs.
     pub fn resultants_of_joint_wrenches(&self, q: &[f64], wrenches: &[Wrench<f64>]) -> Vec<Wrench<f64>> {
         assert_eq!(wrenches.len(), self.nq(), "one joint wrench per joint");

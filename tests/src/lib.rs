@@ -62,6 +62,31 @@ pub fn eval_graph(
     })
 }
 
+/// The outputs of the generator's joint-space dynamics for `model`, as nodes of `g`:
+/// `rnea(q, v, a)`, `rnea(q, v, 0)`, `rnea(q, 0, 0)`, `M(q)` row-major and
+/// `aba(q, v, τ)` (evaluate them with [`eval_graph`]).
+pub struct DynamicsGraph {
+    pub rnea: Vec<dyngen_codegen::sym::NodeId>,
+    pub nonlinear_effects: Vec<dyngen_codegen::sym::NodeId>,
+    pub gravity: Vec<dyngen_codegen::sym::NodeId>,
+    pub crba: Vec<dyngen_codegen::sym::NodeId>,
+    pub aba: Vec<dyngen_codegen::sym::NodeId>,
+}
+
+impl DynamicsGraph {
+    pub fn new(g: &dyngen_codegen::sym::Graph, model: &dyngen_model::Model) -> DynamicsGraph {
+        use dyngen_codegen::algo::{self, Inputs};
+        let ids = |e: &[dyngen_codegen::sym::Expr<'_>]| e.iter().map(|x| x.id()).collect();
+        DynamicsGraph {
+            rnea: ids(&algo::rnea(g, model, Inputs::Full).tau),
+            nonlinear_effects: ids(&algo::rnea(g, model, Inputs::NoAcceleration).tau),
+            gravity: ids(&algo::rnea(g, model, Inputs::Static).tau),
+            crba: algo::crba(g, model).iter().flatten().map(|x| x.id()).collect(),
+            aba: ids(&algo::aba(g, model, algo::Armature::None)),
+        }
+    }
+}
+
 /// A pose as 12 numbers: rotation row-major, then translation.
 pub fn pose_vec(p: &dyngen::Pose<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(12);

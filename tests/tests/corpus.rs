@@ -5,11 +5,12 @@
 //! from the expression graph, so nothing this large is compiled here), and the
 //! reference implementation.
 
-use dyngen_codegen::algo::{self, Inputs};
-use dyngen_codegen::sym::{Graph, NodeId};
+use dyngen_codegen::sym::Graph;
 use dyngen_model::{load_urdf, Model};
 use dyngen_reference::Reference;
-use dyngen_tests::{eval_graph as eval, load_fixture, pose_vec, rel_err, workspace_root, wrench_vec, Fixture};
+use dyngen_tests::{
+    eval_graph as eval, load_fixture, pose_vec, rel_err, workspace_root, wrench_vec, DynamicsGraph, Fixture,
+};
 
 /// Agreement required with Pinocchio (normwise, relative).
 const TOL: f64 = 1e-10;
@@ -103,12 +104,13 @@ fn corpus_generated_algorithms_match_pinocchio() {
     for (name, _) in CORPUS {
         let (model, fx) = load(name);
         let g = Graph::new();
-        let ids = |e: &[dyngen_codegen::sym::Expr<'_>]| e.iter().map(|x| x.id()).collect::<Vec<_>>();
-        let rnea = ids(&algo::rnea(&g, &model, Inputs::Full).tau);
-        let nle = ids(&algo::rnea(&g, &model, Inputs::NoAcceleration).tau);
-        let gravity = ids(&algo::rnea(&g, &model, Inputs::Static).tau);
-        let crba: Vec<NodeId> = algo::crba(&g, &model).iter().flatten().map(|x| x.id()).collect();
-        let aba = ids(&algo::aba(&g, &model, algo::Armature::None));
+        let DynamicsGraph {
+            rnea,
+            nonlinear_effects: nle,
+            gravity,
+            crba,
+            aba,
+        } = DynamicsGraph::new(&g, &model);
         let params = model.standard_params();
         let mut worst = 0.0f64;
         for (k, s) in fx.samples.iter().enumerate() {

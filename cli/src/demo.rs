@@ -15,8 +15,8 @@ pub use dyngen_paper::EXAMPLES;
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// Relative sensor noise of the noisy runs (0.01 is 1 %); see the noise model
-    /// below.
-    #[arg(long, default_value_t = 0.01)]
+    /// below; 0 to 1.
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true, value_parser = crate::ranges::NOISE)]
     pub noise: f64,
     /// Seed of the sensor noise.
     #[arg(long, default_value_t = 1)]
@@ -31,17 +31,17 @@ pub struct DemoArgs {
     /// Replace figures that already exist in --out.
     #[arg(long)]
     pub force: bool,
-    /// Generalising NIM: parameter draws to train on.
-    #[arg(long, default_value_t = 1500)]
+    /// Generalising NIM: parameter draws to train on, 1 to 10000000.
+    #[arg(long, default_value_t = 1500, value_parser = crate::ranges::DRAWS)]
     pub draws: usize,
-    /// Generalising NIM: Adam steps per body.
-    #[arg(long, default_value_t = 6000)]
+    /// Generalising NIM: Adam steps per body, 1 to 100000000.
+    #[arg(long, default_value_t = 6000, value_parser = crate::ranges::ADAM_STEPS)]
     pub steps: usize,
-    /// Unseen parameter draws for the side-by-side comparison.
-    #[arg(long, default_value_t = 100)]
+    /// Unseen parameter draws for the side-by-side comparison, 1 to 1000000.
+    #[arg(long, default_value_t = 100, value_parser = crate::ranges::DEMO_TEST_DRAWS)]
     pub test_draws: usize,
-    /// Bodies trained at once; 0 = one per core.
-    #[arg(long, default_value_t = 0)]
+    /// Bodies trained at once, 0 to 1024; 0 = one per core.
+    #[arg(long, default_value_t = 0, value_parser = crate::ranges::THREADS)]
     pub threads: usize,
 }
 

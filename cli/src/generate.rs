@@ -1,7 +1,7 @@
 //! `dyngen generate`: what `build.rs` (`dyngen_codegen::Config::compile_urdf`) does,
 //! to a file or stdout, through the same `Config`.
 
-use crate::common::{check_overwrite, load_model, with_spinner, ModelArgs, Progress, Result};
+use crate::common::{check_overwrite, load_model, out, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use dyngen_codegen::Config;
 use std::path::PathBuf;
@@ -31,9 +31,10 @@ pub struct GenerateArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// Statements per generated function before it is split into parts (default 6000;
-    /// the regressors and derivatives are split at no more than 1200 and 800).
-    #[arg(long, value_name = "N")]
+    /// Statements per generated function before it is split into parts, 100 to
+    /// 10000000 (default 6000; the regressors and derivatives are split at no more
+    /// than 1200 and 800).
+    #[arg(long, value_name = "N", value_parser = crate::ranges::MAX_STATEMENTS)]
     pub max_statements: Option<usize>,
 
     /// Compose functions whose own code would repeat another's (aba_derivatives,
@@ -74,7 +75,7 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
         e => CliError::failed(e),
     })?;
     match &args.output {
-        None => print!("{content}"),
+        None => out!("{content}"),
         Some(path) => {
             std::fs::write(path, &content).map_err(|e| CliError::output(path, e))?;
             eprintln!(

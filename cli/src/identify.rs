@@ -2,7 +2,7 @@
 //! principal parameters from joint torques, or the principal parameters of every body
 //! by MIM from joint wrenches.
 
-use crate::common::{check_overwrite, load_moving_model, with_spinner, ModelArgs, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, out, outln, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::pipeline::{
@@ -160,8 +160,8 @@ pub struct IdentifyArgs {
     pub friction: Friction,
 
     /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
-    /// prismatic joints).
-    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    /// prismatic joints), 0 < ε ≤ 1000.
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true, value_parser = crate::ranges::EPSILON)]
     pub epsilon: f64,
 
     /// Predict the torques of this second recording (read with the same recipe)
@@ -170,15 +170,15 @@ pub struct IdentifyArgs {
     pub validate: Option<PathBuf>,
 
     /// Ridge: weight of the pull toward the nominal parameters, dimensionless (the
-    /// penalty is λ·Σ ‖column j‖²·(x_j − x0_j)², so units do not matter).
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
+    /// penalty is λ·Σ ‖column j‖²·(x_j − x0_j)², so units do not matter), 0 to 1e12.
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true, value_parser = crate::ranges::LAMBDA)]
     pub lambda: f64,
 
     /// Leave a joint's rows out of its equations where its |velocity| is below
     /// SPEED (rad/s, m/s for prismatic joints): near velocity reversals a real
     /// joint sticks, and the Coulomb term sign(q̇) does not describe it. The number
-    /// of rows left out is printed.
-    #[arg(long, value_name = "SPEED", allow_negative_numbers = true)]
+    /// of rows left out is printed. 0 < SPEED ≤ 1000.
+    #[arg(long, value_name = "SPEED", allow_negative_numbers = true, value_parser = crate::ranges::EXCLUDE_BELOW)]
     pub exclude_below: Option<f64>,
 
     #[command(flatten)]
@@ -194,7 +194,7 @@ pub struct IdentifyArgs {
     pub urdf_out: Option<PathBuf>,
 
     /// With --urdf-out: a body that lumped links attached by fixed joints gets the
-    /// whole identified inertial, and the merged links lose their <inertial>
+    /// whole identified inertial, and the merged links lose their `<inertial>`
     /// (default: refuse to update such a body).
     #[arg(long)]
     pub lump_merged: bool,
@@ -219,8 +219,8 @@ pub struct IdentifyArgs {
 pub struct RecordingArgs {
     /// Low-pass cutoff, Hz (zero phase): velocities and accelerations the file does
     /// not have are estimated through it, and the measured positions and velocities
-    /// are filtered by it too (see --raw-states).
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    /// are filtered by it too (see --raw-states). 0 < Hz ≤ 1e6.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = crate::ranges::CUTOFF)]
     pub cutoff: f64,
 
     /// Use the measured positions and velocities as read, without the low-pass
@@ -332,7 +332,7 @@ pub fn load_recording(
         ..IdentifyOptions::default()
     };
     let loaded = pipeline::load(path, &recipe.recipe()?, dof, &options).map_err(|e| pipeline_error(path, e))?;
-    println!("{}: {}", path.display(), loaded.report);
+    outln!("{}: {}", path.display(), loaded.report);
     Ok(loaded.trajectory)
 }
 
@@ -354,7 +354,7 @@ pub fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
         PipelineError::Identify { at: None, error } => CliError::failed(error),
         PipelineError::MergedLinks { body, merged } => CliError::usage(format!(
             "--urdf-out: body `{body}` is fully identified, but its inertial includes the links [{}] attached by \
-             fixed joints; pass --lump-merged to write it to `{body}` and remove their <inertial> elements",
+             fixed joints; pass --lump-merged to write it to `{body}` and remove their `<inertial>` elements",
             merged.join(", ")
         )),
         PipelineError::Report(e) => CliError::Input(e.to_string()),
@@ -400,12 +400,6 @@ impl IdentifyArgs {
 }
 
 pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
-    if !(args.lambda.is_finite() && args.lambda >= 0.0) {
-        return Err(CliError::usage(format!(
-            "--lambda must be non-negative, got {}",
-            args.lambda
-        )));
-    }
     if args.mode == Mode::Mim && args.method.is_some() {
         return Err(CliError::usage(
             "--method applies to --mode standard and principal; MIM always uses least squares weighted per body axis",
@@ -425,7 +419,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
         return Err(pipeline_error(&args.data, PipelineError::MissingWrenches { dof: n }));
     }
-    println!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
+    outln!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
     let robot = Reference::new(&model);
     let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
         .map_err(|e| pipeline_error(&args.data, e))?;
@@ -435,26 +429,26 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if let Some(speed) = args.exclude_below {
         let total: usize = identified.excluded_rows.iter().sum();
         let per_joint: Vec<String> = identified.excluded_rows.iter().map(usize::to_string).collect();
-        println!(
+        outln!(
             "--exclude-below {speed}: left out {total} of {} torque rows (|q̇| below it; per joint: {})",
             traj.len() * n,
             per_joint.join(", ")
         );
     }
     match (&identified.prediction, &identified.mim) {
-        (_, Some(mim)) => println!("{mim}"),
+        (_, Some(mim)) => outln!("{mim}"),
         (Prediction::Regressor(torque), None) => {
             let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
-            println!("{}", torque.estimate.table(&names));
-            print_fit(&torque.estimate);
+            outln!("{}", torque.estimate.table(&names));
+            print_fit(&torque.estimate)?;
             if let Some(fit) = &identified.stribeck {
-                print!("{fit}");
+                out!("{fit}");
             }
             if args.mode == Mode::Standard && args.friction == Friction::None {
-                hint_friction(&torque.estimate, &traj);
+                hint_friction(&torque.estimate, &traj)?;
             }
             if args.truth_from_urdf {
-                print_errors(&identified, &model);
+                print_errors(&identified, &model)?;
             }
         }
         (Prediction::Parameters(_), None) => {}
@@ -465,7 +459,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             .report
             .write(path, args.force)
             .map_err(|e| CliError::report(path, e))?;
-        println!("wrote the parameters to {}", path.display());
+        outln!("wrote the parameters to {}", path.display());
     }
     if let Some(path) = &args.svg {
         write_svg(args, path, &robot, &traj, &identified, progress)?;
@@ -479,23 +473,24 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             identified.predict(&robot, &other)
         })
         .map_err(|e| pipeline_error(path, e))?;
-        let validation = crate::validate::validation(&model, &other, &predicted)?;
-        println!("prediction of {}:\n{validation}", path.display());
+        let validation = crate::validate::validation(&model, &other, &predicted, None)?;
+        outln!("prediction of {}:\n{validation}", path.display());
     }
     Ok(())
 }
 
 /// Each identified parameter against the URDF's value (torque modes; MIM prints its
 /// own error table).
-fn print_errors(identified: &Identification, model: &Model) {
+fn print_errors(identified: &Identification, model: &Model) -> Result<()> {
     let errors = identified.errors(model);
     match errors.worst {
-        Some((w, name)) => println!(
+        Some((w, name)) => outln!(
             "against the URDF: {} identified parameters with a nonzero true value, largest relative error {w:.3e} ({name})",
             errors.compared
         ),
-        None => println!("against the URDF: no identified parameter with a nonzero true value"),
+        None => outln!("against the URDF: no identified parameter with a nonzero true value"),
     }
+    Ok(())
 }
 
 /// Refuses, before any work, existing output files without --force and two
@@ -540,16 +535,19 @@ fn write_svg(
     let predicted = with_spinner(progress, "predicting torques", || identified.predict(robot, traj))
         .map_err(|e| pipeline_error(&args.data, e))?;
     let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
-    let errors = args.truth_from_urdf.then(|| {
-        let errors = identified.errors(model);
-        if !errors.zero_truth.is_empty() {
-            println!(
-                "note: parameter errors leave out {} (identified, but zero in the URDF, so no relative error)",
-                errors.zero_truth.join(", ")
-            );
+    let errors = match args.truth_from_urdf {
+        true => {
+            let errors = identified.errors(model);
+            if !errors.zero_truth.is_empty() {
+                outln!(
+                    "note: parameter errors leave out {} (identified, but zero in the URDF, so no relative error)",
+                    errors.zero_truth.join(", ")
+                );
+            }
+            Some(errors.relative)
         }
-        errors.relative
-    });
+        false => None,
+    };
     let title = format!(
         "{}: {} on {}",
         model.name,
@@ -562,7 +560,7 @@ fn write_svg(
     let svg = crate::svg::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
         .map_err(|e| CliError::report(path, e))?;
     report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
-    println!("wrote the SVG report to {}", path.display());
+    outln!("wrote the SVG report to {}", path.display());
     Ok(())
 }
 
@@ -581,14 +579,14 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
     })?;
     report::write_new(path, &rewrite.text, args.force).map_err(|e| CliError::report(path, e))?;
     if rewrite.updated.is_empty() {
-        println!(
+        outln!(
             "wrote {}{}: no body has all its parameters identified, so every inertial is the URDF's",
             path.display(),
             if rewrite.dynamics.is_empty() { " unchanged" } else { "" }
         );
     } else {
         let names: Vec<&str> = rewrite.updated.iter().map(|(n, _)| n.as_str()).collect();
-        println!(
+        outln!(
             "wrote {} with the identified inertials of {}",
             path.display(),
             names.join(", ")
@@ -600,10 +598,10 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
             .iter()
             .map(|(j, fv, fc)| format!("{j} (Fv {fv:.4}, Fc {fc:.4})"))
             .collect();
-        println!("with the identified <dynamics> of {}", joints.join(", "));
+        outln!("with the identified <dynamics> of {}", joints.join(", "));
     }
     for (joint, why) in &rewrite.dynamics_kept {
-        println!("note: kept the URDF's <dynamics> of {joint}: {why}");
+        outln!("note: kept the URDF's <dynamics> of {joint}: {why}");
     }
     if !rewrite.kept.is_empty() {
         let kept: Vec<String> = rewrite
@@ -611,14 +609,14 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
             .iter()
             .map(|(body, why)| format!("{body} ({why})"))
             .collect();
-        println!(
+        outln!(
             "note: kept the URDF inertials of {} of {} bodies: {}",
             kept.len(),
             model.bodies.len(),
             kept.join("; ")
         );
         if args.mode != Mode::Mim {
-            println!(
+            outln!(
                 "note: this is expected: joint torques determine only the base parameters (combinations), \
                  so few bodies, if any, have all their parameters identifiable; see --params-json for the \
                  combinations, or identify body by body from joint wrenches with --mode mim"
@@ -631,7 +629,7 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
 /// Torque residuals per joint and relative to the measured torques.
 /// Rigid bodies alone leave a real robot's friction in the residual: say so when the
 /// residual of a joint is a noticeable part of its torque.
-fn hint_friction(estimate: &Estimate, traj: &Trajectory) {
+fn hint_friction(estimate: &Estimate, traj: &Trajectory) -> Result<()> {
     let n = traj.dof();
     let worst = (0..n)
         .filter_map(|j| {
@@ -642,7 +640,7 @@ fn hint_friction(estimate: &Estimate, traj: &Trajectory) {
         .max_by(|a, b| a.0.total_cmp(&b.0));
     if let Some((ratio, j)) = worst {
         if ratio > FRICTION_HINT {
-            println!(
+            outln!(
                 "note: rigid bodies alone leave {:.0} % of joint {}'s torque unexplained; a real robot's joints add \
                  friction and rotor inertia: try --friction auto",
                 100.0 * ratio,
@@ -650,16 +648,17 @@ fn hint_friction(estimate: &Estimate, traj: &Trajectory) {
             );
         }
     }
+    Ok(())
 }
 
 /// A joint's residual RMS above this fraction of its torque RMS prompts the
 /// friction hint.
 const FRICTION_HINT: f64 = 0.05;
 
-fn print_fit(estimate: &Estimate) {
+fn print_fit(estimate: &Estimate) -> Result<()> {
     let r = &estimate.residuals;
     let per_joint: Vec<String> = r.per_channel_rms.iter().map(|x| format!("{x:.3e}")).collect();
-    println!(
+    outln!(
         "torque residual RMS {:.3e} N·m over {} rows (per joint: {}); {} of {} parameter directions identifiable",
         r.rms,
         r.rows,
@@ -667,4 +666,5 @@ fn print_fit(estimate: &Estimate) {
         estimate.rank,
         estimate.n_params()
     );
+    Ok(())
 }

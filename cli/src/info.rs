@@ -1,6 +1,6 @@
 //! `dyngen info`: what dyngen sees in a URDF.
 
-use crate::common::{load_model, with_spinner, ModelArgs, Progress, Result};
+use crate::common::{load_model, out, with_spinner, ModelArgs, Progress, Result};
 use dyngen_codegen::{analyse_model, generate, Options};
 use dyngen_model::graph::{incidence, path_matrix};
 use dyngen_model::Model;
@@ -46,7 +46,7 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
     )
     .ok();
     if n == 0 {
-        print!("{out}");
+        out!("{out}");
         return Ok(());
     }
     let bases = with_spinner(progress, "finding the base parameters", || analyse_model(&model));
@@ -80,7 +80,7 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         }
     }
     if args.no_ops {
-        print!("{out}");
+        out!("{out}");
         return Ok(());
     }
     let generated = with_spinner(progress, "generating code for the op counts", || {
@@ -91,7 +91,7 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
     for line in generated.op_report().lines() {
         writeln!(out, "  {line}").ok();
     }
-    print!("{out}");
+    out!("{out}");
     Ok(())
 }
 
@@ -122,7 +122,17 @@ fn topology(model: &Model, path: &std::path::Path) -> String {
     }
     writeln!(out).ok();
     writeln!(out, "Joints (joint j carries body j; parent 0 is the base)").ok();
-    let width = model.joints.iter().map(|j| j.name.len()).max().unwrap_or(4).max(4);
+    // Capped at the longest name a description may give: a longer one (from a model
+    // built in code) overflows its column, where a width of 65,536 or more would
+    // panic the formatter.
+    const MAX_NAME: usize = dyngen_model::xml::MAX_NAME_CHARS;
+    let width = model
+        .joints
+        .iter()
+        .map(|j| j.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .clamp(4, MAX_NAME);
     writeln!(
         out,
         "  {:>3}  {:<width$}  {:<10}  {:>6}  {:<24}  limits",
@@ -152,7 +162,13 @@ fn topology(model: &Model, path: &std::path::Path) -> String {
     }
     writeln!(out).ok();
     writeln!(out, "Bodies").ok();
-    let width = model.bodies.iter().map(|b| b.name.len()).max().unwrap_or(4).max(4);
+    let width = model
+        .bodies
+        .iter()
+        .map(|b| b.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .clamp(4, MAX_NAME);
     writeln!(
         out,
         "  {:>3}  {:<width$}  {:>10}  merged fixed links",

@@ -21,11 +21,13 @@ mod generate;
 mod identify;
 mod info;
 mod nim;
+mod ranges;
 mod simulate;
 mod svg;
 mod validate;
 
 use clap::{Parser, Subcommand};
+use std::io::Write as _;
 use std::process::ExitCode;
 
 const EXAMPLES: &str = "\
@@ -114,7 +116,9 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // Not `eprintln!`: a stderr that cannot be written must not turn the
+            // error into a panic; the exit code still says what happened.
+            let _ = writeln!(std::io::stderr(), "error: {e}");
             e.into()
         }
     }
@@ -131,7 +135,10 @@ fn install_panic_hook() {
             .or_else(|| info.payload().downcast_ref::<String>().cloned())
             .unwrap_or_else(|| "unknown panic".to_string());
         let location = info.location().map(|l| format!(" at {l}")).unwrap_or_default();
-        eprintln!("error: internal error{location}: {message} (this is a bug of dyngen; please report it)");
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: internal error{location}: {message} (this is a bug of dyngen; please report it)"
+        );
         std::process::exit(1);
     }));
 }

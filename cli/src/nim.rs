@@ -2,7 +2,7 @@
 //! along the joint motion of a CSV file (on simulated parameter draws), `predict`
 //! the principal parameters from measured data.
 
-use crate::common::{check_overwrite, load_moving_model, ModelArgs, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, outln, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
@@ -57,33 +57,34 @@ pub struct TrainArgs {
     pub output: PathBuf,
     #[arg(long)]
     pub force: bool,
-    /// Samples per window.
-    #[arg(long, default_value_t = 20)]
+    /// Samples per window, 1 to 10000.
+    #[arg(long, default_value_t = 20, value_parser = crate::ranges::WINDOW)]
     pub window: usize,
-    /// Parameter draws to train on.
-    #[arg(long, default_value_t = 1500)]
+    /// Parameter draws to train on, 1 to 10000000.
+    #[arg(long, default_value_t = 1500, value_parser = crate::ranges::DRAWS)]
     pub draws: usize,
     /// Relative half-width of the draws: masses and principal second moments
-    /// within ±spread of the URDF's.
-    #[arg(long, default_value_t = 0.3)]
+    /// within ±spread of the URDF's, 0 ≤ spread < 1.
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true, value_parser = crate::ranges::SPREAD)]
     pub spread: f64,
-    /// Relative sensor noise added to the training windows (0.01 = 1 %).
-    #[arg(long, default_value_t = 0.01)]
+    /// Relative sensor noise added to the training windows (0.01 = 1 %), 0 to 1.
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true, value_parser = crate::ranges::NOISE)]
     pub noise: f64,
-    /// Adam steps per body.
-    #[arg(long, default_value_t = 6000)]
+    /// Adam steps per body, 1 to 100000000.
+    #[arg(long, default_value_t = 6000, value_parser = crate::ranges::ADAM_STEPS)]
     pub steps: usize,
     /// After training, identify this many further unseen draws simulated along the
-    /// motion and print the worst errors.
-    #[arg(long, default_value_t = 50)]
+    /// motion and print the worst errors (0 to 1000000).
+    #[arg(long, default_value_t = 50, value_parser = crate::ranges::TEST_DRAWS)]
     pub test_draws: usize,
-    /// Bodies trained at once; 0 = one per core.
-    #[arg(long, default_value_t = 0)]
+    /// Bodies trained at once, 0 to 1024; 0 = one per core.
+    #[arg(long, default_value_t = 0, value_parser = crate::ranges::THREADS)]
     pub threads: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
-    #[arg(long, default_value_t = 10.0)]
+    /// Low-pass cutoff (Hz, 0 < Hz ≤ 1e6) for estimating v and a when the file has no
+    /// such columns.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = crate::ranges::CUTOFF)]
     pub cutoff: f64,
     /// Read the recording through this recipe (layout, units, windows; see the README).
     #[arg(long, value_name = "FILE")]
@@ -103,8 +104,8 @@ pub struct PredictArgs {
     pub nim: PathBuf,
     /// Measured data (CSV with t, q, tau and the joint wrench columns fx1..mzn).
     pub data: PathBuf,
-    /// Windows start every `stride` samples (default: half a window).
-    #[arg(long)]
+    /// Windows start every `stride` samples, 1 to 1000000 (default: half a window).
+    #[arg(long, value_parser = crate::ranges::STRIDE)]
     pub stride: Option<usize>,
     /// Write the estimate as JSON (schema dyngen-parameters/1).
     #[arg(long, value_name = "FILE")]
@@ -114,8 +115,9 @@ pub struct PredictArgs {
     pub truth_from_urdf: bool,
     #[arg(long)]
     pub force: bool,
-    /// Low-pass cutoff (Hz) for estimating v and a when the file has no such columns.
-    #[arg(long, default_value_t = 10.0)]
+    /// Low-pass cutoff (Hz, 0 < Hz ≤ 1e6) for estimating v and a when the file has no
+    /// such columns.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = crate::ranges::CUTOFF)]
     pub cutoff: f64,
     /// Read the recording through this recipe (layout, units, windows; see the README).
     #[arg(long, value_name = "FILE")]
@@ -192,7 +194,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         Optimizer::Adam { batch_size, .. } => batch_size,
         Optimizer::GradientDescent { .. } => config.draws,
     };
-    println!(
+    outln!(
         "training one network per body of {} along {} samples of {}: {} draws within ±{}%, windows of {}, {} steps \
          of {} windows, {}% training noise",
         model.name,
@@ -215,7 +217,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         let outputs: Vec<&str> = body.outputs.iter().map(|&k| mim::THETA_NAMES[k]).collect();
         match history {
             // The targets are logarithms: the RMS error is a relative error.
-            Some(h) => println!(
+            Some(h) => outln!(
                 "  {}: predicts {}; {} windows per draw; RMS relative error of one window's prediction: training \
                  {:.2}%, validation draws {}",
                 nim.body_names[i],
@@ -226,16 +228,16 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
                     .last()
                     .map_or_else(|| "—".to_string(), |v| format!("{:.2}%", 100.0 * v.sqrt()))
             ),
-            None => println!(
+            None => outln!(
                 "  {}: none of m, J1, J2, J3 enters its equations along this motion; no network",
                 nim.body_names[i]
             ),
         }
     }
-    println!("trained in {seconds:.1} s");
+    outln!("trained in {seconds:.1} s");
     nim.save(&args.output, args.force)
         .map_err(|e| nim_file_error(&args.output, e, true))?;
-    println!("wrote the identifier to {}", args.output.display());
+    outln!("wrote the identifier to {}", args.output.display());
     if let Some(svg) = &args.loss_svg {
         // The targets are ln θ: the RMS error of a window's prediction is a relative
         // error of θ.
@@ -266,7 +268,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         })
         .map_err(|e| CliError::report(svg, e))?;
         report::write_new(svg, &text, args.force).map_err(|e| CliError::report(svg, e))?;
-        println!("wrote the training curves to {}", svg.display());
+        outln!("wrote the training curves to {}", svg.display());
     }
     if args.test_draws > 0 {
         test_on_unseen_draws(args, &model, &robot, &motion, &nim, &nominal)?;
@@ -302,7 +304,7 @@ fn test_on_unseen_draws(
         mass = mass.max(m);
         moments = moments.max(j);
     }
-    println!(
+    outln!(
         "on {} unseen draws (noise-free, full dynamics): worst relative error {:.3}% on a mass, {:.3}% on a principal \
          moment",
         args.test_draws,
@@ -357,19 +359,19 @@ fn predict(args: &PredictArgs) -> Result<()> {
     } else {
         estimate
     };
-    println!(
+    outln!(
         "{} samples of {} joints from {}",
         traj.len(),
         model.dof(),
         args.data.display()
     );
-    println!("{estimate}");
+    outln!("{estimate}");
     if let Some(path) = &args.params_json {
         estimate
             .report(&model.name)
             .write(path, args.force)
             .map_err(|e| CliError::report(path, e))?;
-        println!("wrote the parameters to {}", path.display());
+        outln!("wrote the parameters to {}", path.display());
     }
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 use crate::common::{check_overwrite, load_moving_model, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
+use crate::ranges::per_joint;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{
     add_joint_terms, add_stribeck_terms, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Logger,
@@ -62,18 +63,18 @@ pub struct SimulateArgs {
     #[arg(long, value_enum, default_value_t = ExperimentKind::Paper)]
     pub experiment: ExperimentKind,
 
-    /// Length of the experiment, s (default: 2 for paper, one Fourier period for
-    /// fourier).
-    #[arg(long, allow_negative_numbers = true)]
+    /// Length of the experiment, s, 0 < s ≤ 1e6 (default: 2 for paper, one Fourier
+    /// period for fourier).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::ranges::DURATION)]
     pub duration: Option<f64>,
 
-    /// Sampling steps; the file has steps + 1 samples, t = 0 included.
-    #[arg(long, default_value_t = 100)]
+    /// Sampling steps, 1 to 1000000; the file has steps + 1 samples, t = 0 included.
+    #[arg(long, default_value_t = 100, value_parser = crate::ranges::STEPS)]
     pub steps: usize,
 
     /// Relative Gaussian noise on every recorded channel (0.01 = 1 % of each
-    /// channel's RMS); 0 for exact data.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    /// channel's RMS), 0 to 1; 0 for exact data.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::ranges::NOISE)]
     pub noise: f64,
 
     /// Seed of the noise and of the excitation optimisation.
@@ -85,11 +86,11 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "IA", allow_hyphen_values = true)]
     pub armature: Option<String>,
 
-    /// Viscous friction Fv per joint (default: the URDF's <dynamics damping>): τ += Fv·q̇.
+    /// Viscous friction Fv per joint (default: the URDF's `<dynamics damping>`): τ += Fv·q̇.
     #[arg(long, value_name = "FV", allow_hyphen_values = true)]
     pub damping: Option<String>,
 
-    /// Coulomb friction Fc per joint (default: the URDF's <dynamics friction>):
+    /// Coulomb friction Fc per joint (default: the URDF's `<dynamics friction>`):
     /// τ += Fc·sign(q̇).
     #[arg(long, value_name = "FC", allow_hyphen_values = true)]
     pub coulomb: Option<String>,
@@ -110,21 +111,22 @@ pub struct SimulateArgs {
     /// Write the recording as a robot's logger does: sampled every DT seconds with
     /// jittered steps, some rows duplicated or stale, columns t, q, v and tau (or
     /// motor currents with --current-gains); no accelerations or wrenches. The
-    /// experiment's --steps is then ignored.
-    #[arg(long, value_name = "DT")]
+    /// experiment's --steps is then ignored. 0 < DT ≤ 1000 s, and at most 1000000
+    /// samples (--duration / DT).
+    #[arg(long, value_name = "DT", allow_negative_numbers = true, value_parser = crate::ranges::LOGGER_PERIOD)]
     pub logger_period: Option<f64>,
 
-    /// Logger: each step is DT·(1 + u), u uniform within ±this fraction.
-    #[arg(long, default_value_t = 0.25)]
+    /// Logger: each step is DT·(1 + u), u uniform within ±this fraction, 0 ≤ x < 1.
+    #[arg(long, default_value_t = 0.25, allow_negative_numbers = true, value_parser = crate::ranges::JITTER)]
     pub jitter: f64,
 
-    /// Logger: fraction of rows written twice with the same time stamp.
-    #[arg(long, default_value_t = 0.005)]
+    /// Logger: fraction of rows written twice with the same time stamp, 0 to 1.
+    #[arg(long, default_value_t = 0.005, allow_negative_numbers = true, value_parser = crate::ranges::FRACTION)]
     pub duplicates: f64,
 
     /// Logger: fraction of rows repeating the previous row's values under a new time
-    /// stamp.
-    #[arg(long, default_value_t = 0.005)]
+    /// stamp, 0 to 1.
+    #[arg(long, default_value_t = 0.005, allow_negative_numbers = true, value_parser = crate::ranges::FRACTION)]
     pub stale: f64,
 
     /// Logger: write motor currents i = τ/k with these torque constants (N·m/A),
@@ -132,20 +134,20 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "K1,K2,…")]
     pub current_gains: Option<String>,
 
-    /// Logger: round the currents to multiples of this resolution (A).
-    #[arg(long, default_value_t = 0.0)]
+    /// Logger: round the currents to multiples of this resolution (A), 0 to 1000.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::ranges::CURRENT_QUANTUM)]
     pub current_quantum: f64,
 
     /// Fourier: what the coefficients are optimised for.
     #[arg(long, value_enum, default_value_t = CriterionArg::Torques)]
     pub criterion: CriterionArg,
 
-    /// Fourier: harmonics per joint.
-    #[arg(long, default_value_t = 5)]
+    /// Fourier: harmonics per joint, 1 to 50.
+    #[arg(long, default_value_t = 5, value_parser = crate::ranges::HARMONICS)]
     pub harmonics: usize,
 
-    /// Fourier: base frequency, Hz (the trajectory repeats every 1/f s).
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    /// Fourier: base frequency, Hz, 1e-6 ≤ f ≤ 1000 (the trajectory repeats every 1/f s).
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true, value_parser = crate::ranges::BASE_FREQUENCY)]
     pub base_frequency: f64,
 
     /// Fourier: objective evaluations allowed to the optimiser (each one evaluates
@@ -154,52 +156,34 @@ pub struct SimulateArgs {
     /// release build, about 30 s (450 evaluations) for a 31-joint tree, with a
     /// progress bar. Too few for one Nelder–Mead run (0, say; a run needs more than
     /// one evaluation per variable, 1 + 2·harmonics per joint) keep the random feasible
-    /// start.
-    #[arg(long)]
+    /// start. At most 10000000.
+    #[arg(long, value_parser = crate::ranges::EVALUATIONS)]
     pub evaluations: Option<usize>,
 
     /// Fourier: stop optimising after this many seconds and keep the best excitation
     /// so far (the result then depends on the machine's speed; `--evaluations` is the
-    /// reproducible bound).
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    /// reproducible bound); 0 < s ≤ 1e6.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = crate::ranges::TIME_BUDGET)]
     pub time_budget: Option<f64>,
 
     #[command(flatten)]
     pub gravity: ModelArgs,
 }
 
+/// What the flags' own ranges (`crate::ranges`, checked by clap) cannot say: the
+/// logger's number of samples, which depends on two flags.
 fn check_args(args: &SimulateArgs) -> Result<()> {
-    if let Some(d) = args.duration {
-        if !(d.is_finite() && d > 0.0) {
+    if let Some(period) = args.logger_period {
+        let duration = args.duration.unwrap_or(match args.experiment {
+            ExperimentKind::Paper => 2.0,
+            ExperimentKind::Fourier => 1.0 / args.base_frequency,
+        });
+        let samples = duration / period;
+        if samples > crate::ranges::MAX_LOGGER_SAMPLES as f64 {
             return Err(CliError::usage(format!(
-                "--duration must be a positive number of seconds, got {d}"
-            )));
-        }
-    }
-    if args.steps < 1 {
-        return Err(CliError::usage("--steps must be at least 1"));
-    }
-    if let Some(t) = args.time_budget {
-        if !(t.is_finite() && t > 0.0 && t < 1e9) {
-            return Err(CliError::usage(format!(
-                "--time-budget must be a positive number of seconds, got {t}"
-            )));
-        }
-    }
-    if !(args.noise.is_finite() && args.noise >= 0.0) {
-        return Err(CliError::usage(format!(
-            "--noise must be a non-negative fraction (0.01 = 1 %), got {}",
-            args.noise
-        )));
-    }
-    if args.experiment == ExperimentKind::Fourier {
-        if args.harmonics < 1 {
-            return Err(CliError::usage("--harmonics must be at least 1"));
-        }
-        if !(args.base_frequency.is_finite() && args.base_frequency > 0.0) {
-            return Err(CliError::usage(format!(
-                "--base-frequency must be positive, got {}",
-                args.base_frequency
+                "--logger-period {period} over {duration} s gives {samples:.3e} samples; at most {} are written: \
+                 give a longer period or a shorter --duration",
+                crate::ranges::MAX_LOGGER_SAMPLES
             )));
         }
     }
@@ -359,44 +343,9 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// One value for every joint, or one per joint, comma-separated and finite.
-fn per_joint(flag: &str, text: &str, n: usize) -> Result<Vec<f64>> {
-    let values: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-        .collect::<Option<_>>()
-        .ok_or_else(|| CliError::usage(format!("{flag}: `{text}` is not a list of finite numbers")))?;
-    match values.len() {
-        1 => Ok(vec![values[0]; n]),
-        k if k == n => Ok(values),
-        k => Err(CliError::usage(format!(
-            "{flag}: {k} values for {n} joints; give one for all joints or one per joint"
-        ))),
-    }
-}
-
-/// A logger that can write something sensible.
+/// A logger that can write something sensible (the numeric flags were checked by
+/// their value parsers, `crate::ranges`).
 fn check_logger(l: &Logger) -> Result<()> {
-    if !(l.period.is_finite() && l.period > 0.0) {
-        return Err(CliError::usage(format!(
-            "--logger-period must be positive, got {}",
-            l.period
-        )));
-    }
-    if !(0.0..1.0).contains(&l.jitter) {
-        return Err(CliError::usage(format!("--jitter must be in [0, 1), got {}", l.jitter)));
-    }
-    for (flag, x) in [("--duplicates", l.duplicates), ("--stale", l.stale)] {
-        if !(0.0..=1.0).contains(&x) {
-            return Err(CliError::usage(format!("{flag} must be a fraction in [0, 1], got {x}")));
-        }
-    }
-    if !(l.current_quantum.is_finite() && l.current_quantum >= 0.0) {
-        return Err(CliError::usage(format!(
-            "--current-quantum must be ≥ 0, got {}",
-            l.current_quantum
-        )));
-    }
     if let Some(k) = &l.gains {
         if k.contains(&0.0) {
             return Err(CliError::usage("--current-gains must not be zero"));

@@ -2,7 +2,7 @@
 //! (the JSON `identify --params-json` writes) and reports the errors per joint and
 //! overall, optionally as an SVG of measured against predicted torque.
 
-use crate::common::{check_overwrite, load_moving_model, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, outln, Progress, Result};
 use crate::error::CliError;
 use crate::identify::{pipeline_error, RecordingArgs};
 use dyngen_identify::data::Trajectory;
@@ -11,7 +11,7 @@ use dyngen_identify::report::{self, ParameterReport};
 use dyngen_identify::validate::Validation;
 use dyngen_model::Model;
 use dyngen_reference::Reference;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub const EXAMPLES: &str = "\
 Examples:
@@ -46,23 +46,108 @@ pub struct ValidateArgs {
 }
 
 /// The errors of `predicted` against `data`'s torques, named by the model's joints.
-pub fn validation(model: &Model, data: &Trajectory, predicted: &[Vec<f64>]) -> Result<Validation> {
+/// A prediction or an error that is not finite (parameters so large that the torques
+/// or their squares overflow) is refused, as bad input in `params` when given (the
+/// parameters file), as a failed computation otherwise.
+pub fn validation(
+    model: &Model,
+    data: &Trajectory,
+    predicted: &[Vec<f64>],
+    params: Option<&Path>,
+) -> Result<Validation> {
     let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    Validation::new(
+    let overflow = |message: String| match params {
+        Some(path) => CliError::input(path, message),
+        None => CliError::failed(message),
+    };
+    for (k, row) in predicted.iter().enumerate() {
+        if let Some(j) = row.iter().position(|x| !x.is_finite()) {
+            return Err(overflow(format!(
+                "the predicted torque of joint `{}` at sample {k} is {}; the parameters are too large for a finite \
+                 prediction",
+                names.get(j).map_or("?", String::as_str),
+                row[j]
+            )));
+        }
+    }
+    let v = Validation::new(
         &names,
         (0..data.len()).map(|k| data.tau(k)),
         predicted.iter().map(|p| &p[..]),
     )
-    .map_err(CliError::failed)
+    .map_err(CliError::failed)?;
+    let metrics = v.rms.iter().chain(&v.relative).chain([&v.overall]);
+    if let Some(x) = metrics.into_iter().find(|x| !x.is_finite()) {
+        return Err(overflow(format!(
+            "the prediction errors overflow ({x}): the predicted torques are finite but too large to compare (the \
+             parameters are absurdly large)"
+        )));
+    }
+    Ok(v)
 }
+
+/// Refuses parameters identified for another robot: their joints (the residual
+/// channels of the JSON) must be the robot's, in order.
+fn check_joints(params: &ParameterReport, model: &Model, path: &Path) -> Result<()> {
+    let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let theirs: Vec<&str> = params.channels.iter().map(String::as_str).collect();
+    if theirs.is_empty() || theirs == joints {
+        return Ok(());
+    }
+    let missing: Vec<&str> = joints.iter().copied().filter(|j| !theirs.contains(j)).collect();
+    let extra: Vec<&str> = theirs.iter().copied().filter(|j| !joints.contains(j)).collect();
+    let mut differences = Vec::new();
+    if theirs.len() != joints.len() {
+        differences.push(format!("{} joints instead of {}", theirs.len(), joints.len()));
+    }
+    if !extra.is_empty() {
+        differences.push(format!("joints the robot does not have: {}", extra.join(", ")));
+    }
+    if !missing.is_empty() {
+        differences.push(format!("robot joints it lacks: {}", missing.join(", ")));
+    }
+    if missing.is_empty() && extra.is_empty() {
+        differences.push(format!("the joints in another order: [{}]", theirs.join(", ")));
+    }
+    Err(CliError::input(
+        path,
+        format!(
+            "the parameters were identified for `{}` with joints [{}], but robot `{}` has joints [{}]: {}; identify \
+             this robot's parameters with `dyngen identify --params-json`",
+            params.robot,
+            theirs.join(", "),
+            model.name,
+            joints.join(", "),
+            differences.join("; ")
+        ),
+    ))
+}
+
+/// Reads the parameters JSON, at most [`MAX_PARAMS_BYTES`].
+fn read_params(path: &Path) -> Result<ParameterReport> {
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_PARAMS_BYTES + 1).read_to_string(&mut text))
+        .map_err(|e| CliError::input(path, e))?;
+    if text.len() as u64 > MAX_PARAMS_BYTES {
+        return Err(CliError::input(
+            path,
+            format!("larger than {MAX_PARAMS_BYTES} bytes (256 MiB); not a parameters file dyngen wrote"),
+        ));
+    }
+    ParameterReport::from_json(&text).map_err(|e| CliError::input(path, e))
+}
+
+/// Largest parameters JSON read: a few kB in practice.
+const MAX_PARAMS_BYTES: u64 = 1 << 28;
 
 pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     if let Some(svg) = &args.svg {
         check_overwrite(svg, args.force)?;
     }
     let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
-    let text = std::fs::read_to_string(&args.params).map_err(|e| CliError::input(&args.params, e))?;
-    let params = ParameterReport::from_json(&text).map_err(|e| CliError::input(&args.params, e))?;
+    let params = read_params(&args.params)?;
     let prediction = params.prediction.as_ref().ok_or_else(|| {
         CliError::input(
             &args.params,
@@ -70,10 +155,12 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
              identify with --mode standard or principal to validate)",
         )
     })?;
+    check_joints(&params, &model, &args.params)?;
     if params.robot != model.name {
-        println!(
-            "note: the parameters were identified for `{}`, the URDF describes `{}`",
-            params.robot, model.name
+        outln!(
+            "note: the parameters were identified for `{}`, the URDF describes `{}` (with the same joints)",
+            params.robot,
+            model.name
         );
     }
     let data = args.recording.load(&args.data, model.dof())?;
@@ -82,8 +169,8 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
         pipeline::PipelineError::InvalidOption { reason, .. } => CliError::input(&args.params, reason),
         e => pipeline_error(&args.data, e),
     })?;
-    let validation = validation(&model, &data, &predicted)?;
-    println!("{validation}");
+    let validation = validation(&model, &data, &predicted, Some(&args.params))?;
+    outln!("{validation}");
     if let Some(path) = &args.svg {
         let measured: Vec<Vec<f64>> = (0..data.len()).map(|k| data.tau(k).to_vec()).collect();
         let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
@@ -97,7 +184,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
         let svg = crate::svg::svg_report(&title, data.t(), &measured, &predicted, &joints, None)
             .map_err(|e| CliError::report(path, e))?;
         report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
-        println!("wrote the SVG to {}", path.display());
+        outln!("wrote the SVG to {}", path.display());
     }
     Ok(())
 }

@@ -188,7 +188,7 @@ fn bad_inputs_name_the_file_and_line() {
     let broken = common::pendulum(&dir, "broken.urdf", "-1");
     // The error points at the link (line 3) and says what is wrong.
     let o = run!("info", broken);
-    assert_error(&o, "broken.urdf:3: link `arm`: mass -1 is not positive");
+    assert_error(&o, "broken.urdf:3: link `arm`: mass -1 is negative");
     assert_error(&run!("generate", broken, "--name", "Broken"), "broken.urdf:");
     assert_error(&run!("simulate", broken, "-o", dir.join("x.csv")), "broken.urdf:");
 
@@ -293,5 +293,8 @@ fn free_flyer_in_info_and_generate_and_refused_at_run_time() {
     let o = run!("simulate", ur5(), "--free-flyer", "-o", dir.join("x.csv"));
     assert_error(&o, "joint `root_joint` is a floating joint (7 positions, 6 velocities)");
     let o = run!("simulate", ur5(), "-o", dir.join("y.csv"), "--time-budget", "-1");
-    assert_error(&o, "--time-budget must be a positive number of seconds");
+    assert_error(
+        &o,
+        "--time-budget -1: out of range; expected a number with 0 < x ≤ 1000000 (s)",
+    );
 }

@@ -19,12 +19,12 @@ fn exit_codes_say_what_kind_of_failure_it_was() {
     assert_exit(
         &run!("identify", ur5(), csv, "--cutoff", "-1"),
         2,
-        "--cutoff must be a positive",
+        "--cutoff -1: out of range; expected a number with 0 < x ≤ 1000000 (Hz)",
     );
     assert_exit(
         &run!("demo", "--draws", "0"),
         2,
-        "--draws and --test-draws must be at least 1",
+        "--draws 0: out of range; expected a whole number from 1 to 10000000",
     );
 
     // 3: an input file that is missing or invalid.

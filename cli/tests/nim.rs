@@ -120,7 +120,7 @@ fn nim_predict_explains_bad_input() {
 
     // Training options out of range.
     let o = run!("nim", "train", ur5(), csv, "-o", dir.join("x.json"), "--spread", "1.5");
-    assert_error(&o, "invalid spread: 1.5; expected 0 ≤ spread < 1");
+    assert_error(&o, "--spread 1.5: out of range; expected a number with 0 ≤ x < 1");
     let o = run!("nim", "train", ur5(), csv, "-o", dir.join("x.json"), "--window", "500");
     assert_error(
         &o,

@@ -89,6 +89,45 @@ fn cad_rounded_inertia_is_a_warning_and_strict_refuses_it() {
 }
 
 #[test]
+fn a_non_physical_inertia_loads_as_written_balanced_or_refused() {
+    let dir = temp_dir("dyngen-cli", "non-physical");
+    let path = dir.join("rod.urdf");
+    // J3 = 3 > J1 + J2 = 2: a third of the largest moment beyond physical.
+    std::fs::write(
+        &path,
+        r#"<robot name="rod">
+  <link name="base"/>
+  <link name="rod"><inertial><mass value="1"/>
+    <inertia ixx="1" iyy="1" izz="3" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="rod"/><axis xyz="1 0 0"/></joint>
+</robot>
+"#,
+    )
+    .unwrap();
+    let o = run!("info", path);
+    assert_ok(&o);
+    let err = stderr(&o);
+    assert!(
+        err.contains("rod.urdf:3: link `rod`: principal moments")
+            && err.contains("33.333 % of its largest moment away from physical")
+            && err.contains("--balance-inertia"),
+        "{err}"
+    );
+    let o = run!("info", path, "--balance-inertia");
+    assert_ok(&o);
+    let err = stderr(&o);
+    assert!(
+        err.contains("replaced by the nearest physical inertia (principal moments 1.333333e0, 1.333333e0, 2.666667e0"),
+        "{err}"
+    );
+    assert_exit(
+        &run!("info", path, "--strict"),
+        3,
+        "rod.urdf:3: link `rod`: principal moments",
+    );
+}
+
+#[test]
 fn too_few_samples_to_estimate_the_noise_are_refused() {
     let dir = temp_dir("dyngen-cli", "few-samples");
     // Three samples of six joints: 18 rows for 60 parameters.

@@ -177,7 +177,7 @@ fn validate_errors_name_the_file() {
         "--epsilon",
         "-1"
     );
-    assert_exit(&o, 2, "the smoothing ε must be positive");
+    assert_exit(&o, 2, "--epsilon -1: out of range; expected a number with 0 < x ≤ 1000");
     let o = run!(
         "identify",
         ur5(),
@@ -264,7 +264,7 @@ fn simulated_logger_files_identify_their_friction() {
         "1.5",
         "--force"
     );
-    assert_exit(&o, 2, "--jitter must be in [0, 1)");
+    assert_exit(&o, 2, "--jitter 1.5: out of range; expected a number with 0 ≤ x < 1");
 }
 
 /// Total least squares without column scaling on real-looking data: the fit is
@@ -391,7 +391,11 @@ fn rows_below_a_speed_are_left_out() {
             "--exclude-below",
             bad
         );
-        assert_exit(&o, 2, "--exclude-below must be a positive speed");
+        assert_exit(
+            &o,
+            2,
+            &format!("--exclude-below {bad}: out of range; expected a number with 0 < x ≤ 1000"),
+        );
     }
     let o = run!("identify", ur5(), fixture("ur5_identify.csv"), "--exclude-below", "100");
     assert_exit(&o, 2, "--exclude-below 100 leaves no torque row");

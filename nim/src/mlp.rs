@@ -470,11 +470,14 @@ impl Mlp {
             if layer.weights.len() != n_out {
                 return Err(shape_error(format!("{} rows", layer.weights.len())));
             }
+            // Every row checked against the sizes before the matrix is allocated: the
+            // allocation is then no larger than the values the file holds, whatever
+            // sizes it claims (a size of 1e12 is refused here, not by the allocator).
+            if let Some((i, row)) = layer.weights.iter().enumerate().find(|(_, row)| row.len() != n_in) {
+                return Err(shape_error(format!("row {i} of length {}", row.len())));
+            }
             let mut w = vec![0.0; n_out * n_in];
             for (i, row) in layer.weights.iter().enumerate() {
-                if row.len() != n_in {
-                    return Err(shape_error(format!("row {i} of length {}", row.len())));
-                }
                 for (j, &v) in row.iter().enumerate() {
                     if !v.is_finite() {
                         return Err(NimError::InvalidValue {
@@ -539,9 +542,25 @@ impl Mlp {
     }
 }
 
-/// The text of a JSON file (its I/O errors name the path).
+/// Largest weights file read, in bytes: far above any identifier dyngen trains (a
+/// few MB), and a bound on what a wrong path (`/dev/zero`) can take.
+pub(crate) const MAX_JSON_BYTES: u64 = 1 << 30;
+
+/// The text of a JSON file (its I/O errors name the path); at most
+/// [`MAX_JSON_BYTES`].
 pub(crate) fn read_json(path: &Path) -> Result<String, NimError> {
-    std::fs::read_to_string(path).map_err(|e| NimError::io(path, e))
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_JSON_BYTES + 1).read_to_string(&mut text))
+        .map_err(|e| NimError::io(path, e))?;
+    if text.len() as u64 > MAX_JSON_BYTES {
+        return Err(NimError::Io {
+            path: path.to_path_buf(),
+            message: format!("larger than {MAX_JSON_BYTES} bytes (1 GiB); not a weights file dyngen wrote"),
+        });
+    }
+    Ok(text)
 }
 
 /// Writes `json` and a newline to `path`; an existing file only with `overwrite`
@@ -681,6 +700,19 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("size 1 is zero"));
+    }
+
+    #[test]
+    fn a_huge_layer_size_is_refused_before_allocating() {
+        // Sizes claiming 1e12 inputs with one row of 7 values: checked against the
+        // values the file holds, not allocated (8 TB would abort the process).
+        let mut file = net().to_file();
+        file.sizes[0] = 1_000_000_000_000;
+        assert_eq!(
+            Mlp::from_file(file).unwrap_err().to_string(),
+            "layer 0: `weights` has shape row 0 of length 3, expected 7 × 1000000000000 (7 rows of 1000000000000: \
+             outputs × inputs)"
+        );
     }
 
     #[test]

@@ -47,6 +47,15 @@ impl fmt::Display for Field {
 /// larger one is a unit or column mistake (or a sensor fault), not a measurement.
 pub const MAX_ABS_VALUE: f64 = 1e6;
 
+/// Longest line a recording may have, in bytes (1 MiB, terminator excluded): tens
+/// of thousands of numbers. A longer line is refused before it is read whole (a
+/// binary file, `/dev/zero`, a file whose line breaks were lost).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest column number a recipe may name: no line within [`MAX_LINE_BYTES`] has
+/// more fields than this (each needs at least one byte and a separator).
+pub const MAX_COLUMNS: usize = MAX_LINE_BYTES / 2;
+
 /// Bad data or a failed read/write. Messages name the line (1-based file line) and
 /// the column, and say what would be valid.
 ///
@@ -205,6 +214,8 @@ pub enum DataError {
         found: super::Delimiter,
         fields: usize,
     },
+    /// A line longer than [`MAX_LINE_BYTES`] (`limit`), refused before reading it whole.
+    LineTooLong { line: u64, limit: usize },
     /// Several errors found in one pass (at most [`MAX_ERRORS`](super::MAX_ERRORS));
     /// `truncated` when reading stopped there.
     Multiple { errors: Vec<DataError>, truncated: bool },
@@ -238,7 +249,8 @@ impl DataError {
             | DataError::NonFiniteIn { line, .. }
             | DataError::OutOfRange { line, .. }
             | DataError::TimeNotIncreasing { line, .. }
-            | DataError::Separator { line, .. } => Some(*line),
+            | DataError::Separator { line, .. }
+            | DataError::LineTooLong { line, .. } => Some(*line),
             DataError::Recipe(e) => e.line(),
             DataError::NonFinite { at, .. }
             | DataError::NonMonotonicTime { at, .. }
@@ -428,6 +440,12 @@ impl fmt::Display for DataError {
                     mark(*found),
                 )
             }
+            DataError::LineTooLong { line, limit } => write!(
+                f,
+                "line {line} is longer than {limit} bytes ({} MiB) without a line break; a recording holds one \
+                 sample per line, so this is not a text recording (a binary file?) or its line breaks are lost",
+                limit >> 20
+            ),
             DataError::Multiple { errors, truncated } => {
                 write!(f, "{} errors", errors.len())?;
                 if *truncated {

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use super::error::{DataError, Location};
-use super::lines::LineIndex;
+use super::lines::{skip_bom, LineIndex};
 use super::recipe::Delimiter;
 use super::trajectory::Trajectory;
 use dyngen::Wrench;
@@ -298,7 +298,9 @@ pub(super) fn separator_hint(e: DataError, line: u64, used: Delimiter, other: Op
 fn csv_error(e: csv::Error, path: Option<&Path>, line: impl FnOnce(u64) -> u64) -> DataError {
     let line = e.position().map(|p| line(p.byte()));
     match e.into_kind() {
-        csv::ErrorKind::Io(source) => DataError::io(path.map(Path::to_path_buf), source),
+        csv::ErrorKind::Io(source) => {
+            super::lines::line_error(&source).unwrap_or_else(|| DataError::io(path.map(Path::to_path_buf), source))
+        }
         csv::ErrorKind::Utf8 { err, .. } => DataError::Malformed {
             line,
             message: format!("invalid UTF-8 in field {}", err.field() + 1),
@@ -331,7 +333,9 @@ fn read(reader: impl Read, dof: Option<usize>, path: Option<&Path>) -> Result<Tr
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .from_reader(LineIndex::new(reader));
+        .from_reader(LineIndex::new(
+            skip_bom(reader).map_err(|e| DataError::io(path.map(Path::to_path_buf), e))?,
+        ));
     let mut record = csv::StringRecord::new();
     // The csv crate's line numbers skip blank lines; count them ourselves.
     let line_of = |rdr: &mut csv::Reader<LineIndex<_>>, record: &csv::StringRecord| {

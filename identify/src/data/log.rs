@@ -11,8 +11,9 @@ use std::path::Path;
 use nalgebra::Vector3;
 
 use super::derivatives::{hermite, intervals, SAMPLING_TOLERANCE};
-use super::error::{DataError, Field, MAX_ABS_VALUE};
+use super::error::{DataError, Field, MAX_ABS_VALUE, MAX_LINE_BYTES};
 use super::io::{parse_header, separator_hint, Errors, Kind, WRENCH_PREFIXES};
+use super::lines::{line_error, skip_bom, TooLong};
 use super::recipe::{ColumnRef, Delimiter, Recipe, RecipeError, Sampling, Stale, TimeOrigin};
 use super::trajectory::{column, set_column, Trajectory};
 use dyngen::Wrench;
@@ -280,13 +281,13 @@ impl Loaded {
 
 /// The lines of the input, without terminators: `\n`, `\r\n` and a lone `\r` end a
 /// line, as for the plain reader. The buffer is reused, so reading allocates only
-/// when a line is longer than every line before.
+/// when a line is longer than every line before; a line longer than
+/// [`MAX_LINE_BYTES`] is an error ([`TooLong`]) raised before more of it is read.
 struct Lines<R> {
     inner: BufReader<R>,
     buf: Vec<u8>,
-    /// Start of the next line in `buf`; past `end` when `buf` is used up.
-    pos: usize,
-    end: usize,
+    /// The last line ended with `\r`: a `\n` right after it belongs to that break.
+    after_cr: bool,
     number: u64,
 }
 
@@ -295,37 +296,48 @@ impl<R: Read> Lines<R> {
         Lines {
             inner: BufReader::with_capacity(1 << 16, inner),
             buf: Vec::new(),
-            pos: 1,
-            end: 0,
+            after_cr: false,
             number: 0,
         }
     }
 
     fn next_line(&mut self) -> io::Result<Option<(u64, &[u8])>> {
-        if self.pos > self.end {
-            self.buf.clear();
-            if self.inner.read_until(b'\n', &mut self.buf)? == 0 {
-                return Ok(None);
+        self.buf.clear();
+        let mut any = false;
+        loop {
+            let available = match self.inner.fill_buf() {
+                Ok(bytes) => bytes,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            };
+            if available.is_empty() {
+                if !any {
+                    return Ok(None);
+                }
+                break;
             }
-            self.end = self.buf.len() - usize::from(self.buf.last() == Some(&b'\n'));
-            self.pos = 0;
+            if std::mem::take(&mut self.after_cr) && available[0] == b'\n' {
+                self.inner.consume(1);
+                continue;
+            }
+            any = true;
+            let stop = available.iter().position(|&b| b == b'\n' || b == b'\r');
+            let take = stop.unwrap_or(available.len());
+            if self.buf.len() + take > MAX_LINE_BYTES {
+                return Err(TooLong { line: self.number + 1 }.into_io());
+            }
+            self.buf.extend_from_slice(&available[..take]);
+            match stop {
+                Some(i) => {
+                    self.after_cr = available[i] == b'\r';
+                    self.inner.consume(i + 1);
+                    break;
+                }
+                None => self.inner.consume(take),
+            }
         }
-        let start = self.pos;
-        let stop = match self.buf[start..self.end].iter().position(|&b| b == b'\r') {
-            Some(i) => {
-                // A `\r` that ends the chunk (`\r\n`, or `\r` at the end of the
-                // input) starts no new line.
-                let at = start + i;
-                self.pos = if at + 1 == self.end { self.end + 1 } else { at + 1 };
-                at
-            }
-            None => {
-                self.pos = self.end + 1;
-                self.end
-            }
-        };
         self.number += 1;
-        Ok(Some((self.number, &self.buf[start..stop])))
+        Ok(Some((self.number, &self.buf)))
     }
 }
 
@@ -949,8 +961,8 @@ fn read(reader: impl Read, recipe: &Recipe, dof: Option<usize>, path: Option<&Pa
             expected: "at least 1 joint (or `None` to take it from the columns)".into(),
         });
     }
-    let io_error = |e: io::Error| DataError::io(path.map(Path::to_path_buf), e);
-    let mut lines = Lines::new(reader);
+    let io_error = |e: io::Error| line_error(&e).unwrap_or_else(|| DataError::io(path.map(Path::to_path_buf), e));
+    let mut lines = Lines::new(skip_bom(reader).map_err(io_error)?);
     for _ in 0..recipe.skip {
         if lines.next_line().map_err(io_error)?.is_none() {
             return Err(DataError::Empty);
@@ -1548,6 +1560,53 @@ mod tests {
         let csv = "t,q1,tau1\r\n0,0,0\r0.01,0,0\r\n\n0.02,x,0\n";
         let e = load_err("", csv, None);
         assert_eq!(e, "line 5, column `q1`: `x` is not a number");
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped_by_both_readers() {
+        let csv = "\u{feff}t,q1,tau1\n0,0,1\n0.01,0.1,1\n0.02,0.2,1\n";
+        assert_eq!(load("", csv, None).unwrap().trajectory.len(), 3);
+        assert_eq!(from_reader(csv.as_bytes(), None).unwrap().len(), 3);
+        // Without a header too, and only at the very start.
+        assert_eq!(
+            load("header = false", &format!("\u{feff}{}", &csv[3 + 10..]), None)
+                .unwrap()
+                .trajectory
+                .len(),
+            3
+        );
+        let e = load_err("", "t,q1,tau1\n\u{feff}0,0,1\n0.01,0.1,1\n", None);
+        assert!(e.starts_with("line 2, column `t`: `\u{feff}0` is not a number"), "{e}");
+    }
+
+    #[test]
+    fn a_line_longer_than_the_limit_is_refused_by_both_readers() {
+        let mut long = b"t,q1,tau1\n0,0,1\n".to_vec();
+        long.extend(std::iter::repeat_n(b'7', MAX_LINE_BYTES + 1));
+        long.extend_from_slice(b"\n0.02,0.2,1\n");
+        let message = "line 3 is longer than 1048576 bytes (1 MiB) without a line break; a recording holds one \
+                       sample per line, so this is not a text recording (a binary file?) or its line breaks are lost";
+        let e = Recipe::default().read_from(&long[..], None).unwrap_err();
+        assert!(matches!(e, DataError::LineTooLong { line: 3, .. }), "{e}");
+        assert_eq!(e.to_string(), message);
+        let e = from_reader(&long[..], None).unwrap_err();
+        assert_eq!((e.to_string(), e.line()), (message.to_string(), Some(3)));
+        // A line of exactly the limit is read (spaces around fields are ignored),
+        // also after `\r` line breaks.
+        let mut at_limit = b"t,q1,tau1\r0,0,1\r\n0.01,0.1,1\r".to_vec();
+        let row = b"0.02,0.2,1";
+        at_limit.extend_from_slice(row);
+        at_limit.extend(std::iter::repeat_n(b' ', MAX_LINE_BYTES - row.len()));
+        at_limit.push(b'\r');
+        assert_eq!(
+            Recipe::default()
+                .read_from(&at_limit[..], None)
+                .unwrap()
+                .trajectory
+                .len(),
+            3
+        );
+        assert_eq!(from_reader(&at_limit[..], None).unwrap().len(), 3);
     }
 
     #[test]

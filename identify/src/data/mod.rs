@@ -34,6 +34,10 @@
 //!   infinities are rejected;
 //! - `t` strictly increases; at least 2 samples.
 //!
+//! A UTF-8 byte order mark at the start of the file is skipped; a line longer than
+//! [`MAX_LINE_BYTES`] (1 MiB) is an error naming it, raised before the line is read
+//! whole. Files are read as a stream, line by line: only the samples are kept.
+//!
 //! Empty lines hold no data and are skipped (before the header, so are lines of
 //! spaces); line numbers in errors count them. The reader goes through the whole file
 //! and collects up to [`MAX_ERRORS`] errors (a single error is returned as itself,
@@ -83,7 +87,7 @@
 //! | `header` | `true`, `false`: whether the first line (after `skip`) names the columns | `true` |
 //! | `skip` | lines to skip before the header or first row (a preamble) | `0` |
 //! | `time` | the time column: its number (from 1) or header name | `1` when `q` is given |
-//! | `q` | one column per joint: numbers, names, ranges `2-7`, comma-separated | |
+//! | `q` | one column per joint: numbers (1 to [`MAX_COLUMNS`]), names, ranges `2-7`, comma-separated | |
 //! | `v` | measured velocities, one column per joint (optional) | |
 //! | `a` | measured accelerations, one column per joint (optional) | |
 //! | `tau` | torques (forces), or motor currents when `gains` is given, one per joint | |
@@ -205,7 +209,7 @@ pub use derivatives::{
     butterworth_filtfilt, central_difference, nonuniform_difference, nonuniform_second_difference, second_difference,
     SAMPLING_TOLERANCE,
 };
-pub use error::{DataError, Field, Location, MAX_ABS_VALUE};
+pub use error::{DataError, Field, Location, MAX_ABS_VALUE, MAX_COLUMNS, MAX_LINE_BYTES};
 pub use io::{csv_header, from_reader, overwrite_csv, read_csv, to_writer, write_csv, MAX_ERRORS};
 pub use log::{LoadReport, Loaded, Provenance, TimeSteps, MAX_RESAMPLE_FACTOR};
 pub use recipe::{

@@ -5,6 +5,8 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use super::error::MAX_COLUMNS;
+
 /// Field separator of a log.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Delimiter {
@@ -235,6 +237,9 @@ impl Default for Recipe {
     }
 }
 
+/// Largest recipe file read, in bytes.
+const MAX_RECIPE_BYTES: u64 = 1 << 20;
+
 /// Every key of the format, in the order of the docs.
 pub const RECIPE_KEYS: [&str; 18] = [
     "delimiter",
@@ -384,12 +389,17 @@ fn parse_columns(value: &str) -> Option<Vec<ColumnRef>> {
             let (a, b) = (a.trim().parse::<usize>().ok()?, b.trim().parse::<usize>().ok()?);
             Some((a, b))
         });
+        // Bounded before a range is expanded: `2-4000000000` is no file's columns.
         match (range, item.parse::<usize>()) {
-            (Some((a, b)), _) if a >= 1 && a <= b => out.extend((a..=b).map(ColumnRef::Index)),
+            (Some((a, b)), _) if a >= 1 && a <= b && b <= MAX_COLUMNS => out.extend((a..=b).map(ColumnRef::Index)),
             (Some(_), _) => return None,
             (None, Ok(0)) => return None,
+            (None, Ok(i)) if i > MAX_COLUMNS => return None,
             (None, Ok(i)) => out.push(ColumnRef::Index(i)),
             (None, Err(_)) => out.push(ColumnRef::Name(item.to_string())),
+        }
+        if out.len() > MAX_COLUMNS {
+            return None;
         }
     }
     Some(out)
@@ -410,12 +420,25 @@ fn parse_number(value: &str) -> Option<f64> {
 impl Recipe {
     /// Reads a recipe file (format in the [module docs](super#recipes)).
     pub fn from_file(path: impl AsRef<Path>) -> Result<Recipe, RecipeError> {
+        use std::io::Read;
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| RecipeError::Io {
+        let io = |source| RecipeError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
-        Recipe::parse(&text)
+        };
+        // A recipe is a few lines: read at most 1 MiB and a byte, so that a wrong
+        // path (`/dev/zero`, a recording) fails instead of filling the memory.
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_RECIPE_BYTES + 1).read_to_string(&mut text))
+            .map_err(io)?;
+        if text.len() as u64 > MAX_RECIPE_BYTES {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("longer than {MAX_RECIPE_BYTES} bytes; a recipe is a few `key = value` lines"),
+            )));
+        }
+        Recipe::parse(text.strip_prefix('\u{feff}').unwrap_or(&text))
     }
 
     /// Parses a recipe from its text: `key = value` lines, `#` comments, blank
@@ -470,7 +493,10 @@ impl Recipe {
             value: value.to_string(),
             expected,
         };
-        const COLUMNS: &str = "column numbers (from 1) or header names, separated by commas; ranges as `2-7`";
+        const COLUMNS: &str =
+            "column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by \
+             commas; ranges as `2-7`";
+        const _: () = assert!(MAX_COLUMNS == 524288, "the message above states MAX_COLUMNS");
         match key {
             "delimiter" => {
                 self.delimiter = match value {
@@ -757,9 +783,11 @@ stale = drop
             ("header = maybe", "line 1: `header = maybe`: expected `true` or `false`"),
             ("skip = -1", "line 1: `skip = -1`: expected a number of lines, 0 or more"),
             ("time = 1, 2", "line 1: `time = 1, 2`: expected one column number (from 1) or header name"),
-            ("q = 0", "line 1: `q = 0`: expected column numbers (from 1) or header names, separated by commas; ranges as `2-7`"),
-            ("q = 5-2", "line 1: `q = 5-2`: expected column numbers (from 1) or header names, separated by commas; ranges as `2-7`"),
-            ("q = 1,,2", "line 1: `q = 1,,2`: expected column numbers (from 1) or header names, separated by commas; ranges as `2-7`"),
+            ("q = 0", "line 1: `q = 0`: expected column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by commas; ranges as `2-7`"),
+            ("q = 5-2", "line 1: `q = 5-2`: expected column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by commas; ranges as `2-7`"),
+            ("q = 1,,2", "line 1: `q = 1,,2`: expected column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by commas; ranges as `2-7`"),
+            ("q = 2-4000000000", "line 1: `q = 2-4000000000`: expected column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by commas; ranges as `2-7`"),
+            ("tau = 524289", "line 1: `tau = 524289`: expected column numbers (from 1 to 524288, the most fields a line of 1 MiB holds) or header names, separated by commas; ranges as `2-7`"),
             ("time_unit = h", "line 1: `time_unit = h`: expected `s`, `ms`, `us` (or `µs`) or `ns`"),
             ("time_origin = 0", "line 1: `time_origin = 0`: expected `file` (time stamps as they are) or `first` (the first row is t = 0)"),
             ("units = grad", "line 1: `units = grad`: expected `rad`, `deg`, `m` or `mm`, once for every joint or once per joint"),

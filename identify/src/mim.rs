@@ -1,4 +1,5 @@
-//! MIM as in the paper (docs/design.md, "The paper's decoupled body model"): identification of the principal
+//! MIM, the Model Identification Method of the source paper (Advances in Mechanical Engineering, 2025, doi:10.1177/16878132251321050;
+//! docs/design.md, "The paper's decoupled body model"): identification of the principal
 //! parameters `θ_i = (m, J1, J2, J3)` on the decoupled multibody model, and of the
 //! identifiable combinations from joint torques alone.
 //!

@@ -1,5 +1,7 @@
-//! NIM, the neural-network identification method: networks that read a body's
-//! measured motion and wrench and return its principal inertial parameters
+//! NIM, the numerical (neural-network) identification method of the source paper
+//! (Advances in Mechanical Engineering, 2025, doi:10.1177/16878132251321050):
+//! networks that read a body's measured motion and wrench and return its principal
+//! inertial parameters
 //! `θ = (m, J1, J2, J3)`. No machine-learning framework: the networks are written
 //! over faer.
 //!

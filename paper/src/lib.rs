@@ -1,4 +1,5 @@
-//! The source paper's experiment on its 6-DOF manipulator (paper6), end to end, as
+//! The source paper's experiment (Advances in Mechanical Engineering, 2025, doi:10.1177/16878132251321050) on its 6-DOF
+//! manipulator (paper6), end to end, as
 //! `dyngen demo` shows it. MIM: the paper's Tables 2–3 from the single instant t = 1.5 s and from all
 //! samples, noise-free and with sensor noise; an excitation designed for MIM; a noise
 //! study on both experiments. NIM: the paper's network as described (Tables 4–5,

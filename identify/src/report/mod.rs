@@ -48,7 +48,7 @@ pub fn write_new(path: &Path, contents: &str, overwrite: bool) -> Result<(), Rep
     file.write_all(contents.as_bytes()).map_err(io)
 }
 
-/// Writes an SVG report made by [`svg_report`] (see [`write_new`]).
+/// Writes an SVG report (a [`LineChart`] rendered to text) as [`write_new`] writes any file.
 pub fn write_report(path: &Path, svg: &str, overwrite: bool) -> Result<(), ReportError> {
     write_new(path, svg, overwrite)
 }

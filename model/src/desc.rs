@@ -124,10 +124,9 @@ pub fn check_inertial(inertial: &Inertial) -> Result<(), ErrorKind> {
 }
 
 /// Checks that an inertial is physical: finite, mass ≥ 0, inertia about the centre
-/// of mass positive semi-definite and satisfying the triangle inequalities. Each
-/// link's share of a body is held to this before merging (point masses and massless
-/// frames are common on fixed joints, and only the merged body needs the strict
-/// [`check_inertial`]), and so is an identified inertial before it is written.
+/// of mass positive semi-definite and satisfying the triangle inequalities (point
+/// masses and massless frames pass, where [`check_inertial`] wants a strictly
+/// positive body). An identified inertial is held to this before it is written.
 pub fn check_physical(inertial: &Inertial) -> Result<(), ErrorKind> {
     check_finite(inertial)?;
     if inertial.mass < 0.0 {
@@ -197,9 +196,10 @@ pub struct LoadOptions {
     /// a floating base, as Pinocchio's `buildModel(urdf, JointModelFreeFlyer())`.
     pub free_flyer: bool,
     /// Replace every non-physical body inertia by the nearest physical one
-    /// ([`Inertial::nearest_physical`], as MuJoCo's `balanceinertia`), each with a
-    /// warning naming the link and the moments before and after. Without it the
-    /// inertia is kept as written, as Pinocchio reads it, with a warning.
+    /// ([`Inertial::nearest_physical`]: the least change of the moments, where
+    /// MuJoCo's `balanceinertia` sets them to their mean), each with a warning naming
+    /// the link and the moments before and after. Without it the inertia is kept as
+    /// written, as Pinocchio reads it, with a warning.
     pub balance_inertia: bool,
 }
 
@@ -505,9 +505,8 @@ impl Description {
         if model.joints.is_empty() && errors.is_empty() {
             errors.push(err(Element::Robot, None, ErrorKind::NoMovingJoint));
         }
-        if !errors.is_empty() {
-            return Err(errors);
-        }
+        // Only a tree without errors so far has a mass matrix worth factoring below.
+        let factor = errors.is_empty();
         for (b, inertial) in body_inertial.into_iter().enumerate() {
             let body = &mut model.bodies[b];
             body.inertial = inertial.unwrap_or(Inertial::principal(0.0, [0.0; 3]));
@@ -533,7 +532,8 @@ impl Description {
                 }
             }
         }
-        for k in singular_joints(&model) {
+        let singular = if factor { singular_joints(&model) } else { Vec::new() };
+        for k in singular {
             let name = &model.joints[k].name;
             let line = self.joints.iter().find(|j| j.name == *name).and_then(|j| j.line);
             let e = err(Element::Joint(name.clone()), line, ErrorKind::SingularMassMatrix);

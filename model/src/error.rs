@@ -83,7 +83,6 @@ pub enum ErrorKind {
         what: &'static str,
         value: f64,
     },
-    MissingInertial,
     NonPositiveMass(f64),
     NotPositiveDefinite([f64; 3]),
     TriangleInequality([f64; 3]),
@@ -200,10 +199,6 @@ impl fmt::Display for ErrorKind {
                 f,
                 "{what} holds {value:e}, beyond ±{:e} in SI units (m, kg, kg·m²); check the unit",
                 crate::desc::MAX_MAGNITUDE
-            ),
-            ErrorKind::MissingInertial => write!(
-                f,
-                "this moving body has no <inertial> (nor any fixed-attached link with one); give it a mass and inertia"
             ),
             ErrorKind::NonPositiveMass(m) if *m < 0.0 => {
                 write!(f, "mass {m} is negative; a mass is ≥ 0 kg (0 for a massless link)")

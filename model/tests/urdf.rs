@@ -531,6 +531,21 @@ fn massless_parts_keep_their_rotational_inertia_when_merged() {
 }
 
 #[test]
+fn a_strict_load_names_every_bad_body_at_once() {
+    // A negative mass (an error in any load) and a broken triangle inequality (an
+    // error when strict) in two bodies: both, in file order.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link_with("a", "-1", ["1", "1", "1"]),
+        &link_with("b", "1", ["1", "1", "3"]),
+        &joint("ja", "continuous", "base", "a", ""),
+        &joint("jb", "continuous", "a", "b", ""),
+    ]);
+    let lines: Vec<Option<usize>> = strict_errors(&text).iter().map(|e| e.line).collect();
+    assert_eq!(lines, [Some(3), Some(4)]);
+}
+
+#[test]
 fn zero_and_negative_mass() {
     // Mass 0 with a rotational inertia is not a rigid body: loaded, with a warning.
     let (model, warned) = load_warned(&one_body(&link_with("a", "0", ["1", "1", "1"])));

@@ -5,7 +5,8 @@
 //!
 //! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree
 //! inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia
-//! settotalmass>` (MuJoCo's default angle unit is the degree), `<option gravity>`,
+//! settotalmass>` (MuJoCo's default angle unit is the degree), `<option gravity>`
+//! and its `<flag gravity="disable">` (no gravity),
 //! `<default>` classes (nested, `class` on joints, geoms and sites, `childclass` on
 //! bodies) for joint, geom and site attributes, `<worldbody>` with nested `<body name
 //! pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass diaginertia (with an
@@ -66,8 +67,9 @@
 //! A named `<site>` is a frame of the model ([`crate::ir::Frame`]), a link without
 //! inertial fixed to its body (or to the base, in `<worldbody>`), at its `pos` and
 //! orientation (or `fromto`) in the body frame. An unnamed site (MuJoCo allows them)
-//! is skipped: no frame. A site named as a body is refused, since frames and bodies
-//! share one namespace.
+//! is skipped: no frame. A site named as a body (MuJoCo's sites and bodies have
+//! separate names, dyngen's frames and bodies one namespace) is left out with a
+//! warning: no frame.
 //!
 //! # Joints and their coordinates
 //!
@@ -108,7 +110,7 @@
 //!   is refused.
 //!
 //! Refused, each naming the element and its line: a free joint not directly in
-//! `<worldbody>` or with other joints in its body, `<include>`, `<frame>`,
+//! `<worldbody>` or with other joints in its body, `<frame>`,
 //! `<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, unknown classes,
 //! `fullinertia` with an orientation on the `<inertial>` (MuJoCo refuses it too),
 //! `<compiler coordinate="global">`, the geoms above. Left out with a warning naming
@@ -118,7 +120,28 @@
 //! dynamics alone. Cameras, lights, assets, actuators, sensors, geoms of bodies with
 //! an `<inertial>` and the rest are skipped.
 //!
-//! Siblings are numbered in declaration order, as MuJoCo numbers its bodies.
+//! Siblings are numbered in declaration order, as MuJoCo numbers its bodies. An
+//! element with `name=""` is unnamed, as in MuJoCo (a body `body_ID`, a joint
+//! `joint_ID`, a site no frame).
+//!
+//! # Includes
+//!
+//! `<include file="x.xml"/>`, anywhere, is replaced by the children of the included
+//! file's document element, which must be `<mujoco>`. As in MuJoCo, `file` is
+//! relative to the folder of the top-level file, also in nested includes (at most
+//! [`MAX_INCLUDE_DEPTH`] deep), and a file is included at most once. Refused, naming
+//! the `<include>` and its line: no `file`, an absolute path or one that leads out of
+//! the top-level file's folder (after `..` are resolved, and through links), a file
+//! that cannot be read or is larger than [`MAX_FILE_BYTES`], a file included again
+//! or including a file that includes it (a cycle), children in the `<include>`, and
+//! any `<include>` in text read without its file ([`parse_mjcf`]: load it with
+//! [`load_mjcf`]). Nesting is limited across files as in one file.
+//!
+//! [`ModelErrors`] names one file, so an error or warning about an element of an
+//! included file carries the line of the top-level file's `<include>` that brings it
+//! in, and its message starts with ``in `FILE` line N`` (and `, included from `FILE`
+//! line N` for each include in between); errors whose kind has no message of its own
+//! are given as [`ErrorKind::InvalidMjcf`] with that prefix and their text.
 
 use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
@@ -140,6 +163,7 @@ const UNLIMITED: f64 = 1e6;
 
 /// Parses and checks MJCF text; errors carry line numbers but no file name.
 /// Warnings as for [`parse_urdf`](crate::parse_urdf), and for what is left out.
+/// Text has no folder: an `<include>` is refused (read the file with [`load_mjcf`]).
 pub fn parse_mjcf(text: &str) -> Result<Model, ModelErrors> {
     parse_mjcf_with(text, false)
 }
@@ -157,10 +181,12 @@ pub fn parse_mjcf_with(text: &str, strict: bool) -> Result<Model, ModelErrors> {
 
 /// [`parse_mjcf`] with every [`LoadOptions`] (a free flyer under the root link).
 pub fn parse_mjcf_options(text: &str, options: LoadOptions) -> Result<Model, ModelErrors> {
-    build(text, options).map_err(|errors| ModelErrors { file: None, errors })
+    build(text, None, options).map_err(|errors| ModelErrors { file: None, errors })
 }
 
-/// Reads, parses and checks an MJCF file; errors are prefixed with its path.
+/// Reads, parses and checks an MJCF file and the files it `<include>`s (relative to
+/// its folder); errors are prefixed with its path (see the module documentation for
+/// errors in included files).
 pub fn load_mjcf(path: &Path) -> Result<Model, ModelErrors> {
     load_mjcf_with(path, false)
 }
@@ -183,7 +209,7 @@ pub fn load_mjcf_options(path: &Path, options: LoadOptions) -> Result<Model, Mod
         file: file.clone(),
         errors,
     })?;
-    build(&text, options).map_err(|errors| ModelErrors { file, errors })
+    build(&text, Some(path), options).map_err(|errors| ModelErrors { file, errors })
 }
 
 /// Loads a robot by its file name: `.xml` or `.mjcf` as MJCF ([`load_mjcf`], siblings
@@ -219,7 +245,7 @@ pub fn load_robot_options(path: &Path, options: LoadOptions) -> Result<Model, Mo
 /// (not of the tree it describes) are returned here.
 pub fn mjcf_description(text: &str) -> Result<Description, ModelErrors> {
     let fail = |errors| ModelErrors { file: None, errors };
-    let read = read(text).map_err(fail)?;
+    let read = read(text, None).map_err(fail)?;
     if !read.errors.is_empty() {
         return Err(fail(read.errors));
     }
@@ -238,8 +264,18 @@ fn read_file(path: &Path) -> Result<String, Vec<ModelError>> {
     Ok(text)
 }
 
-fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
-    let mut read = read(text)?;
+fn build(text: &str, path: Option<&Path>, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
+    let mut read = read(text, path)?;
+    let sources = std::mem::take(&mut read.sources);
+    built(read, options)
+        .map_err(|errors| relocate(&sources, errors))
+        .map(|mut model| {
+            model.warnings = relocate(&sources, std::mem::take(&mut model.warnings));
+            model
+        })
+}
+
+fn built(mut read: Read, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
     if options.free_flyer {
         let free = DeclaredJointType::Moving(JointKind::FreeFlyer);
         match read.desc.joints.iter().find(|j| j.kind == free) {
@@ -304,9 +340,11 @@ struct Read {
     root_line: Option<usize>,
     errors: Vec<ModelError>,
     warnings: Vec<ModelError>,
+    /// The files read, the top-level one first, for [`relocate`].
+    sources: Vec<Source>,
 }
 
-fn read(text: &str) -> Result<Read, Vec<ModelError>> {
+fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(vec![robot_error(
             None,
@@ -315,20 +353,7 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
             },
         )]);
     }
-    let tags = match scan(text) {
-        Ok(tags) => tags,
-        Err(SyntaxError {
-            line,
-            too_deep: Some(tag),
-            ..
-        }) => return Err(vec![robot_error(Some(line), ErrorKind::TooDeep { tag })]),
-        Err(e) => {
-            return Err(vec![robot_error(
-                Some(e.line),
-                ErrorKind::InvalidMjcf(format!("not valid XML: {}", e.message)),
-            )])
-        }
-    };
+    let tags = scan_mjcf(text, 0)?;
     let root = tags.iter().position(|t| t.parent.is_none()).unwrap_or(0);
     if tags[root].name != "mujoco" {
         return Err(vec![robot_error(
@@ -339,11 +364,49 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
             )),
         )]);
     }
-    let mut children = vec![Vec::new(); tags.len()];
-    for (k, t) in tags.iter().enumerate() {
-        if let Some(p) = t.parent {
-            children[p].push(k);
+    let mut includes = Includes {
+        top: path.map(|p| {
+            let dir = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            let canonical = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+            (dir.to_path_buf(), canonical)
+        }),
+        tags: Vec::new(),
+        children: Vec::new(),
+        sources: vec![Source {
+            name: path.map_or_else(|| "the MJCF text".to_string(), |p| p.display().to_string()),
+            base: 0,
+            lines: crate::xml::line_of(text, text.len()),
+            included_at: None,
+        }],
+        seen: Vec::new(),
+        errors: Vec::new(),
+    };
+    let main = path.and_then(|p| std::fs::canonicalize(p).ok());
+    let root = includes.add(tags, 0, &mut main.into_iter().collect());
+    let Includes {
+        tags,
+        children,
+        sources,
+        errors: include_errors,
+        ..
+    } = includes;
+    // Each file was scanned within the nesting limit; the model, its includes in
+    // place, must be too.
+    let mut stack = vec![(root, 1usize)];
+    while let Some((k, depth)) = stack.pop() {
+        if depth > crate::xml::MAX_DEPTH {
+            let e = robot_error(
+                Some(tags[k].line),
+                ErrorKind::TooDeep {
+                    tag: tags[k].name.clone(),
+                },
+            );
+            return Err(relocate(&sources, vec![e]));
         }
+        stack.extend(children[k].iter().map(|&c| (c, depth + 1)));
     }
     let mut reader = Reader {
         tags: &tags,
@@ -372,6 +435,7 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
         sites: Vec::new(),
         uncounted: Vec::new(),
     };
+    reader.errors = include_errors;
     reader.read_document(root);
     reader.apply_mass_rules();
     reader.check_site_names();
@@ -386,7 +450,264 @@ fn read(text: &str) -> Result<Read, Vec<ModelError>> {
         root_line: Some(tags[root].line),
         errors: reader.errors,
         warnings: reader.warnings,
+        sources,
     })
+}
+
+/// Deepest nesting of `<include>`s: the top-level file's includes are at depth 1.
+pub const MAX_INCLUDE_DEPTH: usize = 8;
+
+/// Scans MJCF text, its lines counted from `base` (see [`Source`]).
+fn scan_mjcf(text: &str, base: usize) -> Result<Vec<Tag>, Vec<ModelError>> {
+    let mut tags = match scan(text) {
+        Ok(tags) => tags,
+        Err(SyntaxError {
+            line,
+            too_deep: Some(tag),
+            ..
+        }) => return Err(vec![robot_error(Some(base + line), ErrorKind::TooDeep { tag })]),
+        Err(e) => {
+            return Err(vec![robot_error(
+                Some(base + e.line),
+                ErrorKind::InvalidMjcf(format!("not valid XML: {}", e.message)),
+            )])
+        }
+    };
+    for t in &mut tags {
+        t.line += base;
+        // MuJoCo reads `name=""` as no name.
+        t.attrs.retain(|(n, v)| !(n == "name" && v.is_empty()));
+    }
+    Ok(tags)
+}
+
+/// A file of the model. Included files' lines are numbered on from the lines of the
+/// files before them (line `l` of a file is `base + l` in the tags), so that every
+/// tag, error and warning carries one number; [`relocate`] turns the numbers of
+/// included files back into their own.
+struct Source {
+    /// The top-level file's path, or an included file's path as resolved against
+    /// the top-level file's folder.
+    name: String,
+    base: usize,
+    lines: usize,
+    /// The source and (numbered-on) line of the `<include>` that brought it in.
+    included_at: Option<(usize, usize)>,
+}
+
+/// The files of a model, `<include>`s replaced by the children of the `<mujoco>`
+/// of the file they name, in one list of tags.
+struct Includes {
+    /// The top-level file's folder, as written and canonical; `None` for text.
+    top: Option<(std::path::PathBuf, std::path::PathBuf)>,
+    tags: Vec<Tag>,
+    children: Vec<Vec<usize>>,
+    sources: Vec<Source>,
+    /// Canonical paths of the files included so far, with their source.
+    seen: Vec<(std::path::PathBuf, usize)>,
+    errors: Vec<ModelError>,
+}
+
+impl Includes {
+    /// Adds the tags of source `source` and, in place of each `<include>`, the
+    /// files it names; returns the index of its document element. `stack` holds the
+    /// canonical paths of the files including this one, and this one.
+    fn add(&mut self, tags: Vec<Tag>, source: usize, stack: &mut Vec<std::path::PathBuf>) -> usize {
+        let offset = self.tags.len();
+        let count = tags.len();
+        self.children.extend((0..count).map(|_| Vec::new()));
+        let mut root = offset;
+        for (k, mut t) in tags.into_iter().enumerate() {
+            match t.parent {
+                Some(p) => {
+                    t.parent = Some(p + offset);
+                    self.children[p + offset].push(offset + k);
+                }
+                None => root = offset + k,
+            }
+            self.tags.push(t);
+        }
+        for k in offset..offset + count {
+            if self.tags[k].name != "include" {
+                continue;
+            }
+            let parent = self.tags[k].parent.unwrap_or(root);
+            let spliced = match self.include(k, source, stack) {
+                Ok(included_root) => self.children[included_root].clone(),
+                Err(e) => {
+                    self.errors.push(e);
+                    Vec::new()
+                }
+            };
+            let at = self.children[parent].iter().position(|&c| c == k).unwrap_or(0);
+            self.children[parent].splice(at..=at, spliced);
+        }
+        root
+    }
+
+    /// Reads the file `<include>` tag `k` (of source `source`) names; the index of
+    /// its `<mujoco>`, or why it is refused.
+    fn include(&mut self, k: usize, source: usize, stack: &mut Vec<std::path::PathBuf>) -> Result<usize, ModelError> {
+        let line = self.tags[k].line;
+        let fail = |message: String| robot_error(Some(line), ErrorKind::InvalidMjcf(message));
+        let Some(file) = self.tags[k].attr("file").map(str::to_string) else {
+            return Err(fail(
+                "<include> has no `file`; write <include file=\"NAME.xml\"/> with a path relative to the top-level \
+                 model file's folder"
+                    .into(),
+            ));
+        };
+        let what = format!("<include file=\"{file}\">");
+        let Some((dir, canonical_dir)) = self.top.clone() else {
+            return Err(robot_error(
+                Some(line),
+                ErrorKind::NotSupported(format!(
+                    "{what}: MJCF text read without its file has no folder to resolve the include against; \
+                     load the model from its file (load_mjcf)"
+                )),
+            ));
+        };
+        if !self.children[k].is_empty() {
+            return Err(fail(format!("{what} has child elements; an <include> must be empty")));
+        }
+        // The path, normalised, must stay inside the top-level file's folder.
+        let mut relative = std::path::PathBuf::new();
+        for part in Path::new(&file).components() {
+            use std::path::Component;
+            match part {
+                Component::Normal(p) => relative.push(p),
+                Component::CurDir => {}
+                Component::ParentDir => {
+                    if !relative.pop() {
+                        return Err(fail(format!(
+                            "{what} leads out of the top-level model file's folder; an included file must be in \
+                             that folder or below it, named by a relative path such as `common/materials.xml`"
+                        )));
+                    }
+                }
+                Component::RootDir | Component::Prefix(_) => {
+                    return Err(fail(format!(
+                        "{what} is an absolute path; name the included file by a path relative to the top-level \
+                         model file's folder, such as `common/materials.xml`"
+                    )))
+                }
+            }
+        }
+        if relative.as_os_str().is_empty() {
+            return Err(fail(format!(
+                "{what} names no file; name an XML file such as `common/materials.xml`"
+            )));
+        }
+        let path = dir.join(&relative);
+        let canonical =
+            std::fs::canonicalize(&path).map_err(|e| fail(format!("{what}: cannot read `{}`: {e}", path.display())))?;
+        if !canonical.starts_with(&canonical_dir) {
+            return Err(fail(format!(
+                "{what} leads (through a link) out of the top-level model file's folder; an included file must be \
+                 in that folder or below it"
+            )));
+        }
+        if stack.contains(&canonical) {
+            return Err(fail(format!(
+                "{what} includes a file that is including it (an include cycle); remove this <include>"
+            )));
+        }
+        if let Some(&(_, earlier)) = self.seen.iter().find(|(p, _)| *p == canonical) {
+            let at = self.sources[earlier]
+                .included_at
+                .map_or(0, |(s, l)| l - self.sources[s].base);
+            let by = self.sources[earlier].included_at.map_or(0, |(s, _)| s);
+            return Err(fail(format!(
+                "{what}: `{}` is already included (line {at} of `{}`); MuJoCo includes a file once: remove one \
+                 of the <include>s",
+                relative.display(),
+                self.sources[by].name
+            )));
+        }
+        if stack.len() > MAX_INCLUDE_DEPTH {
+            return Err(fail(format!(
+                "{what} is nested {} includes deep, more than the {MAX_INCLUDE_DEPTH} allowed; include the file \
+                 from a file nearer the top",
+                stack.len()
+            )));
+        }
+        let text = read_file(&path).map_err(|errors| {
+            let why = errors.first().map_or_else(String::new, |e| e.kind.to_string());
+            fail(format!("{what}: `{}`: {why}", relative.display()))
+        })?;
+        let base = self.sources.iter().map(|s| s.base + s.lines).max().unwrap_or(0);
+        let index = self.sources.len();
+        self.sources.push(Source {
+            name: relative.display().to_string(),
+            base,
+            lines: crate::xml::line_of(&text, text.len()),
+            included_at: Some((source, line)),
+        });
+        self.seen.push((canonical.clone(), index));
+        let tags = scan_mjcf(&text, base).map_err(|mut e| e.remove(0))?;
+        let root = tags
+            .iter()
+            .find(|t| t.parent.is_none())
+            .map_or(("", base + 1), |t| (t.name.as_str(), t.line));
+        if root.0 != "mujoco" {
+            return Err(robot_error(
+                Some(root.1),
+                ErrorKind::InvalidMjcf(format!(
+                    "the document element of an included file is <{}>, not <mujoco>; an included file holds its \
+                     elements in a <mujoco> element",
+                    root.0
+                )),
+            ));
+        }
+        stack.push(canonical);
+        let root = self.add(tags, index, stack);
+        stack.pop();
+        Ok(root)
+    }
+}
+
+/// Gives the errors and warnings in included files the line of the top-level
+/// file's `<include>` that brings them in, and says in the message which file and
+/// line they are about (free-text messages are prefixed; other kinds become
+/// [`ErrorKind::InvalidMjcf`] with the prefix and their text).
+fn relocate(sources: &[Source], errors: Vec<ModelError>) -> Vec<ModelError> {
+    let find = |line: usize| {
+        sources
+            .iter()
+            .position(|s| line > s.base && line <= s.base + s.lines.max(1))
+            .unwrap_or(0)
+    };
+    errors
+        .into_iter()
+        .map(|mut e| {
+            let Some(line) = e.line else { return e };
+            let mut s = find(line);
+            if s == 0 {
+                return e;
+            }
+            let mut place = format!("in `{}` line {}", sources[s].name, line - sources[s].base);
+            let mut top = line;
+            while let Some((by, at)) = sources[s].included_at {
+                if by != 0 {
+                    place.push_str(&format!(
+                        ", included from `{}` line {}",
+                        sources[by].name,
+                        at - sources[by].base
+                    ));
+                }
+                top = at;
+                s = by;
+            }
+            e.line = Some(top);
+            e.kind = match e.kind {
+                ErrorKind::NotSupported(m) => ErrorKind::NotSupported(format!("{place}: {m}")),
+                ErrorKind::Ignored(m) => ErrorKind::Ignored(format!("{place}: {m}")),
+                ErrorKind::InvalidMjcf(m) => ErrorKind::InvalidMjcf(format!("{place}: {m}")),
+                other => ErrorKind::InvalidMjcf(format!("{place}: {other}")),
+            };
+            e
+        })
+        .collect()
 }
 
 /// A `<default>` class: its parent class and the attributes it sets, by element
@@ -506,23 +827,29 @@ impl<'t> Reader<'t> {
 
     fn read_document(&mut self, root: usize) {
         let tags = self.tags;
-        for t in tags.iter().filter(|t| t.name == "include") {
-            let file = t.attr("file").unwrap_or_default();
-            self.error(
-                Element::Robot,
-                t.line,
-                ErrorKind::NotSupported(format!(
-                    "<include file=\"{file}\"> is not supported yet; paste the included file's elements in its place"
-                )),
-            );
-        }
         for c in self.children_named(root, "compiler") {
             self.read_compiler(&tags[c]);
         }
+        let mut gravity_on = true;
         for c in self.children_named(root, "option") {
             if let Some(g) = self.numbers(&tags[c], "gravity", 3, &Element::Robot) {
                 self.gravity = [g[0], g[1], g[2]];
             }
+            // `<flag gravity="disable">`: MuJoCo applies no gravity at all.
+            for f in self.children_named(c, "flag") {
+                match tags[f].attr("gravity") {
+                    Some("disable") => gravity_on = false,
+                    Some("enable") | None => {}
+                    Some(other) => self.error(
+                        Element::Robot,
+                        tags[f].line,
+                        ErrorKind::InvalidMjcf(format!("<flag gravity=\"{other}\"> is neither `enable` nor `disable`")),
+                    ),
+                }
+            }
+        }
+        if !gravity_on {
+            self.gravity = [0.0; 3];
         }
         self.classes.insert(
             "main".into(),
@@ -1715,14 +2042,20 @@ impl<'t> Reader<'t> {
             .cloned()
             .collect();
         for (name, line) in clashes {
-            self.error(
-                Element::Link(name.clone()),
-                line,
-                ErrorKind::InvalidMjcf(format!(
-                    "site `{name}` has the name of a body; sites become frames of the model, which share one \
-                     namespace with the bodies: rename the site"
+            // MuJoCo's sites and bodies have names of their own; here the site's frame
+            // would be a second link of that name: leave the frame out.
+            let site = |l: &Option<usize>| *l == Some(line);
+            self.links.retain(|l| !(l.name == name && site(&l.line)));
+            self.joints
+                .retain(|j| !(j.kind == DeclaredJointType::Fixed && j.child == name && site(&j.line)));
+            self.warnings.push(ModelError {
+                element: Element::Link(name.clone()),
+                line: Some(line),
+                kind: ErrorKind::Ignored(format!(
+                    "site `{name}` has the name of a body and is left out: sites become frames of the model, which \
+                     share one namespace with the bodies (MuJoCo's do not); rename the site to have its frame"
                 )),
-            );
+            });
         }
     }
 }

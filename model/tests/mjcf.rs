@@ -7,8 +7,10 @@
 //! the hand-written `armature.xml`, `geoms.xml`, `compiler.xml` and `ref.xml` give
 //! MuJoCo's `qM` as `M + diag(Ia)`, its site poses, its geom-derived and
 //! compiler-adjusted inertias and its dynamics with joint `ref` and several joints in
-//! one body (`scripts/make_mjcf_armature_fixtures.py`), and one test per refused
-//! construct checks the message names the element and its line.
+//! one body (`scripts/make_mjcf_armature_fixtures.py`), `<include>` splices files
+//! (each refusal named with the `<include>`'s line, errors in included files with
+//! theirs), and one test per refused construct checks the message names the element
+//! and its line.
 
 use dyngen_model::regressor::joint_torque_regressor;
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
@@ -370,7 +372,7 @@ fn bad_numbers_name_their_line() {
 }
 
 #[test]
-fn include_is_refused() {
+fn include_in_text_is_refused() {
     let text = "<mujoco model=\"t\">\n  <include file=\"arm.xml\"/>\n  <worldbody/>\n</mujoco>\n";
     let e = errors(text);
     assert_eq!(
@@ -380,8 +382,237 @@ fn include_is_refused() {
     );
     assert!(
         e.to_string()
-            .contains("line 2: robot: <include file=\"arm.xml\"> is not supported yet"),
+            .contains("line 2: robot: <include file=\"arm.xml\">: MJCF text read without its file")
+            && e.to_string().contains("load_mjcf"),
         "{e}"
+    );
+}
+
+/// A fresh folder under the temporary directory, named for the test and the process.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(format!("dyngen-mjcf-include-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+
+    fn write(&self, name: &str, text: &str) -> PathBuf {
+        let path = self.0.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const BODY_A: &str =
+    "<body name=\"a\"><joint name=\"ja\"/><inertial pos=\"0 0 0\" mass=\"1\" diaginertia=\"0.1 0.1 0.1\"/></body>";
+
+/// The refusal of `load_mjcf(top)`: its only error, on `line` of the top-level file,
+/// saying `says`.
+fn load_error(top: &std::path::Path, line: usize, says: &str) -> String {
+    let e = load_mjcf(top).expect_err("should be refused");
+    assert_eq!(e.errors.len(), 1, "{e}");
+    assert_eq!(e.errors[0].line, Some(line), "{e}");
+    let message = e.to_string();
+    assert!(message.contains(&format!("top.xml:{line}: ")), "{message}");
+    assert!(message.contains(says), "{message}");
+    message
+}
+
+#[test]
+fn include_is_replaced_by_the_included_files_elements() {
+    let dir = TempDir::new("splice");
+    // Paths relative to the top-level file's folder, nested includes too (MuJoCo's
+    // rule: `sub/b.xml` includes `c.xml` of the top folder, not `sub/c.xml`).
+    let top = dir.write(
+        "top.xml",
+        "<mujoco model=\"t\">\n<include file=\"sub/b.xml\"/>\n<worldbody>\n<include file=\"./arm.xml\"/>\n\
+         <body name=\"z\"><joint name=\"jz\"/><inertial pos=\"0 0 0\" mass=\"1\" diaginertia=\"1 1 1\"/></body>\n\
+         </worldbody>\n</mujoco>\n",
+    );
+    dir.write("sub/b.xml", "<mujoco>\n<include file=\"c.xml\"/>\n</mujoco>\n");
+    dir.write("sub/c.xml", "<mujoco><option gravity=\"0 0 -4\"/></mujoco>\n");
+    dir.write("c.xml", "<mujoco><option gravity=\"0 0 -3\"/></mujoco>\n");
+    dir.write(
+        "arm.xml",
+        &format!("<mujoco>\n{BODY_A}\n<body name=\"b\"><joint name=\"jb\"/>{INERTIAL}</body>\n</mujoco>\n"),
+    );
+    let model = load_mjcf(&top).unwrap();
+    assert_eq!(model.gravity, [0.0, 0.0, -3.0]);
+    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    // In place of the <include>, in order.
+    assert_eq!(names, ["ja", "jb", "jz"]);
+}
+
+#[test]
+fn errors_in_an_included_file_name_it_and_its_line() {
+    let dir = TempDir::new("inner");
+    let top = dir.write(
+        "top.xml",
+        "<mujoco model=\"t\">\n<worldbody>\n<include file=\"parts/arm.xml\"/>\n</worldbody>\n</mujoco>\n",
+    );
+    dir.write(
+        "parts/arm.xml",
+        "<mujoco>\n<body name=\"a\">\n<joint name=\"j\" damping=\"fast\"/>\n</body>\n</mujoco>\n",
+    );
+    let message = load_error(
+        &top,
+        3,
+        "in `parts/arm.xml` line 3: <joint damping=\"fast\"> is not a number",
+    );
+    assert!(message.contains("joint `j`"), "{message}");
+    // Nested: the chain of includes is named.
+    dir.write(
+        "parts/arm.xml",
+        "<mujoco>\n\n<include file=\"parts/hand.xml\"/>\n</mujoco>\n",
+    );
+    dir.write(
+        "parts/hand.xml",
+        "<mujoco>\n<body name=\"h\">\n<frame/>\n</body>\n</mujoco>\n",
+    );
+    load_error(
+        &top,
+        3,
+        "in `parts/hand.xml` line 3, included from `parts/arm.xml` line 3: <frame>",
+    );
+    // Not XML.
+    dir.write("parts/arm.xml", "<mujoco>\n<body>\n</mujoco>\n");
+    load_error(&top, 3, "in `parts/arm.xml` line 3: not valid XML");
+    // Warnings too.
+    dir.write("parts/arm.xml", &format!("<mujoco>\n{BODY_A}\n</mujoco>\n"));
+    let top2 = dir.write(
+        "top.xml",
+        "<mujoco model=\"t\">\n<worldbody>\n<include file=\"parts/arm.xml\"/>\n</worldbody>\n\
+         <include file=\"eq.xml\"/>\n</mujoco>\n",
+    );
+    dir.write(
+        "eq.xml",
+        "<mujoco>\n<equality>\n<joint joint1=\"ja\"/>\n</equality>\n</mujoco>\n",
+    );
+    let model = load_mjcf(&top2).unwrap();
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert_eq!(model.warnings[0].line, Some(5));
+    assert!(
+        model.warnings[0]
+            .to_string()
+            .contains("in `eq.xml` line 3: <equality> <joint>"),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn include_errors_name_the_include_and_what_is_valid() {
+    let dir = TempDir::new("errors");
+    let top_with = |include: &str| {
+        dir.write(
+            "top.xml",
+            &format!("<mujoco model=\"t\">\n<worldbody>\n{BODY_A}\n</worldbody>\n{include}\n</mujoco>\n"),
+        )
+    };
+    let top = top_with("<include/>");
+    load_error(&top, 5, "<include> has no `file`; write <include file=\"NAME.xml\"/>");
+    let top = top_with("<include file=\"missing.xml\"/>");
+    load_error(&top, 5, "<include file=\"missing.xml\">: cannot read");
+    let absolute = dir.write("abs.xml", "<mujoco/>");
+    let top = top_with(&format!("<include file=\"{}\"/>", absolute.display()));
+    load_error(
+        &top,
+        5,
+        "is an absolute path; name the included file by a path relative",
+    );
+    let top = top_with("<include file=\"sub/../../x.xml\"/>");
+    load_error(
+        &top,
+        5,
+        "<include file=\"sub/../../x.xml\"> leads out of the top-level model file's folder",
+    );
+    // `..` that stays inside is fine.
+    dir.write("inside.xml", "<mujoco><option gravity=\"0 0 -1\"/></mujoco>");
+    let top = top_with("<include file=\"sub/../inside.xml\"/>");
+    assert_eq!(load_mjcf(&top).unwrap().gravity, [0.0, 0.0, -1.0]);
+    // Children in the <include>.
+    let top = top_with("<include file=\"inside.xml\"><option/></include>");
+    load_error(
+        &top,
+        5,
+        "<include file=\"inside.xml\"> has child elements; an <include> must be empty",
+    );
+    // Root other than <mujoco>.
+    dir.write("robot.xml", "<robot name=\"r\"/>");
+    let top = top_with("<include file=\"robot.xml\"/>");
+    load_error(
+        &top,
+        5,
+        "in `robot.xml` line 1: the document element of an included file is <robot>, not <mujoco>",
+    );
+    // The same file twice, as MuJoCo refuses it.
+    let top = top_with("<include file=\"inside.xml\"/><include file=\"./inside.xml\"/>");
+    load_error(&top, 5, "`inside.xml` is already included (line 5 of `");
+    // A cycle.
+    dir.write("loop.xml", "<mujoco>\n<include file=\"top.xml\"/>\n</mujoco>");
+    let top = top_with("<include file=\"loop.xml\"/>");
+    load_error(
+        &top,
+        5,
+        "in `loop.xml` line 2: <include file=\"top.xml\"> includes a file that is including it",
+    );
+    dir.write("self.xml", "<mujoco>\n<include file=\"self.xml\"/>\n</mujoco>");
+    let top = top_with("<include file=\"self.xml\"/>");
+    load_error(
+        &top,
+        5,
+        "in `self.xml` line 2: <include file=\"self.xml\"> includes a file that is including it",
+    );
+    // Too deep: d0 includes d1 ... up to d9.
+    for k in 0..10 {
+        dir.write(
+            &format!("d{k}.xml"),
+            &format!("<mujoco>\n<include file=\"d{}.xml\"/>\n</mujoco>", k + 1),
+        );
+    }
+    dir.write("d10.xml", "<mujoco/>");
+    let top = top_with("<include file=\"d0.xml\"/>");
+    load_error(
+        &top,
+        5,
+        "<include file=\"d8.xml\"> is nested 9 includes deep, more than the 8 allowed",
+    );
+    // Too large.
+    let big = format!(
+        "<mujoco>{}</mujoco>",
+        " ".repeat(dyngen_model::urdf::MAX_FILE_BYTES as usize)
+    );
+    dir.write("big.xml", &big);
+    let top = top_with("<include file=\"big.xml\"/>");
+    load_error(&top, 5, "<include file=\"big.xml\">: `big.xml`: ");
+}
+
+#[test]
+fn empty_names_are_no_names() {
+    let text = mjcf(&[
+        "<body name=\"\"><joint name=\"\"/>",
+        INERTIAL,
+        "<body name=\"\"><joint name=\"\"/>",
+        INERTIAL,
+        "<site name=\"\"/></body></body>",
+    ]);
+    let model = parse_mjcf(&text).unwrap();
+    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(names, ["joint_0", "joint_1"]);
+    assert!(
+        model.frames.iter().all(|f| !f.name.is_empty()),
+        "{:?}",
+        model.frames.iter().map(|f| &f.name).collect::<Vec<_>>()
     );
 }
 
@@ -1416,22 +1647,32 @@ fn fullinertia_with_an_orientation_is_refused() {
     }
 }
 
+/// MuJoCo's sites and bodies have separate names (the control suite names sites after
+/// their bodies); dyngen's frames share the bodies' namespace: the site is left out
+/// with a warning.
 #[test]
-fn a_site_named_as_a_body_is_refused() {
+fn a_site_named_as_a_body_is_left_out_with_a_warning() {
     let text = mjcf(&[
         "<body name=\"a\">",
         INERTIAL,
         "<joint name=\"j\"/>",
-        "<body name=\"b\" pos=\"0 0 1\"><site name=\"a\"/></body>",
+        "<body name=\"b\" pos=\"0 0 1\"><site name=\"a\"/><site name=\"s\"/></body>",
         "</body>",
     ]);
-    only_error(
-        &text,
-        Element::Link("a".into()),
-        6,
-        "site `a` has the name of a body; sites become frames of the model, which share one namespace with the \
-         bodies: rename the site",
+    let model = parse_mjcf(&text).unwrap();
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let w = &model.warnings[0];
+    assert_eq!((&w.element, w.line), (&Element::Link("a".into()), Some(6)));
+    assert!(
+        w.to_string().contains(
+            "site `a` has the name of a body and is left out: sites become frames of the model, which share one \
+             namespace with the bodies (MuJoCo's do not); rename the site to have its frame"
+        ),
+        "{w}"
     );
+    let a = model.frames.iter().find(|f| f.name == "a").unwrap();
+    assert_eq!(a.placement.translation, [0.0; 3], "the body's frame, not the site's");
+    assert!(model.frames.iter().any(|f| f.name == "s"));
 }
 
 /// A site in a body with a joint `pos` and a rotation: its frame is in the link frame
@@ -1488,5 +1729,27 @@ fn mesh_geoms_of_a_body_welded_to_the_world_are_no_error() {
         Element::Link("base".into()),
         4,
         "<compiler settotalmass> counts the mass of body `base`, whose geoms' inertia is not computed here",
+    );
+}
+
+/// `<option><flag gravity="disable"/></option>` turns gravity off, as in MuJoCo (the
+/// control suite's finger and fish).
+#[test]
+fn a_gravity_flag_disables_gravity() {
+    let body = format!("<worldbody><body name=\"a\"><joint name=\"j\"/>{INERTIAL}</body></worldbody>");
+    let with = |option: &str| format!("<mujoco model=\"t\">\n{option}\n{body}\n</mujoco>\n");
+    let on = parse_mjcf(&with("<option gravity=\"0 0 -5\"><flag gravity=\"enable\"/></option>")).unwrap();
+    assert_eq!(on.gravity, [0.0, 0.0, -5.0]);
+    let off = parse_mjcf(&with(
+        "<option gravity=\"0 0 -5\"><flag contact=\"disable\" gravity=\"disable\"/></option>",
+    ))
+    .unwrap();
+    assert_eq!(off.gravity, [0.0; 3]);
+    let e = errors(&with("<option><flag gravity=\"off\"/></option>"));
+    assert_eq!(e.errors[0].line, Some(2), "{e}");
+    assert!(
+        e.to_string()
+            .contains("<flag gravity=\"off\"> is neither `enable` nor `disable`"),
+        "{e}"
     );
 }

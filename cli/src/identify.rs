@@ -8,7 +8,7 @@ use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::pipeline::{
     self, Estimator, Identification, IdentifyOptions, JointTerms, PipelineError, Prediction,
 };
-use dyngen_identify::report::{self, MergedLinks};
+use dyngen_identify::report::{self, DataSpan, MergedLinks};
 use dyngen_identify::{Accumulation, Estimate};
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::Model;
@@ -169,6 +169,18 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "CSV")]
     pub validate: Option<PathBuf>,
 
+    /// With --validate: use only the validation recording's samples with
+    /// t0 ≤ t ≤ t1 (s). The training --window (or the recipe's window and rows) is
+    /// never applied to the validation recording: without this flag all of it is used.
+    #[arg(long, value_name = "T0:T1", allow_hyphen_values = true, requires = "validate")]
+    pub validate_window: Option<String>,
+
+    /// With --validate: read the validation recording through this recipe file
+    /// instead of the training one (whose window and rows are dropped in any case;
+    /// the recipe flags such as --degrees do not apply to it either).
+    #[arg(long, value_name = "FILE", requires = "validate")]
+    pub validate_recipe: Option<PathBuf>,
+
     /// Ridge: weight of the pull toward the nominal parameters, dimensionless (the
     /// penalty is λ·Σ ‖column j‖²·(x_j − x0_j)², so units do not matter), 0 to 1e12.
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true, value_parser = crate::ranges::LAMBDA)]
@@ -219,9 +231,10 @@ pub struct IdentifyArgs {
 pub struct RecordingArgs {
     /// Low-pass cutoff, Hz (zero phase): velocities and accelerations the file does
     /// not have are estimated through it, and the measured positions and velocities
-    /// are filtered by it too (see --raw-states). 0 < Hz ≤ 1e6.
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = crate::ranges::CUTOFF)]
-    pub cutoff: f64,
+    /// are filtered by it too (see --raw-states). 0 < Hz ≤ 1e6; default 10 (`validate`:
+    /// the cutoff recorded in the parameters file).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::ranges::CUTOFF)]
+    pub cutoff: Option<f64>,
 
     /// Use the measured positions and velocities as read, without the low-pass
     /// filter (only estimated derivatives are filtered).
@@ -235,10 +248,13 @@ pub struct RecordingArgs {
     pub recipe: RecipeArgs,
 }
 
+/// The cutoff when --cutoff is not given (and no parameters file records one).
+pub const DEFAULT_CUTOFF_HZ: f64 = 10.0;
+
 impl RecordingArgs {
-    /// Loads `path` as these flags say (see [`load_recording`]).
-    pub fn load(&self, path: &Path, dof: usize) -> Result<Trajectory> {
-        load_recording(path, &self.recipe, dof, self.cutoff, !self.raw_states)
+    /// --cutoff, or its default.
+    pub fn cutoff(&self) -> f64 {
+        self.cutoff.unwrap_or(DEFAULT_CUTOFF_HZ)
     }
 }
 
@@ -291,21 +307,18 @@ pub struct RecipeArgs {
 impl RecipeArgs {
     /// The recipe: the file's (or the default), then the flags.
     pub fn recipe(&self) -> Result<Recipe> {
-        let mut recipe = match &self.recipe {
-            Some(path) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,
-            None => Recipe::default(),
+        self.recipe_over(None)
+    }
+
+    /// The recipe: the --recipe file's, else `stored` (a parameters file's), else
+    /// the default; then the flags.
+    pub fn recipe_over(&self, stored: Option<Recipe>) -> Result<Recipe> {
+        let mut recipe = match (&self.recipe, stored) {
+            (Some(path), _) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,
+            (None, Some(stored)) => stored,
+            (None, None) => Recipe::default(),
         };
-        let flags = [
-            ("--no-header", "header", self.no_header.then_some("false")),
-            ("--delimiter", "delimiter", self.delimiter.as_deref()),
-            ("--degrees", "units", self.degrees.then_some("deg")),
-            ("--gains", "gains", self.gains.as_deref()),
-            ("--resample", "resample", self.resample.as_deref()),
-            ("--window", "window", self.window.as_deref()),
-            ("--decimate", "decimate", self.decimate.as_deref()),
-            ("--drop-stale", "stale", self.drop_stale.then_some("drop")),
-        ];
-        for (flag, key, value) in flags {
+        for (flag, key, value) in self.flags() {
             if let Some(value) = value {
                 recipe
                     .set(key, value)
@@ -315,13 +328,35 @@ impl RecipeArgs {
         recipe.check().map_err(|e| CliError::Input(format!("recipe: {e}")))?;
         Ok(recipe)
     }
+
+    /// The recipe flags given (not --recipe itself).
+    pub fn flags_given(&self) -> Vec<&'static str> {
+        self.flags()
+            .into_iter()
+            .filter_map(|(flag, _, value)| value.map(|_| flag))
+            .collect()
+    }
+
+    /// Each recipe flag, the recipe key it sets, and its value when given.
+    fn flags(&self) -> [(&'static str, &'static str, Option<&str>); 8] {
+        [
+            ("--no-header", "header", self.no_header.then_some("false")),
+            ("--delimiter", "delimiter", self.delimiter.as_deref()),
+            ("--degrees", "units", self.degrees.then_some("deg")),
+            ("--gains", "gains", self.gains.as_deref()),
+            ("--resample", "resample", self.resample.as_deref()),
+            ("--window", "window", self.window.as_deref()),
+            ("--decimate", "decimate", self.decimate.as_deref()),
+            ("--drop-stale", "stale", self.drop_stale.then_some("drop")),
+        ]
+    }
 }
 
-/// Reads a recording through the recipe the flags describe, estimates what it does
-/// not measure, and prints what was done.
+/// Reads a recording through `recipe`, estimates what it does not measure, and
+/// prints what was done.
 pub fn load_recording(
     path: &Path,
-    recipe: &RecipeArgs,
+    recipe: &Recipe,
     dof: usize,
     cutoff: f64,
     low_pass_states: bool,
@@ -331,9 +366,55 @@ pub fn load_recording(
         low_pass_states,
         ..IdentifyOptions::default()
     };
-    let loaded = pipeline::load(path, &recipe.recipe()?, dof, &options).map_err(|e| pipeline_error(path, e))?;
+    let loaded = pipeline::load(path, recipe, dof, &options).map_err(|e| pipeline_error(path, e))?;
     outln!("{}: {}", path.display(), loaded.report);
     Ok(loaded.trajectory)
+}
+
+/// `recipe` without its time and row windows.
+pub fn without_window(recipe: &Recipe) -> Recipe {
+    Recipe {
+        window: None,
+        rows: None,
+        ..recipe.clone()
+    }
+}
+
+/// Only the time and row windows of `recipe`, as recipe lines (`window = 5:65`);
+/// `None` when it has neither.
+pub fn window_lines(recipe: &Recipe) -> Option<String> {
+    let windows = Recipe {
+        window: recipe.window,
+        rows: recipe.rows,
+        ..Recipe::default()
+    };
+    let text = windows.to_text();
+    (!text.is_empty()).then(|| text.trim_end().replace('\n', "; "))
+}
+
+/// Which samples of `path` `traj` holds.
+pub fn data_span(path: &Path, traj: &Trajectory) -> DataSpan {
+    let last = traj.len().saturating_sub(1);
+    DataSpan {
+        file: path.display().to_string(),
+        samples: traj.len(),
+        first: traj.location(0).to_string(),
+        last: traj.location(last).to_string(),
+        t_first: traj.t().first().copied(),
+        t_last: traj.t().last().copied(),
+    }
+}
+
+/// `1000 samples of run.csv, line 2 to line 1001 (t = 0 … 9.99 s)`.
+pub fn describe_span(span: &DataSpan) -> String {
+    let times = match (span.t_first, span.t_last) {
+        (Some(a), Some(b)) => format!(" (t = {a} … {b} s)"),
+        _ => String::new(),
+    };
+    format!(
+        "{} samples of {}, {} to {}{times}",
+        span.samples, span.file, span.first, span.last
+    )
 }
 
 /// A pipeline error as a command-line error; `data` names the recording.
@@ -391,7 +472,7 @@ impl IdentifyArgs {
                 Friction::StribeckSmooth => JointTerms::Stribeck(Coulomb::Smooth { epsilon: self.epsilon }),
             },
             exclude_below: self.exclude_below,
-            cutoff_hz: self.recording.cutoff,
+            cutoff_hz: self.recording.cutoff(),
             low_pass_states: !self.recording.raw_states,
             model_is_truth: self.truth_from_urdf,
             ..IdentifyOptions::default()
@@ -415,16 +496,64 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
     let n = model.dof();
-    let traj = args.recording.load(&args.data, n)?;
+    let recipe = args.recording.recipe.recipe()?;
+    // The validation recording's recipe, checked before any work.
+    let validation_recipe = match &args.validate_recipe {
+        Some(path) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,
+        None => without_window(&recipe),
+    };
+    let validation_recipe = match &args.validate_window {
+        Some(window) => {
+            let mut r = validation_recipe;
+            r.set("window", window)
+                .map_err(|e| CliError::usage(format!("--validate-window: {e}")))?;
+            r
+        }
+        None => validation_recipe,
+    };
+    validation_recipe
+        .check()
+        .map_err(|e| CliError::Input(format!("validation recipe: {e}")))?;
+    let cutoff = args.recording.cutoff();
+    let low_pass_states = !args.recording.raw_states;
+    let traj = load_recording(&args.data, &recipe, n, cutoff, low_pass_states)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
         return Err(pipeline_error(&args.data, PipelineError::MissingWrenches { dof: n }));
     }
     outln!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
+    let training = data_span(&args.data, &traj);
+    if args.validate.is_some() {
+        outln!("training: {}", describe_span(&training));
+    }
     let robot = Reference::new(&model);
     let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
         .map_err(|e| pipeline_error(&args.data, e))?;
     for w in &identified.warnings {
         eprintln!("warning: {w}");
+    }
+    let mut identified = identified;
+    if let Some(prediction) = identified.report.prediction.as_mut() {
+        if let Some(pre) = prediction.preprocessing.as_mut() {
+            pre.recipe = Some(without_window(&recipe).to_text());
+            pre.window = window_lines(&recipe);
+            pre.data = Some(training.clone());
+            pre.gravity = args.recording.gravity.get()?;
+        }
+    }
+    let identified = identified;
+    if args.friction == Friction::Auto {
+        if let Some(epsilon) = identified
+            .report
+            .prediction
+            .as_ref()
+            .and_then(|p| p.preprocessing.as_ref())
+            .and_then(|p| p.coulomb_epsilon)
+        {
+            outln!(
+                "--friction auto: Coulomb smoothing tanh(q̇/ε) with ε = {epsilon:.4e} rad/s (m/s for prismatic \
+                 joints), one ε for all joints, chosen by the fit residual"
+            );
+        }
     }
     if let Some(speed) = args.exclude_below {
         let total: usize = identified.excluded_rows.iter().sum();
@@ -440,6 +569,17 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         (Prediction::Regressor(torque), None) => {
             let names: Vec<&str> = torque.names.iter().map(String::as_str).collect();
             outln!("{}", torque.estimate.table(&names));
+            if let Some(prediction) = &identified.report.prediction {
+                for p in &prediction.nonphysical {
+                    outln!(
+                        "non-physical: {} = {:.4e} (joint `{}`): {}",
+                        p.parameter,
+                        p.value,
+                        p.joint,
+                        p.reason
+                    );
+                }
+            }
             print_fit(&torque.estimate)?;
             if let Some(fit) = &identified.stribeck {
                 out!("{fit}");
@@ -468,13 +608,30 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         write_urdf(args, path, &model, &identified)?;
     }
     if let Some(path) = &args.validate {
-        let other = args.recording.load(path, n)?;
+        let other = load_recording(path, &validation_recipe, n, cutoff, low_pass_states)?;
+        let how = match (&args.validate_recipe, &args.validate_window) {
+            (Some(r), _) => format!("read through --validate-recipe {}", r.display()),
+            (None, _) => "read through the training recipe".to_string(),
+        };
+        let window = match (&args.validate_window, window_lines(&recipe)) {
+            (Some(w), _) => format!("--validate-window {w}"),
+            (None, Some(training)) => format!("all of it: the training window ({training}) is not applied to it"),
+            (None, None) => "all of it".to_string(),
+        };
+        outln!(
+            "validation: {} ({how}; {window})",
+            describe_span(&data_span(path, &other))
+        );
         let predicted = with_spinner(progress, "predicting the validation recording", || {
             identified.predict(&robot, &other)
         })
         .map_err(|e| pipeline_error(path, e))?;
         let validation = crate::validate::validation(&model, &other, &predicted, None)?;
-        outln!("prediction of {}:\n{validation}", path.display());
+        outln!(
+            "prediction of {}:\n{validation}\n{}",
+            path.display(),
+            crate::validate::exact_overall(&validation)
+        );
     }
     Ok(())
 }

@@ -139,7 +139,7 @@ fn read_data(path: &Path, model: &Model, cutoff: f64, recipe: Option<&Path>) -> 
         recipe: recipe.map(Path::to_path_buf),
         ..Default::default()
     };
-    crate::identify::load_recording(path, &recipe, model.dof(), cutoff, true)
+    crate::identify::load_recording(path, &recipe.recipe()?, model.dof(), cutoff, true)
 }
 
 /// A NIM error about the file `path`: reading it is input, writing it output.

@@ -2,10 +2,10 @@
 //! (the JSON `identify --params-json` writes) and reports the errors per joint and
 //! overall, optionally as an SVG of measured against predicted torque.
 
-use crate::common::{check_overwrite, load_moving_model, outln, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, outln, ModelArgs, Progress, Result};
 use crate::error::CliError;
-use crate::identify::{pipeline_error, RecordingArgs};
-use dyngen_identify::data::Trajectory;
+use crate::identify::{load_recording, pipeline_error, RecordingArgs, DEFAULT_CUTOFF_HZ};
+use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::pipeline;
 use dyngen_identify::report::{self, ParameterReport};
 use dyngen_identify::validate::Validation;
@@ -20,7 +20,9 @@ Examples:
 
 The parameters must come from --mode standard or principal (they predict through
 the regressor and its full solution vector, which the JSON holds); the recording is
-read as `identify` reads it (same recipe flags). Relative errors are
+read as the parameters file records it was identified from (cutoff, recipe without
+the training window, gravity: printed as `preprocessing from FILE: …`); a flag given
+here overrides the recorded choice, and says so. Relative errors are
 ‖τ̂ − τ‖ / ‖τ‖ per joint and over all joints; a joint at or above 100 % is predicted no
 better than by zero torque.";
 
@@ -86,6 +88,11 @@ pub fn validation(
     Ok(v)
 }
 
+/// The overall relative error to full precision, for comparing two runs exactly.
+pub fn exact_overall(v: &Validation) -> String {
+    format!("(as a fraction, full precision: {:?})", v.overall)
+}
+
 /// Refuses parameters identified for another robot: their joints (the residual
 /// channels of the JSON) must be the robot's, in order.
 fn check_joints(params: &ParameterReport, model: &Model, path: &Path) -> Result<()> {
@@ -142,12 +149,114 @@ fn read_params(path: &Path) -> Result<ParameterReport> {
 /// Largest parameters JSON read: a few kB in practice.
 const MAX_PARAMS_BYTES: u64 = 1 << 28;
 
+/// How to read and filter the recording: the parameters file's preprocessing, each
+/// choice overridden by a flag given on the command line; prints which applies.
+struct Reading {
+    recipe: Recipe,
+    cutoff: f64,
+    low_pass_states: bool,
+    gravity: ModelArgs,
+}
+
+fn reading(args: &ValidateArgs, params: &ParameterReport) -> Result<Reading> {
+    let file = args.params.display().to_string();
+    let flags = &args.recording;
+    let pre = params.prediction.as_ref().and_then(|p| p.preprocessing.as_ref());
+    let mut said = Vec::new();
+    let mut overrides = Vec::new();
+    let stored_recipe = match pre.and_then(|p| p.recipe.as_deref()) {
+        Some(text) => Some(Recipe::parse(text).map_err(|e| CliError::input(&args.params, format!("its recipe: {e}")))?),
+        None => None,
+    };
+    match (pre.and_then(|p| p.cutoff_hz), flags.cutoff) {
+        (Some(c), None) => said.push(format!("cutoff {c} Hz")),
+        (Some(c), Some(f)) if c != f => overrides.push(format!("--cutoff {f} Hz instead of its {c} Hz")),
+        _ => {}
+    }
+    let stored_low_pass = pre.and_then(|p| p.low_pass_states);
+    match (stored_low_pass, flags.raw_states) {
+        (Some(true), true) => overrides.push("--raw-states instead of its low-passed positions and velocities".into()),
+        (Some(true), false) => said.push("positions and velocities low-passed".into()),
+        (Some(false), _) => said.push("positions and velocities as read (raw)".into()),
+        (None, _) => {}
+    }
+    if let Some(text) = pre.and_then(|p| p.recipe.as_deref()) {
+        let lines = text.trim_end().replace('\n', "; ");
+        let lines = if lines.is_empty() {
+            "the default CSV schema".to_string()
+        } else {
+            lines
+        };
+        match &flags.recipe.recipe {
+            Some(path) => overrides.push(format!("--recipe {} instead of its recipe ({lines})", path.display())),
+            None => said.push(format!("recipe: {lines}")),
+        }
+    }
+    let given = flags.recipe.flags_given();
+    if pre.is_some() && !given.is_empty() {
+        overrides.push(format!("{} on top of the recipe", given.join(", ")));
+    }
+    if let Some(window) = pre.and_then(|p| p.window.as_deref()) {
+        said.push(format!("its training window ({window}) not applied"));
+    }
+    if let Some(f) = pre.and_then(|p| p.friction.as_deref()) {
+        let epsilon = match (pre.and_then(|p| p.coulomb_epsilon), pre.and_then(|p| p.epsilon_auto)) {
+            (Some(e), Some(true)) => format!(" (ε = {e:e} chosen by the fit)"),
+            (Some(e), _) => format!(" (ε = {e:e})"),
+            _ => String::new(),
+        };
+        said.push(format!("friction {f}{epsilon}"));
+    }
+    let mut gravity = flags.gravity.clone();
+    match (pre.and_then(|p| p.gravity), &flags.gravity.gravity) {
+        (Some(g), None) => {
+            said.push(format!("gravity {} {} {}", g[0], g[1], g[2]));
+            gravity.gravity = Some(g.to_vec());
+        }
+        (Some(g), Some(f)) if f[..] != g[..] => overrides.push(format!(
+            "--gravity {} instead of its {} {} {}",
+            f.iter().map(f64::to_string).collect::<Vec<_>>().join(" "),
+            g[0],
+            g[1],
+            g[2]
+        )),
+        _ => {}
+    }
+    match pre {
+        Some(_) => outln!("preprocessing from {file}: {}", said.join(", ")),
+        None => outln!(
+            "note: {file} records no preprocessing (written by an older dyngen): reading the recording with the \
+             defaults and the flags given (cutoff {} Hz{})",
+            flags.cutoff(),
+            if flags.raw_states {
+                ", raw states"
+            } else {
+                ", positions and velocities low-passed"
+            }
+        ),
+    }
+    if !overrides.is_empty() {
+        outln!("overriding {file} from the command line: {}", overrides.join("; "));
+    }
+    Ok(Reading {
+        recipe: flags.recipe.recipe_over(stored_recipe)?,
+        cutoff: flags
+            .cutoff
+            .or(pre.and_then(|p| p.cutoff_hz))
+            .unwrap_or(DEFAULT_CUTOFF_HZ),
+        low_pass_states: !flags.raw_states && stored_low_pass.unwrap_or(true),
+        gravity,
+    })
+}
+
 pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     if let Some(svg) = &args.svg {
         check_overwrite(svg, args.force)?;
     }
-    let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
+    // Read first: its recorded preprocessing (gravity among it) says how to load the rest.
     let params = read_params(&args.params)?;
+    let reading = reading(args, &params)?;
+    let model = load_moving_model(&args.urdf, &reading.gravity)?;
     let prediction = params.prediction.as_ref().ok_or_else(|| {
         CliError::input(
             &args.params,
@@ -163,14 +272,20 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
             model.name
         );
     }
-    let data = args.recording.load(&args.data, model.dof())?;
+    let data = load_recording(
+        &args.data,
+        &reading.recipe,
+        model.dof(),
+        reading.cutoff,
+        reading.low_pass_states,
+    )?;
     let robot = Reference::new(&model);
     let predicted = pipeline::predict_with(prediction, &robot, &data).map_err(|e| match e {
         pipeline::PipelineError::InvalidOption { reason, .. } => CliError::input(&args.params, reason),
         e => pipeline_error(&args.data, e),
     })?;
     let validation = validation(&model, &data, &predicted, Some(&args.params))?;
-    outln!("{validation}");
+    outln!("{validation}\n{}", exact_overall(&validation));
     if let Some(path) = &args.svg {
         let measured: Vec<Vec<f64>> = (0..data.len()).map(|k| data.tau(k).to_vec()).collect();
         let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();

@@ -25,7 +25,8 @@
 use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
 use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
 use crate::report::{
-    self, CoulombReport, MergedLinks, ParamStatus, ParameterReport, Parameterisation, PredictionModel, ReportError,
+    self, CoulombReport, MergedLinks, NonPhysical, ParamStatus, ParameterReport, Parameterisation, PredictionModel,
+    Preprocessing, ReportError,
 };
 use crate::simulate::Recording;
 use crate::stribeck::StribeckFit;
@@ -370,6 +371,7 @@ fn from_torques(
     let model = dynamics.model();
     let n = dynamics.nv();
     let principal = options.mode == Mode::Principal;
+    let mut chosen_epsilon = None;
     let regressor = match (principal, options.joints) {
         (true, _) => TorqueRegressor::Principal,
         (false, JointTerms::None) => TorqueRegressor::Standard,
@@ -392,6 +394,7 @@ fn from_torques(
             if let Some(e) = failure {
                 return Err(e);
             }
+            chosen_epsilon = Some(epsilon);
             TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon })
         }
     };
@@ -485,11 +488,60 @@ fn from_torques(
         _ => (Parameterisation::Standard, None),
     };
     let mut report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
+    let nonphysical = match regressor {
+        TorqueRegressor::StandardAndJoints(_) => {
+            let values: Vec<Option<f64>> = report.parameters[10 * n..10 * n + PER_JOINT * n]
+                .iter()
+                .map(|p| match p.status {
+                    // Not told apart from zero (or from the prior): not reported as identified.
+                    ParamStatus::NotSignificant | ParamStatus::FromPrior => None,
+                    _ => p.value,
+                })
+                .collect();
+            nonphysical_joint_terms(&values, &joint_names)
+        }
+        _ => Vec::new(),
+    };
+    if !nonphysical.is_empty() {
+        let list: Vec<String> = nonphysical
+            .iter()
+            .map(|p| format!("{} = {:.4e} (`{}`)", p.parameter, p.value, p.joint))
+            .collect();
+        let remedy = if options.estimator == Estimator::Consistent {
+            "--method consistent was used, which keeps Ia, Fv and Fc >= 0 only to its numerical tolerance: \
+             treat these as zero"
+        } else {
+            "--method consistent keeps every joint's Ia, Fv and Fc >= 0 (and every body physical): try it"
+        };
+        warnings.push(format!(
+            "non-physical joint parameters reported: {} (a negative rotor inertia, viscous or Coulomb friction is \
+             not physical); {remedy}",
+            list.join("; ")
+        ));
+    }
+    let (coulomb_epsilon, friction) = match options.joints {
+        JointTerms::None => (None, "none"),
+        JointTerms::Friction(Coulomb::Sign) => (None, "sign"),
+        JointTerms::Friction(Coulomb::Smooth { epsilon }) => (Some(epsilon), "smooth"),
+        JointTerms::FrictionAuto => (chosen_epsilon, "auto"),
+        JointTerms::Stribeck(Coulomb::Sign) => (None, "stribeck"),
+        JointTerms::Stribeck(Coulomb::Smooth { epsilon }) => (Some(epsilon), "stribeck_smooth"),
+    };
     report.prediction = Some(PredictionModel {
         regressor: parameterisation,
         coulomb,
         solution: estimate.solution.clone(),
         stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
+        preprocessing: Some(Preprocessing {
+            cutoff_hz: Some(options.cutoff_hz),
+            low_pass_states: Some(options.low_pass_states),
+            friction: Some(friction.to_string()),
+            coulomb_epsilon,
+            epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
+            exclude_below: options.exclude_below,
+            ..Preprocessing::default()
+        }),
+        nonphysical,
     });
     if let Some(fit) = &stribeck {
         report.parameters.extend(fit.param_reports());
@@ -508,6 +560,35 @@ fn from_torques(
         excluded_rows,
         stribeck,
     })
+}
+
+/// The joint parameters among `values` (per joint `[Ia, Fv, Fc, F0]`, `None` where
+/// no value is reported) that are not physical: a negative rotor inertia `Ia`,
+/// viscous friction `Fv` or Coulomb friction `Fc` (the offset `F0` may have either
+/// sign). `joints` names the joints (missing names become `joint <j>`).
+pub fn nonphysical_joint_terms(values: &[Option<f64>], joints: &[&str]) -> Vec<NonPhysical> {
+    const WHAT: [&str; 3] = [
+        "a negative rotor inertia",
+        "a negative viscous friction",
+        "a negative Coulomb friction",
+    ];
+    values
+        .chunks(PER_JOINT)
+        .enumerate()
+        .flat_map(|(j, terms)| {
+            terms.iter().take(3).enumerate().filter_map(move |(k, v)| {
+                let v = (*v)?;
+                (v < 0.0).then(|| NonPhysical {
+                    joint: joints
+                        .get(j)
+                        .map_or_else(|| format!("joint {}", j + 1), |s| s.to_string()),
+                    parameter: dyngen_model::names::param_name(dyngen_model::joint_params::NAMES[k], j + 1),
+                    value: v,
+                    reason: format!("{} is not physical", WHAT[k]),
+                })
+            })
+        })
+        .collect()
 }
 
 /// The input of `traj` of largest magnitude: its value, where it is and what it is.
@@ -1075,6 +1156,38 @@ mod tests {
         assert_eq!(id.report.parameters.len(), 4 * model.dof());
         assert_eq!(id.report.parameters[1].name, "J1_1");
         assert_eq!(id.per_body(), 4);
+    }
+
+    #[test]
+    fn non_physical_joint_terms_are_named() {
+        // Per joint [Ia, Fv, Fc, F0]: joint 1 physical (F0 < 0 is fine), joint 2 with
+        // a negative Fv, joint 3 with every term negative but Fc unreported.
+        let values = [
+            Some(0.1),
+            Some(2.0),
+            Some(0.0),
+            Some(-3.0),
+            Some(0.2),
+            Some(-1e-3),
+            Some(4.0),
+            Some(1.0),
+            Some(-0.5),
+            Some(-2.0),
+            None,
+            Some(-1.0),
+        ];
+        let flagged = nonphysical_joint_terms(&values, &["a", "b"]);
+        let got: Vec<(&str, &str, f64)> = flagged
+            .iter()
+            .map(|p| (p.joint.as_str(), p.parameter.as_str(), p.value))
+            .collect();
+        assert_eq!(
+            got,
+            [("b", "Fv2", -1e-3), ("joint 3", "Ia3", -0.5), ("joint 3", "Fv3", -2.0)]
+        );
+        assert!(flagged[0].reason.contains("viscous"), "{:?}", flagged[0]);
+        assert!(flagged[1].reason.contains("rotor inertia"), "{:?}", flagged[1]);
+        assert!(nonphysical_joint_terms(&[Some(0.0); 8], &[]).is_empty());
     }
 
     #[test]

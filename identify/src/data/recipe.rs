@@ -479,6 +479,110 @@ impl Recipe {
         Ok(recipe)
     }
 
+    /// The recipe as `key = value` lines that [`Recipe::parse`] reads back to the
+    /// same recipe; only the keys that differ from [`Recipe::default`] are written
+    /// (the default recipe is the empty text). Header names holding `,` or `#`
+    /// cannot be written as recipe lines and come back differently.
+    pub fn to_text(&self) -> String {
+        let d = Recipe::default();
+        let mut lines: Vec<String> = Vec::new();
+        let mut put = |key: &str, value: String| lines.push(format!("{key} = {value}"));
+        let columns = |c: &[ColumnRef]| {
+            c.iter()
+                .map(|c| match c {
+                    ColumnRef::Index(i) => i.to_string(),
+                    ColumnRef::Name(n) => n.clone(),
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let bound = |x: Option<String>| x.unwrap_or_default();
+        if self.delimiter != d.delimiter {
+            put("delimiter", self.delimiter.name().into());
+        }
+        if self.header != d.header {
+            put("header", self.header.to_string());
+        }
+        if self.skip != d.skip {
+            put("skip", self.skip.to_string());
+        }
+        if let Some(t) = &self.columns.time {
+            put("time", columns(std::slice::from_ref(t)));
+        }
+        for (key, c) in [
+            ("q", &self.columns.q),
+            ("v", &self.columns.v),
+            ("a", &self.columns.a),
+            ("tau", &self.columns.tau),
+        ] {
+            if let Some(c) = c {
+                put(key, columns(c));
+            }
+        }
+        if self.time_unit != d.time_unit {
+            let unit = match self.time_unit {
+                TimeUnit::Seconds => "s",
+                TimeUnit::Milliseconds => "ms",
+                TimeUnit::Microseconds => "us",
+                TimeUnit::Nanoseconds => "ns",
+            };
+            put("time_unit", unit.into());
+        }
+        if self.time_origin != d.time_origin {
+            put("time_origin", "first".into());
+        }
+        if !self.units.is_empty() {
+            let units: Vec<&str> = self
+                .units
+                .iter()
+                .map(|u| match u {
+                    JointUnit::Rad => "rad",
+                    JointUnit::Deg => "deg",
+                    JointUnit::M => "m",
+                    JointUnit::Mm => "mm",
+                })
+                .collect();
+            put("units", units.join(", "));
+        }
+        if let Some(gains) = &self.gains {
+            put("gains", gains.iter().map(f64::to_string).collect::<Vec<_>>().join(", "));
+        }
+        if !self.signs.is_empty() {
+            let signs: Vec<&str> = self.signs.iter().map(|s| if *s < 0.0 { "-1" } else { "1" }).collect();
+            put("sign", signs.join(", "));
+        }
+        if let Some(w) = &self.window {
+            put(
+                "window",
+                format!(
+                    "{}:{}",
+                    bound(w.start.map(|x| x.to_string())),
+                    bound(w.end.map(|x| x.to_string()))
+                ),
+            );
+        }
+        if let Some(r) = &self.rows {
+            put(
+                "rows",
+                format!(
+                    "{}:{}",
+                    bound(r.first.map(|x| x.to_string())),
+                    bound(r.last.map(|x| x.to_string()))
+                ),
+            );
+        }
+        if self.decimate != d.decimate {
+            put("decimate", self.decimate.to_string());
+        }
+        if let Sampling::Resample(dt) = self.sampling {
+            put("resample", dt.to_string());
+        }
+        if self.stale != d.stale {
+            put("stale", "drop".into());
+        }
+        lines.iter().map(|l| format!("{l}\n")).collect()
+    }
+
     /// Sets one key as a recipe line `key = value` would (a later setting replaces
     /// an earlier one): how command-line flags override a recipe file.
     pub fn set(&mut self, key: &str, value: &str) -> Result<(), RecipeError> {
@@ -673,6 +777,22 @@ mod tests {
 
     fn err(text: &str) -> String {
         Recipe::parse(text).expect_err("an error").to_string()
+    }
+
+    #[test]
+    fn to_text_reads_back_to_the_same_recipe() {
+        assert_eq!(Recipe::default().to_text(), "");
+        for text in [
+            "delimiter = tab\nheader = false\nskip = 2\ntime = 1\nq = 2-3, 5\nv = 6,7,8\na = 9-11\n\
+             tau = t1, t2, t3\ntime_unit = µs\ntime_origin = first\nunits = deg, rad, mm\ngains = 0.1, 0.2, 1e-7\n\
+             sign = 1, -1, +1\nwindow = -1.5:\nrows = :100\ndecimate = 3\nresample = 0.001\nstale = drop\n",
+            "window = :7.25\nrows = 4:\nunits = deg\n",
+            "time_unit = ms\nq = q_a, q_b\ntau = 8-9\n",
+        ] {
+            let recipe = Recipe::parse(text).unwrap();
+            let written = recipe.to_text();
+            assert_eq!(Recipe::parse(&written).unwrap(), recipe, "{written}");
+        }
     }
 
     #[test]

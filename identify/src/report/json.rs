@@ -96,6 +96,71 @@ pub struct PredictionModel {
     /// solution ([`crate::stribeck`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stribeck: Option<Vec<crate::stribeck::Stribeck>>,
+    /// How the recording was read and filtered before the fit; `dyngen validate`
+    /// reads a recording to predict the same way. Absent in files from before it
+    /// was recorded (the defaults then apply).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preprocessing: Option<Preprocessing>,
+    /// Joint parameters whose reported value is not physical (negative rotor
+    /// inertia, viscous or Coulomb friction).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub nonphysical: Vec<NonPhysical>,
+}
+
+/// Every preprocessing choice of an identification: what a tool needs to read and
+/// filter another recording as this one was. Every field may be missing (its
+/// default then); unknown fields are ignored, so later versions may add some.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Preprocessing {
+    /// Zero-phase low-pass cutoff (Hz) of the estimated derivatives.
+    pub cutoff_hz: Option<f64>,
+    /// Measured positions and velocities low-passed at the cutoff too.
+    pub low_pass_states: Option<bool>,
+    /// The recipe the recording was read through, as `key = value` lines, without
+    /// its time and row windows (empty: dyngen's own CSV schema).
+    pub recipe: Option<String>,
+    /// The training recording's window as recipe lines (`window = 5:65`,
+    /// `rows = …`); not applied to other recordings.
+    pub window: Option<String>,
+    /// The training recording and the part of it used.
+    pub data: Option<DataSpan>,
+    /// Gravity in the base frame (m/s²) when it was not the model's default.
+    pub gravity: Option<[f64; 3]>,
+    /// `none`, `sign`, `smooth`, `auto`, `stribeck` or `stribeck_smooth`.
+    pub friction: Option<String>,
+    /// ε of the Coulomb smoothing `tanh(q̇/ε)` (rad/s), when smoothed.
+    pub coulomb_epsilon: Option<f64>,
+    /// `true` when ε was chosen by the fit (one for all joints).
+    pub epsilon_auto: Option<bool>,
+    /// Rows of a joint slower than this (rad/s) left out of the fit.
+    pub exclude_below: Option<f64>,
+}
+
+/// Which samples of which file an identification used.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct DataSpan {
+    pub file: String,
+    pub samples: usize,
+    /// Where the first and last sample used are (`line 12` or `sample 0 (0-based)`).
+    pub first: String,
+    pub last: String,
+    /// Their time stamps (s).
+    pub t_first: Option<f64>,
+    pub t_last: Option<f64>,
+}
+
+/// A joint parameter reported with a value that is not physical.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NonPhysical {
+    /// The joint's name.
+    pub joint: String,
+    /// The parameter's name (`Fv3`).
+    pub parameter: String,
+    pub value: f64,
+    /// Why it is not physical.
+    pub reason: String,
 }
 
 /// [`Status`] as written in the JSON.

@@ -13,8 +13,8 @@ mod urdf;
 pub use chart::{Corner, LineChart};
 pub use error::ReportError;
 pub use json::{
-    CombinationReport, CoulombReport, ParamReport, ParamStatus, ParameterReport, Parameterisation, PredictionModel,
-    Term, SCHEMA,
+    CombinationReport, CoulombReport, DataSpan, NonPhysical, ParamReport, ParamStatus, ParameterReport,
+    Parameterisation, PredictionModel, Preprocessing, Term, SCHEMA,
 };
 pub use urdf::{rewrite_urdf_dynamics, rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 

@@ -602,8 +602,8 @@ fn balanced_warning(e: ModelError, balanced: &Inertial) -> ModelError {
 /// factorisation of the mass matrix at a generic configuration (a fixed draw) meets
 /// a pivot below `1e-12` of the largest diagonal entry. Only a body whose spatial
 /// inertia is not positive definite (no mass, or a principal moment ≤ 0) can cause
-/// that, so for every other model nothing is computed; otherwise `M` comes column
-/// by column from the joint torque regressor with `a = eₖ`, `v = 0`, no gravity.
+/// that, so for every other model nothing is computed; otherwise `M` comes from
+/// [`crate::regressor::mass_matrix`].
 fn singular_joints(model: &Model) -> Vec<usize> {
     let degenerate = model.bodies.iter().any(|b| {
         let (ev, _) = b.inertial.principal_axes();
@@ -612,25 +612,11 @@ fn singular_joints(model: &Model) -> Vec<usize> {
     if !degenerate {
         return Vec::new();
     }
-    let free = Model {
-        gravity: [0.0; 3],
-        ..model.clone()
-    };
     let n = model.nv();
-    let params = model.standard_params();
     let q = crate::sample::structure_states(model, 1, 0x5eed).remove(0).q;
-    let zero = vec![0.0; n];
-    let mut m = vec![vec![0.0; n]; n];
-    for k in 0..n {
-        let mut a = zero.clone();
-        a[k] = 1.0;
-        let Ok(y) = crate::regressor::joint_torque_regressor(&free, &q, &zero, &a) else {
-            return Vec::new();
-        };
-        for (r, row) in y.iter().enumerate() {
-            m[r][k] = row.iter().zip(&params).map(|(y, p)| y * p).sum();
-        }
-    }
+    let Ok(m) = crate::regressor::mass_matrix(model, &q) else {
+        return Vec::new();
+    };
     let scale = (0..n).fold(0.0f64, |s, k| s.max(m[k][k].abs()));
     // LDLᵀ without pivoting; a collapsed pivot's row and column are left out.
     let mut l = vec![vec![0.0; n]; n];

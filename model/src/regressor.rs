@@ -89,6 +89,36 @@ pub fn principal_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Re
     Ok(principal_from_standard(model, &torque_regressor(model, q, v, a)))
 }
 
+/// Inverse dynamics with the model's own (nominal) parameters: `τ = Y(q, v, a) π`.
+pub fn inverse_dynamics(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<f64>, RegressorError> {
+    let pi = model.standard_params();
+    Ok(joint_torque_regressor(model, q, v, a)?
+        .iter()
+        .map(|row| row.iter().zip(&pi).map(|(y, p)| y * p).sum())
+        .collect())
+}
+
+/// The joint-space mass matrix `M(q)` of the model's own parameters, as rows: column
+/// `k` is `τ(q, 0, eₖ)` without gravity. `nv` regressor evaluations, so for checks
+/// and tests rather than loops.
+pub fn mass_matrix(model: &Model, q: &[f64]) -> Result<Vec<Vec<f64>>, RegressorError> {
+    let weightless = Model {
+        gravity: [0.0; 3],
+        ..model.clone()
+    };
+    let n = model.nv();
+    let zero = vec![0.0; n];
+    let mut m = vec![vec![0.0; n]; n];
+    for k in 0..n {
+        let mut e = zero.clone();
+        e[k] = 1.0;
+        for (row, x) in m.iter_mut().zip(inverse_dynamics(&weightless, q, &zero, &e)?) {
+            row[k] = x;
+        }
+    }
+    Ok(m)
+}
+
 fn check_state(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<(), RegressorError> {
     for (argument, x, expected) in [("q", q, model.nq()), ("v", v, model.nv()), ("a", a, model.nv())] {
         if x.len() != expected {

@@ -12,7 +12,7 @@
 //! theirs), and one test per refused construct checks the message names the element
 //! and its line.
 
-use dyngen_model::regressor::joint_torque_regressor;
+use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
 use serde_json::Value;
 use std::path::PathBuf;
@@ -34,31 +34,14 @@ fn flat3(m: &[[f64; 3]; 3]) -> Vec<f64> {
     m.iter().flatten().copied().collect()
 }
 
-/// `τ = Y(q, v, a) π` with the model's nominal parameters.
-fn torque(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
-    let pi = model.standard_params();
-    joint_torque_regressor(model, q, v, a)
-        .unwrap()
-        .iter()
-        .map(|row| row.iter().zip(&pi).map(|(y, p)| y * p).sum())
-        .collect()
-}
-
-/// Mass matrix (columns `τ(q, 0, e_k) − τ(q, 0, 0)`) and bias `τ(q, v, 0)`.
+/// Mass matrix and bias `τ(q, v, 0)` with the model's nominal parameters, for any
+/// model (`nq` positions, `nv` velocities).
 fn dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>) {
-    let n = model.dof();
-    let zero = vec![0.0; n];
-    let g = torque(model, q, &zero, &zero);
-    let mut m = vec![vec![0.0; n]; n];
-    for k in 0..n {
-        let mut e = zero.clone();
-        e[k] = 1.0;
-        let col = torque(model, q, &zero, &e);
-        for r in 0..n {
-            m[r][k] = col[r] - g[r];
-        }
-    }
-    (m, torque(model, q, v, &zero))
+    let zero = vec![0.0; model.nv()];
+    (
+        mass_matrix(model, q).unwrap(),
+        inverse_dynamics(model, q, v, &zero).unwrap(),
+    )
 }
 
 fn numbers(v: &Value) -> Vec<f64> {
@@ -950,24 +933,6 @@ fn max_abs(x: &[f64]) -> f64 {
     x.iter().fold(0.0f64, |m, y| m.max(y.abs()))
 }
 
-/// Mass matrix (columns `τ(q, 0, e_k)` without gravity) and bias `τ(q, v, 0)` with
-/// it, for any model (`nq` positions, `nv` velocities).
-fn floating_dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>) {
-    let nv = model.nv();
-    let mut weightless = model.clone();
-    weightless.gravity = [0.0; 3];
-    let zero = vec![0.0; nv];
-    let mut m = vec![vec![0.0; nv]; nv];
-    for k in 0..nv {
-        let mut e = zero.clone();
-        e[k] = 1.0;
-        for (r, x) in torque(&weightless, q, &zero, &e).into_iter().enumerate() {
-            m[r][k] = x;
-        }
-    }
-    (m, torque(model, q, v, &zero))
-}
-
 /// MuJoCo's mass matrix and bias forces of `floating.xml`, converted to dyngen's
 /// coordinates by the script (quaternions `x y z w`, the free joint's linear velocity
 /// in the body frame, `M = T⁻ᵀ M_mj T⁻¹`, `b = T⁻ᵀ b_mj + M [ω × v; 0]`), equal the
@@ -1000,7 +965,7 @@ fn floating_mass_matrix_and_bias_equal_mujocos() {
             let norm: f64 = q[qa..qa + 4].iter().map(|x| x * x).sum();
             assert!((norm - 1.0).abs() < 1e-15);
         }
-        let (m, bias) = floating_dynamics(&model, &q, &v);
+        let (m, bias) = dynamics(&model, &q, &v);
         let m: Vec<f64> = m.into_iter().flatten().collect();
         let (m_ref, bias_ref) = (numbers(&s["M"]), numbers(&s["bias"]));
         dm = dm.max(max_abs_diff(&m, &m_ref) / max_abs(&m_ref));
@@ -1258,13 +1223,7 @@ fn floating_quadruped_reads_the_same_from_urdf_and_mjcf() {
     assert_eq!(names(&urdf), names(&mjcf));
     assert_eq!(mjcf.joints[0].kind, JointKind::FreeFlyer);
     assert_eq!((mjcf.nq(), mjcf.nv()), (19, 18));
-    let dynamics = |m: &Model, q: &[f64], v: &[f64], a: &[f64]| {
-        let y = joint_torque_regressor(m, q, v, a).unwrap();
-        let p = m.standard_params();
-        y.iter()
-            .map(|row| row.iter().zip(&p).map(|(a, b)| a * b).sum::<f64>())
-            .collect::<Vec<f64>>()
-    };
+    let dynamics = |m: &Model, q: &[f64], v: &[f64], a: &[f64]| inverse_dynamics(m, q, v, a).unwrap();
     let mut worst: f64 = 0.0;
     for s in dyngen_model::sample::sample_states(&urdf, 5, 9) {
         let (a, b) = (dynamics(&urdf, &s.q, &s.v, &s.a), dynamics(&mjcf, &s.q, &s.v, &s.a));
@@ -1326,7 +1285,7 @@ fn armature_against_mujoco(name: &str) -> [f64; 3] {
     for s in reference["samples"].as_array().unwrap() {
         let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
         assert_eq!(q, dyngen_q(&model, &numbers(&s["mujoco_qpos"])));
-        let (m, bias) = floating_dynamics(&model, &q, &v);
+        let (m, bias) = dynamics(&model, &q, &v);
         let rigid: Vec<f64> = m.iter().flatten().copied().collect();
         let with_rotors: Vec<f64> = (0..nv * nv)
             .map(|k| rigid[k] + if k / nv == k % nv { ia[k / nv] } else { 0.0 })
@@ -1353,7 +1312,7 @@ fn mass_matrix_with_armature_equals_mujocos_qm() {
     // And the armature is in it: without it the difference is the armature.
     let model = load_mjcf(&fixture("armature.xml")).unwrap();
     let s = &reference_json("armature")["samples"][1];
-    let (m, _) = floating_dynamics(&model, &numbers(&s["q"]), &numbers(&s["v"]));
+    let (m, _) = dynamics(&model, &numbers(&s["q"]), &numbers(&s["v"]));
     let qm = numbers(&s["M"]);
     assert!((qm[8] - m[1][1] - 0.35).abs() < 1e-12);
 }

@@ -14,7 +14,7 @@
 //!
 //! `cargo test -p dyngen-tests --test census_mjcf -- --nocapture` prints the table.
 
-use dyngen_model::regressor::joint_torque_regressor;
+use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, Model};
 use dyngen_tests::{json_numbers, load_json, rel_err, workspace_root};
 use serde_json::Value;
@@ -109,32 +109,13 @@ fn congruence(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
     out
 }
 
-/// `τ = Y(q, v, a) π` with the model's nominal (rigid-body) parameters.
-fn torque(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
-    let pi = model.standard_params();
-    joint_torque_regressor(model, q, v, a)
-        .unwrap()
-        .iter()
-        .map(|row| row.iter().zip(&pi).map(|(y, p)| y * p).sum())
-        .collect()
-}
-
-/// The rigid mass matrix (row-major, columns `τ(q, 0, e_k)` without gravity) and the
-/// bias `τ(q, v, 0)`.
+/// The rigid mass matrix (row-major) and the bias `τ(q, v, 0)`.
 fn dynamics(model: &Model, q: &[f64], v: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let nv = model.nv();
-    let mut weightless = model.clone();
-    weightless.gravity = [0.0; 3];
-    let zero = vec![0.0; nv];
-    let mut m = vec![0.0; nv * nv];
-    for k in 0..nv {
-        let mut e = zero.clone();
-        e[k] = 1.0;
-        for (r, x) in torque(&weightless, q, &zero, &e).into_iter().enumerate() {
-            m[r * nv + k] = x;
-        }
-    }
-    (m, torque(model, q, v, &zero))
+    let zero = vec![0.0; model.nv()];
+    (
+        mass_matrix(model, q).unwrap().concat(),
+        inverse_dynamics(model, q, v, &zero).unwrap(),
+    )
 }
 
 /// One row of the table.

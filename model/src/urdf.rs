@@ -7,7 +7,7 @@ use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptio
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
-use crate::xml::{scan, SyntaxError, Tag};
+use crate::xml::{is_xml_space, scan, shorten, SyntaxError, Tag};
 use std::io::Read as _;
 use std::path::Path;
 
@@ -164,8 +164,8 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
     }
     // urdf-rs stops at the first unreadable number without a position; it also reads
     // any document element as <robot>, a link named "", and an unusable `quat_xyzw`
-    // as no rotation (`crate::xml::urdf_errors`).
-    let numbers = [crate::xml::urdf_errors(&tags), number_errors(&tags)].concat();
+    // as no rotation ([`urdf_errors`]).
+    let numbers = [urdf_errors(&tags), number_errors(&tags)].concat();
     if !numbers.is_empty() {
         return Err(numbers);
     }
@@ -330,6 +330,131 @@ fn number_errors(tags: &[Tag]) -> Vec<ModelError> {
         }
     }
     errors
+}
+
+/// What a URDF must hold that urdf-rs does not check, each with its element and
+/// line: `<robot>` as the document element, a non-empty name on every link and
+/// joint, and a `quat_xyzw` (URDF 1.1) that is a rotation. urdf-rs reads any
+/// document element as the robot, a link named "", and turns a `quat_xyzw` that is
+/// not a number (`nan`), has no direction (`0 0 0 0`, `1e-200 0 0 0`) or no finite
+/// norm (`1e300 1e300 0 0`) into the identity; a URDF 1.0 reader ignores
+/// `quat_xyzw`. `tags` is an outline from [`scan`].
+fn urdf_errors(tags: &[Tag]) -> Vec<ModelError> {
+    let Some(root) = tags.first() else { return Vec::new() };
+    let error = |element: Element, line: usize, message: String| ModelError {
+        element,
+        line: Some(line),
+        kind: ErrorKind::Parse(message),
+    };
+    if root.name != "robot" {
+        return vec![error(
+            Element::Robot,
+            root.line,
+            format!(
+                "the document element is <{}>, not <robot>; a URDF describes one <robot name=\"...\"> holding its \
+                 <link> and <joint> elements",
+                shorten(&root.name)
+            ),
+        )];
+    }
+    let mut errors = Vec::new();
+    for t in tags.iter().filter(|t| t.parent == Some(0)) {
+        let element: fn(String) -> Element = match t.name.as_str() {
+            "link" => Element::Link,
+            "joint" => Element::Joint,
+            _ => continue,
+        };
+        let name = t.attr("name").unwrap_or_default();
+        if name.trim_matches(is_xml_space).is_empty() {
+            let what = if t.attr("name").is_some() {
+                "an empty name"
+            } else {
+                "no name"
+            };
+            errors.push(error(
+                element(name.to_string()),
+                t.line,
+                format!(
+                    "this <{}> has {what}; every link and joint needs a unique name, such as name=\"{}_1\"",
+                    t.name, t.name
+                ),
+            ));
+        }
+    }
+    let version = root
+        .attr("version")
+        .and_then(|v| {
+            let (major, minor) = v.trim().split_once('.')?;
+            Some((major.parse::<u32>().ok()?, minor.parse::<u32>().ok()?))
+        })
+        .unwrap_or((1, 0));
+    for t in tags.iter().filter(|t| t.name == "origin") {
+        let Some(quat) = t.attr("quat_xyzw") else { continue };
+        // The link or joint (a child of <robot>) the origin belongs to.
+        let mut owner = t.parent;
+        while let Some(k) = owner.filter(|&k| tags[k].parent.is_some_and(|p| p != 0)) {
+            owner = tags[k].parent;
+        }
+        let element = match owner.map(|k| &tags[k]) {
+            Some(o) if o.name == "link" || o.name == "joint" => element_of(o),
+            _ => Element::Robot,
+        };
+        let shown = format!("<origin quat_xyzw=\"{}\">", shorten(quat));
+        let message = if version < (1, 1) {
+            Some(format!(
+                "{shown} is URDF 1.1, but this file is URDF {}.{} (the `version` of <robot>), whose readers ignore \
+                 quat_xyzw and would leave this origin unrotated; write version=\"1.1\" on <robot>, or give the \
+                 rotation as rpy",
+                version.0, version.1
+            ))
+        } else if t.attr("rpy").is_some() {
+            Some(format!(
+                "{shown} also gives rpy; give the rotation once, as rpy or as quat_xyzw"
+            ))
+        } else {
+            quaternion_problem(quat).map(|problem| format!("{shown} {problem}"))
+        };
+        if let Some(message) = message {
+            errors.push(error(element, t.line, message));
+        }
+    }
+    errors
+}
+
+/// Smallest and largest norm of a `quat_xyzw` taken as a rotation: within them
+/// the quaternion normalises exactly (its squares neither underflow nor overflow).
+pub const QUATERNION_NORM_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// Why `quat_xyzw` text is not a rotation: not four numbers, not finite, or a norm
+/// outside [`QUATERNION_NORM_RANGE`].
+fn quaternion_problem(quat: &str) -> Option<String> {
+    const VALID: &str = "write a rotation as a unit quaternion x y z w, such as `0 0 0 1` (none) or \
+                         `0 0 0.7071068 0.7071068` (90° about z)";
+    let q: Vec<f64> = match quat
+        .split_whitespace()
+        .map(str::parse::<f64>)
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(q) if q.len() == 4 => q,
+        _ => return Some(format!("is not four numbers; {VALID}")),
+    };
+    if q.iter().any(|x| !x.is_finite()) {
+        return Some(format!("holds a value that is not a finite number; {VALID}"));
+    }
+    // The norm, scaled so that its squares neither underflow nor overflow.
+    let scale = q.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let norm = if scale == 0.0 {
+        0.0
+    } else {
+        scale * q.iter().map(|x| (x / scale).powi(2)).sum::<f64>().sqrt()
+    };
+    let (low, high) = QUATERNION_NORM_RANGE;
+    (!(low..=high).contains(&norm)).then(|| {
+        format!(
+            "has norm {norm:e}, not a rotation: it is normalised to norm 1, which needs a norm between {low:e} and \
+             {high:e}; {VALID}"
+        )
+    })
 }
 
 /// A `<mimic>` in a moving joint: reported rather than read as an independent joint.

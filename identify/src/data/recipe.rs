@@ -496,7 +496,11 @@ impl Recipe {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        let bound = |x: Option<String>| x.unwrap_or_default();
+        // `start:end`, an open end left empty.
+        fn span<T: ToString>(start: Option<T>, end: Option<T>) -> String {
+            let bound = |x: Option<T>| x.map(|x| x.to_string()).unwrap_or_default();
+            format!("{}:{}", bound(start), bound(end))
+        }
         if self.delimiter != d.delimiter {
             put("delimiter", self.delimiter.name().into());
         }
@@ -552,24 +556,10 @@ impl Recipe {
             put("sign", signs.join(", "));
         }
         if let Some(w) = &self.window {
-            put(
-                "window",
-                format!(
-                    "{}:{}",
-                    bound(w.start.map(|x| x.to_string())),
-                    bound(w.end.map(|x| x.to_string()))
-                ),
-            );
+            put("window", span(w.start, w.end));
         }
         if let Some(r) = &self.rows {
-            put(
-                "rows",
-                format!(
-                    "{}:{}",
-                    bound(r.first.map(|x| x.to_string())),
-                    bound(r.last.map(|x| x.to_string()))
-                ),
-            );
+            put("rows", span(r.first, r.last));
         }
         if self.decimate != d.decimate {
             put("decimate", self.decimate.to_string());

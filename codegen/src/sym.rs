@@ -445,6 +445,21 @@ impl<'g> Neg for Expr<'g> {
     }
 }
 
+/// The expression graph is a scalar of the algorithms: running `dyngen_algo`'s rnea,
+/// crba, aba or Jacobians on it records the straight-line program they compute, with
+/// the model's constants folded.
+impl<'g> dyngen_algo::Real for Expr<'g> {
+    type Context = &'g Graph;
+
+    fn constant(graph: &'g Graph, x: f64) -> Expr<'g> {
+        graph.constant(x)
+    }
+
+    fn sin_cos(self) -> (Expr<'g>, Expr<'g>) {
+        (self.sin(), self.cos())
+    }
+}
+
 /// Operation counts of a set of outputs: what the emitted code computes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OpCount {

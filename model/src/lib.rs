@@ -28,6 +28,7 @@ mod ir;
 pub mod joint_params;
 pub mod math;
 pub mod mjcf;
+mod multibody;
 pub mod names;
 pub mod principal;
 pub mod regressor;
@@ -43,6 +44,7 @@ pub use desc::{
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
 pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+pub use multibody::joint_type;
 pub use mjcf::{
     load_mjcf, load_mjcf_options, load_mjcf_with, load_robot, load_robot_options, load_robot_with, parse_mjcf,
     parse_mjcf_options, parse_mjcf_with,

@@ -1,0 +1,94 @@
+//! Forward kinematics: every body's placement, in its parent and in the base frame.
+
+use crate::multibody::{Multibody, Workspace};
+use crate::spatial::{add, cross};
+use crate::Real;
+
+/// Panics with a message naming `what` when `x` does not have `expected` entries.
+#[track_caller]
+pub(crate) fn check_len<S>(what: &str, x: &[S], expected: usize) {
+    assert!(
+        x.len() == expected,
+        "`{what}` has {} entries; the multibody needs {expected}",
+        x.len()
+    );
+}
+
+/// `λ(i)M_i(q)` of every body into `workspace.placement`.
+pub(crate) fn placements<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
+    check_len("q", q, multibody.nq());
+    let c = workspace.context;
+    for (i, j) in multibody.joints.iter().enumerate() {
+        workspace.placement[i + 1] = j.placement(c, &q[j.q_offset..j.q_offset + j.nq()]);
+    }
+}
+
+/// Every body's placement in its parent (`workspace.placement`) and in the base
+/// frame (`workspace.world`, `⁰M_i = ⁰M_λ(i) · λ(i)M_i(q)`): Pinocchio's
+/// `forwardKinematics(model, data, q)` (`data.liMi`, `data.oMi`).
+pub fn forward_kinematics<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
+    placements(multibody, workspace, q);
+    let (z, o) = (workspace.zero(), S::constant(workspace.context, 1.0));
+    for (i, j) in multibody.joints.iter().enumerate() {
+        let local = workspace.placement[i + 1].se3(z, o);
+        workspace.world[i + 1] = if j.parent == 0 {
+            local
+        } else {
+            workspace.world[j.parent].compose(&local)
+        };
+    }
+}
+
+/// The Newton–Euler forward pass (Luh, Walker and Paul) at the velocities `v` and
+/// accelerations `a`, after [`placements`]: in body `i`'s axes its angular velocity
+/// `ω_i`, angular acceleration `ω̇_i` and the linear acceleration `a_i` of its origin,
+/// gravity entering as `a_0 = −g`. With the joint's own motion `(ω_q, v_q) = S q̇` and
+/// `(ω̇_q, a_q) = S q̈`, and `x_in` the parent's quantities in body `i`'s axes:
+///
+/// ```text
+/// ω_i = ω_in + ω_q,   ω̇_i = ω̇_in + ω̇_q + ω_in × ω_q
+/// a_i = Rᵀ (a_λ + ω̇_λ × p + ω_λ × (ω_λ × p)) + a_q + (2 ω_in + ω_q) × v_q
+/// ```
+pub(crate) fn newton_euler_pass<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, v: &[S], a: &[S]) {
+    let c = workspace.context;
+    let z = workspace.zero();
+    workspace.angular_velocity[0] = [z; 3];
+    workspace.angular_acceleration[0] = [z; 3];
+    workspace.linear_acceleration[0] = multibody.gravity.map(|x| S::constant(c, -x));
+    for (k, j) in multibody.joints.iter().enumerate() {
+        let i = k + 1;
+        let range = j.v_offset..j.v_offset + j.nv();
+        let x = workspace.placement[i];
+        let vq = j.motion(c, &v[range.clone()]);
+        let aq = j.motion(c, &a[range]);
+        let acc = workspace.linear_acceleration[j.parent];
+        let (w, wd, acc) = if j.parent == 0 {
+            // The base does not move: only gravity comes in.
+            (vq.angular, aq.angular, add(x.to_child(acc), aq.linear))
+        } else {
+            let (w, wd) = (
+                workspace.angular_velocity[j.parent],
+                workspace.angular_acceleration[j.parent],
+            );
+            let t = x.translation;
+            let origin = add(acc, add(cross(wd, t), cross(w, cross(w, t))));
+            let (w_in, wd_in) = (x.to_child(w), x.to_child(wd));
+            let wd = add(add(wd_in, aq.angular), cross(w_in, vq.angular));
+            let acc = add(x.to_child(origin), aq.linear);
+            let acc = if j.moves_linearly() {
+                add(acc, cross(add(add(w_in, w_in), vq.angular), vq.linear))
+            } else {
+                acc
+            };
+            (add(w_in, vq.angular), wd, acc)
+        };
+        let acc = if j.parent == 0 && j.moves_linearly() {
+            add(acc, cross(vq.angular, vq.linear))
+        } else {
+            acc
+        };
+        workspace.angular_velocity[i] = w;
+        workspace.angular_acceleration[i] = wd;
+        workspace.linear_acceleration[i] = acc;
+    }
+}

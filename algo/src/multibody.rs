@@ -1,0 +1,226 @@
+//! The kinematic tree the algorithms run on, and the workspace they write into.
+
+use crate::joint::{Axis, Joint, JointPlacement, JointType, Rotation};
+use crate::spatial::{Force, Inertia, Motion, Se3, SpatialMatrix, Vec3};
+use crate::Real;
+use alloc::vec::Vec;
+
+/// Standard parameters per body: `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`,
+/// inertia about the body-frame origin.
+pub const PARAMS_PER_BODY: usize = 10;
+
+/// A kinematic tree in regular labelling: joint `i` (0-based) carries body `i + 1`,
+/// whose parent is a body `< i + 1`; body 0 is fixed (the base, or the world under a
+/// free flyer).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Multibody {
+    pub joints: Vec<Joint>,
+    /// Gravity in the base frame, m/s².
+    pub gravity: [f64; 3],
+    /// The nominal standard parameters, [`PARAMS_PER_BODY`] per body.
+    pub params: Vec<f64>,
+    nq: usize,
+    nv: usize,
+    /// Per velocity coordinate: the coordinate before it on the path to the base
+    /// (in its own joint, or the last of the parent joint's), `usize::MAX` at the base.
+    coordinate_parent: Vec<usize>,
+}
+
+/// One joint of [`Multibody::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointSpec {
+    pub kind: JointType,
+    /// The parent body (0 the base), smaller than this joint's body.
+    pub parent: usize,
+    /// The joint frame at `q = 0` in the parent body's frame.
+    pub origin: Se3<f64>,
+    /// Unit axis (plane normal of a planar joint; ignored for a ball and a free flyer).
+    pub axis: [f64; 3],
+    /// The in-plane axes of a planar joint (ignored otherwise).
+    pub plane: [[f64; 3]; 2],
+    /// The carried body's standard parameters.
+    pub params: [f64; PARAMS_PER_BODY],
+}
+
+/// Why [`Multibody::new`] refused a tree.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TreeError {
+    /// Joint `joint` (0-based) names a parent that is not an earlier body.
+    ParentNotBefore { joint: usize, parent: usize },
+    /// A free flyer anywhere but as the first joint, on the base.
+    FreeFlyerNotAtRoot { joint: usize },
+}
+
+impl core::fmt::Display for TreeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            TreeError::ParentNotBefore { joint, parent } => write!(
+                f,
+                "joint {joint} (body {}) has parent body {parent}; a parent must be 0 (the base) or an earlier body",
+                joint + 1
+            ),
+            TreeError::FreeFlyerNotAtRoot { joint } => {
+                write!(
+                    f,
+                    "joint {joint} is a free flyer; only the first joint, on the base, may be one"
+                )
+            }
+        }
+    }
+}
+
+impl Multibody {
+    pub fn new(gravity: [f64; 3], specs: &[JointSpec]) -> Result<Multibody, TreeError> {
+        let (mut nq, mut nv) = (0, 0);
+        let mut joints = Vec::with_capacity(specs.len());
+        let mut params = Vec::with_capacity(PARAMS_PER_BODY * specs.len());
+        let mut coordinate_parent = Vec::new();
+        for (i, s) in specs.iter().enumerate() {
+            if s.parent > i {
+                return Err(TreeError::ParentNotBefore {
+                    joint: i,
+                    parent: s.parent,
+                });
+            }
+            if s.kind == JointType::FreeFlyer && (i != 0 || s.parent != 0) {
+                return Err(TreeError::FreeFlyerNotAtRoot { joint: i });
+            }
+            let joint = Joint {
+                kind: s.kind,
+                parent: s.parent,
+                origin: s.origin,
+                axis: Axis::new(s.axis),
+                plane: s.plane,
+                q_offset: nq,
+                v_offset: nv,
+            };
+            for k in 0..s.kind.nv() {
+                coordinate_parent.push(if k > 0 {
+                    nv + k - 1
+                } else if s.parent == 0 {
+                    usize::MAX
+                } else {
+                    let p = &joints[s.parent - 1] as &Joint;
+                    p.v_offset + p.nv() - 1
+                });
+            }
+            nq += s.kind.nq();
+            nv += s.kind.nv();
+            joints.push(joint);
+            params.extend_from_slice(&s.params);
+        }
+        Ok(Multibody {
+            joints,
+            gravity,
+            params,
+            nq,
+            nv,
+            coordinate_parent,
+        })
+    }
+
+    /// Number of moving bodies (= joints).
+    pub fn bodies(&self) -> usize {
+        self.joints.len()
+    }
+
+    pub fn nq(&self) -> usize {
+        self.nq
+    }
+
+    pub fn nv(&self) -> usize {
+        self.nv
+    }
+
+    /// The velocity coordinate before `d` on the path to the base, `None` at the base.
+    pub fn coordinate_parent(&self, d: usize) -> Option<usize> {
+        Some(self.coordinate_parent[d]).filter(|&p| p != usize::MAX)
+    }
+
+    /// The neutral configuration: zero coordinates, identity quaternions.
+    pub fn neutral(&self) -> Vec<f64> {
+        let mut q = alloc::vec![0.0; self.nq];
+        for j in &self.joints {
+            match j.kind {
+                JointType::Spherical => q[j.q_offset + 3] = 1.0,
+                JointType::FreeFlyer => q[j.q_offset + 6] = 1.0,
+                _ => {}
+            }
+        }
+        q
+    }
+}
+
+/// Everything an algorithm computes on the way, sized once for one [`Multibody`]
+/// so that no call allocates. Entries are per body, 0 the base.
+#[derive(Clone, Debug)]
+pub struct Workspace<S: Real> {
+    pub(crate) context: S::Context,
+    /// `λ(i)M_i`: body `i` in its parent.
+    pub placement: Vec<JointPlacement<S>>,
+    /// `⁰M_i`: body `i` in the base frame.
+    pub world: Vec<Se3<S>>,
+    /// Spatial velocity of body `i` in its frame (aba).
+    pub(crate) velocity: Vec<Motion<S>>,
+    /// Spatial acceleration of body `i` in its frame, gravity included as a base
+    /// acceleration `−g` (aba).
+    pub(crate) acceleration: Vec<Motion<S>>,
+    /// The Newton–Euler pass (rnea, regressor), in body `i`'s axes: its angular
+    /// velocity and acceleration, and the linear acceleration of its origin with
+    /// gravity included as `−g`.
+    pub(crate) angular_velocity: Vec<Vec3<S>>,
+    pub(crate) angular_acceleration: Vec<Vec3<S>>,
+    pub(crate) linear_acceleration: Vec<Vec3<S>>,
+    /// After [`crate::rnea`]: the wrench joint `i` transmits to body `i`, in its
+    /// frame (Pinocchio's `data.f`).
+    pub force: Vec<Force<S>>,
+    pub(crate) inertia: Vec<Inertia<S>>,
+    pub(crate) articulated: Vec<SpatialMatrix<S>>,
+    /// Per body: `p^A` (aba).
+    pub(crate) bias_force: Vec<Force<S>>,
+    /// Per body: the velocity-product acceleration `c_i = v_i × S_i q̇_i` (aba).
+    pub(crate) bias_acceleration: Vec<Motion<S>>,
+    /// Per velocity coordinate: `U = I^A S` (aba), `F = I^c S` (crba).
+    pub(crate) u: Vec<Force<S>>,
+    /// Per velocity coordinate: `u = τ − Sᵀ p^A`.
+    pub(crate) u_torque: Vec<S>,
+    /// Per joint, `D⁻¹` (nv × nv row-major, at most 36 entries).
+    pub(crate) d_inv: Vec<[S; 36]>,
+}
+
+impl<S: Real> Workspace<S> {
+    /// A workspace for `multibody`, its numbers made in `context` (`()` for `f64`).
+    pub fn new(multibody: &Multibody, context: S::Context) -> Workspace<S> {
+        let n = multibody.bodies() + 1;
+        let (z, o) = (S::constant(context, 0.0), S::constant(context, 1.0));
+        Workspace {
+            context,
+            placement: alloc::vec![
+                JointPlacement {
+                    origin: None,
+                    motion: Rotation::Identity,
+                    translation: [z; 3],
+                };
+                n
+            ],
+            world: alloc::vec![Se3::identity(z, o); n],
+            velocity: alloc::vec![Motion::zero(z); n],
+            acceleration: alloc::vec![Motion::zero(z); n],
+            angular_velocity: alloc::vec![[z; 3]; n],
+            angular_acceleration: alloc::vec![[z; 3]; n],
+            linear_acceleration: alloc::vec![[z; 3]; n],
+            force: alloc::vec![Force::zero(z); n],
+            inertia: alloc::vec![Inertia::zero(z); n],
+            articulated: alloc::vec![Inertia::zero(z).to_matrix(z); n],
+            bias_force: alloc::vec![Force::zero(z); n],
+            bias_acceleration: alloc::vec![Motion::zero(z); n],
+            u: alloc::vec![Force::zero(z); multibody.nv()],
+            u_torque: alloc::vec![z; multibody.nv()],
+            d_inv: alloc::vec![[z; 36]; n],
+        }
+    }
+
+    pub(crate) fn zero(&self) -> S {
+        S::constant(self.context, 0.0)
+    }
+}

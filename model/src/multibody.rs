@@ -1,0 +1,65 @@
+//! The bridge to the algorithms: a checked [`Model`] as the [`Multibody`] that
+//! `dyngen-algo`'s rnea, crba, aba and Jacobians run on at run time.
+
+use crate::math::plane_basis;
+use crate::{JointKind, Model};
+use dyngen_algo::{JointSpec, JointType, Multibody, Se3, TreeError};
+
+/// The algorithms' joint type of a model joint kind.
+pub fn joint_type(kind: JointKind) -> JointType {
+    match kind {
+        JointKind::Revolute => JointType::Revolute,
+        JointKind::Continuous => JointType::Continuous,
+        JointKind::Prismatic => JointType::Prismatic,
+        JointKind::Spherical => JointType::Spherical,
+        JointKind::FreeFlyer => JointType::FreeFlyer,
+        JointKind::Planar => JointType::Planar,
+    }
+}
+
+impl Model {
+    /// This model as the algorithms' [`Multibody`]: the same numbering, placements,
+    /// axes, gravity and nominal standard parameters ([`Model::standard_params`]).
+    ///
+    /// ```
+    /// let model = dyngen_model::parse_urdf(r#"<robot name="r"><link name="base"/>
+    ///   <link name="arm"><inertial><mass value="2"/><origin xyz="0 0 -0.5"/>
+    ///     <inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    ///   <joint name="j" type="continuous"><parent link="base"/><child link="arm"/>
+    ///     <axis xyz="0 1 0"/></joint></robot>"#).unwrap();
+    /// let body = model.multibody().unwrap();
+    /// let mut ws = dyngen_algo::Workspace::new(&body, ());
+    /// let mut m = [0.0];
+    /// dyngen_algo::crba(&body, &mut ws, &[0.3], &body.params, &mut m);
+    /// assert!((m[0] - (0.1 + 2.0 * 0.25)).abs() < 1e-12); // I_yy + m l²
+    /// ```
+    ///
+    /// # Errors
+    /// Only for a model that was not checked (its fields edited by hand): a parent
+    /// that is not an earlier body, or a free flyer below the root.
+    pub fn multibody(&self) -> Result<Multibody, TreeError> {
+        let params = self.standard_params();
+        let specs: Vec<JointSpec> = self
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(k, j)| {
+                let (e1, e2) = plane_basis(&j.axis);
+                let mut p = [0.0; 10];
+                p.copy_from_slice(&params[10 * k..10 * k + 10]);
+                JointSpec {
+                    kind: joint_type(j.kind),
+                    parent: j.parent,
+                    origin: Se3 {
+                        rotation: j.origin.rotation,
+                        translation: j.origin.translation,
+                    },
+                    axis: j.axis,
+                    plane: [e1, e2],
+                    params: p,
+                }
+            })
+            .collect();
+        Multibody::new(self.gravity, &specs)
+    }
+}

@@ -24,6 +24,10 @@ pub struct Multibody {
     /// Per velocity coordinate: the coordinate before it on the path to the base
     /// (in its own joint, or the last of the parent joint's), `usize::MAX` at the base.
     coordinate_parent: Vec<usize>,
+    /// The velocity coordinates that move each body, root first: body `i`'s are
+    /// `supports[support_offsets[i]..support_offsets[i + 1]]` (body 0 has none).
+    pub(crate) supports: Vec<usize>,
+    pub(crate) support_offsets: Vec<usize>,
 }
 
 /// One joint of [`Multibody::new`].
@@ -109,6 +113,15 @@ impl Multibody {
             joints.push(joint);
             params.extend_from_slice(&s.params);
         }
+        let (mut supports, mut support_offsets) = (Vec::new(), alloc::vec![0, 0]);
+        for j in &joints {
+            let (from, to) = (support_offsets[j.parent], support_offsets[j.parent + 1]);
+            for t in from..to {
+                supports.push(supports[t]);
+            }
+            supports.extend(j.v_offset..j.v_offset + j.nv());
+            support_offsets.push(supports.len());
+        }
         Ok(Multibody {
             joints,
             gravity,
@@ -116,6 +129,8 @@ impl Multibody {
             nq,
             nv,
             coordinate_parent,
+            supports,
+            support_offsets,
         })
     }
 
@@ -186,6 +201,9 @@ pub struct Workspace<S: Real> {
     pub(crate) u_torque: Vec<S>,
     /// Per joint, `D⁻¹` (nv × nv row-major, at most 36 entries).
     pub(crate) d_inv: Vec<[S; 36]>,
+    /// Per body, the motion subspaces of the coordinates that move it, in its frame
+    /// (the regressor), laid out as `Multibody::supports`.
+    pub(crate) axes: Vec<Motion<S>>,
 }
 
 impl<S: Real> Workspace<S> {
@@ -217,6 +235,7 @@ impl<S: Real> Workspace<S> {
             u: alloc::vec![Force::zero(z); multibody.nv()],
             u_torque: alloc::vec![z; multibody.nv()],
             d_inv: alloc::vec![[z; 36]; n],
+            axes: alloc::vec![Motion::zero(z); multibody.supports.len()],
         }
     }
 

@@ -50,10 +50,13 @@ pub fn force_regressor<S: Real>(
     out
 }
 
-/// `Y(q, q̇, q̈)` into `y`, `nv × 10 n` row-major (`y[d · 10n + 10(i − 1) + k]`): each
-/// body's [`force_regressor`] carried towards the base, `Y_{d, i} = S_dᵀ ᵈX_i* F_i`
-/// for every coordinate `d` on the path from body `i` to the base, zero elsewhere.
-/// Gravity enters as the base acceleration `−g`, so `Y π = rnea(q, q̇, q̈, π)`.
+/// `Y(q, q̇, q̈)` into `y`, `nv × 10 n` row-major (`y[d · 10n + 10(i − 1) + k]`), zero
+/// unless coordinate `d` moves body `i`. With `ⁱX_d S_d` the motion subspace of
+/// coordinate `d` seen from body `i` (carried outwards one joint at a time,
+/// `ⁱX_d S_d = ⁱX_λ(i) · λ(i)X_d S_d`) and `F_i` body `i`'s [`force_regressor`],
+/// `Y_{d, i} = (ⁱX_d S_d)ᵀ F_i`: one motion transform and ten dot products per
+/// (coordinate, body) pair. Gravity enters as the base acceleration `−g`, so
+/// `Y π = rnea(q, q̇, q̈, π)`.
 ///
 /// # Panics
 /// If a slice's length does not match the multibody.
@@ -72,36 +75,31 @@ pub fn joint_torque_regressor<S: Real>(
     placements(multibody, workspace, q);
     newton_euler_pass(multibody, workspace, v, a);
     let c = workspace.context;
-    let z = workspace.zero();
-    y.fill(z);
+    y.fill(workspace.zero());
     let cols = PARAMS_PER_BODY * nb;
-    let mut projected = [z; 6];
+    let offsets = &multibody.support_offsets;
     for (k, j) in multibody.joints.iter().enumerate() {
         let i = k + 1;
-        let mut forces = force_regressor(
+        let x = workspace.placement[i];
+        let (from, inherited) = (offsets[i], offsets[j.parent + 1] - offsets[j.parent]);
+        for t in 0..inherited {
+            workspace.axes[from + t] = x.motion_to_child(workspace.axes[offsets[j.parent] + t]);
+        }
+        for e in 0..j.nv() {
+            workspace.axes[from + inherited + e] = j.column(c, e);
+        }
+        let forces = force_regressor(
             c,
             workspace.angular_velocity[i],
             workspace.angular_acceleration[i],
             workspace.linear_acceleration[i],
         );
-        let (mut body, mut joint) = (i, j);
-        loop {
-            let n = joint.nv();
-            for (p, f) in forces.iter().enumerate() {
-                joint.project(c, f, &mut projected[..n]);
-                for (r, &x) in projected[..n].iter().enumerate() {
-                    y[(joint.v_offset + r) * cols + PARAMS_PER_BODY * k + p] = x;
-                }
+        for t in from..offsets[i + 1] {
+            let (d, axis) = (multibody.supports[t], workspace.axes[t]);
+            let row = &mut y[d * cols + PARAMS_PER_BODY * k..][..PARAMS_PER_BODY];
+            for (x, f) in row.iter_mut().zip(&forces) {
+                *x = axis.dot(*f);
             }
-            if joint.parent == 0 {
-                break;
-            }
-            let x = workspace.placement[body];
-            for f in forces.iter_mut() {
-                *f = x.force_to_parent(*f);
-            }
-            body = joint.parent;
-            joint = &multibody.joints[body - 1];
         }
     }
 }

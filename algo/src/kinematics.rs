@@ -1,7 +1,7 @@
 //! Forward kinematics: every body's placement, in its parent and in the base frame.
 
 use crate::multibody::{Multibody, Workspace};
-use crate::spatial::{add, cross};
+use crate::spatial::{add, cross, Motion};
 use crate::Real;
 
 /// Panics with a message naming `what` when `x` does not have `expected` entries.
@@ -36,6 +36,37 @@ pub fn forward_kinematics<S: Real>(multibody: &Multibody, workspace: &mut Worksp
         } else {
             workspace.world[j.parent].compose(&local)
         };
+    }
+}
+
+/// Every body's placement ([`forward_kinematics`]), spatial velocity
+/// (`workspace.velocity`) and gravity-free spatial acceleration
+/// (`workspace.acceleration`) in its own frame: Pinocchio's
+/// `forwardKinematics(model, data, q, v, a)` (`data.v`, `data.a`),
+///
+/// ```text
+/// v_i = ⁱX_λ(i) v_λ(i) + S_i q̇_i,   a_i = ⁱX_λ(i) a_λ(i) + S_i q̈_i + v_i × S_i q̇_i
+/// ```
+///
+/// # Panics
+/// If a slice's length does not match the multibody.
+pub fn body_motions<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], v: &[S], a: &[S]) {
+    check_len("v", v, multibody.nv());
+    check_len("a", a, multibody.nv());
+    forward_kinematics(multibody, workspace, q);
+    let c = workspace.context;
+    let z = workspace.zero();
+    workspace.velocity[0] = Motion::zero(z);
+    workspace.acceleration[0] = Motion::zero(z);
+    for (k, j) in multibody.joints.iter().enumerate() {
+        let i = k + 1;
+        let range = j.v_offset..j.v_offset + j.nv();
+        let x = workspace.placement[i];
+        let vj = j.motion(c, &v[range.clone()]);
+        let vel = x.motion_to_child(workspace.velocity[j.parent]) + vj;
+        workspace.acceleration[i] =
+            x.motion_to_child(workspace.acceleration[j.parent]) + j.motion(c, &a[range]) + vel.cross_motion(vj);
+        workspace.velocity[i] = vel;
     }
 }
 

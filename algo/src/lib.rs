@@ -10,12 +10,13 @@
 //!
 //! One file per algorithm:
 //!
-//! - [`forward_kinematics`] (`kinematics.rs`): every body's placement;
+//! - [`forward_kinematics`], [`body_motions`] (`kinematics.rs`): every body's
+//!   placement, velocity and acceleration;
 //! - [`rnea`] (`rnea.rs`): inverse dynamics, and the joint wrenches on the way;
 //! - [`crba`] (`crba.rs`): the joint-space mass matrix;
 //! - [`aba`] (`aba.rs`): forward dynamics, with rotor inertia;
 //! - [`joint_torque_regressor`] (`regressor.rs`): `τ = Y π`, linear in the standard
-//!   parameters;
+//!   parameters, and [`joint_wrench_regressor`], `6 n` rows of joint wrenches;
 //! - [`frame_jacobian`] (`jacobian.rs`): a frame's Jacobian in any [`ReferenceFrame`].
 //!
 //! ```
@@ -55,9 +56,9 @@ pub use aba::aba;
 pub use crba::crba;
 pub use jacobian::{frame_jacobian, ReferenceFrame};
 pub use joint::{quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
-pub use kinematics::forward_kinematics;
+pub use kinematics::{body_motions, forward_kinematics};
 pub use multibody::{JointSpec, Multibody, TreeError, Workspace, PARAMS_PER_BODY};
 pub use real::Real;
-pub use regressor::{force_regressor, joint_torque_regressor};
+pub use regressor::{force_regressor, joint_torque_regressor, joint_wrench_regressor};
 pub use rnea::rnea;
 pub use spatial::{Force, Inertia, Motion, Se3};

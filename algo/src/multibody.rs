@@ -175,11 +175,11 @@ pub struct Workspace<S: Real> {
     pub placement: Vec<JointPlacement<S>>,
     /// `⁰M_i`: body `i` in the base frame.
     pub world: Vec<Se3<S>>,
-    /// Spatial velocity of body `i` in its frame (aba).
-    pub(crate) velocity: Vec<Motion<S>>,
-    /// Spatial acceleration of body `i` in its frame, gravity included as a base
-    /// acceleration `−g` (aba).
-    pub(crate) acceleration: Vec<Motion<S>>,
+    /// Spatial velocity of body `i` in its frame (after [`crate::body_motions`]).
+    pub velocity: Vec<Motion<S>>,
+    /// Spatial acceleration of body `i` in its frame (after [`crate::body_motions`],
+    /// gravity-free; during aba, gravity included as a base acceleration `−g`).
+    pub acceleration: Vec<Motion<S>>,
     /// The Newton–Euler pass (rnea, regressor), in body `i`'s axes: its angular
     /// velocity and acceleration, and the linear acceleration of its origin with
     /// gravity included as `−g`.

@@ -103,3 +103,56 @@ pub fn joint_torque_regressor<S: Real>(
         }
     }
 }
+
+/// The joint wrench regressor `W(q, q̇, q̈)` into `w`, `6 n × 10 n` row-major
+/// (`w[(6(j − 1) + r) · 10n + 10(i − 1) + k]`): block `(j, i)` is `ʲX_i* F_i`, body
+/// `i`'s [`force_regressor`] moved into joint `j`'s frame, for every joint `j` that
+/// supports body `i`, zero elsewhere. `W π` is every joint's wrench on its body
+/// (rnea's `workspace.force`); `Y` is its projection on the motion subspaces.
+///
+/// # Panics
+/// If a slice's length does not match the multibody.
+pub fn joint_wrench_regressor<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    w: &mut [S],
+) {
+    let (nv, nb) = (multibody.nv(), multibody.bodies());
+    check_len("v", v, nv);
+    check_len("a", a, nv);
+    check_len("w", w, 6 * nb * PARAMS_PER_BODY * nb);
+    placements(multibody, workspace, q);
+    newton_euler_pass(multibody, workspace, v, a);
+    let c = workspace.context;
+    w.fill(workspace.zero());
+    let cols = PARAMS_PER_BODY * nb;
+    for k in 0..nb {
+        let i = k + 1;
+        let mut forces = force_regressor(
+            c,
+            workspace.angular_velocity[i],
+            workspace.angular_acceleration[i],
+            workspace.linear_acceleration[i],
+        );
+        let mut body = i;
+        loop {
+            for (p, f) in forces.iter().enumerate() {
+                for (r, x) in f.to_array().into_iter().enumerate() {
+                    w[(6 * (body - 1) + r) * cols + PARAMS_PER_BODY * k + p] = x;
+                }
+            }
+            let parent = multibody.joints[body - 1].parent;
+            if parent == 0 {
+                break;
+            }
+            let x = workspace.placement[body];
+            for f in forces.iter_mut() {
+                *f = x.force_to_parent(*f);
+            }
+            body = parent;
+        }
+    }
+}

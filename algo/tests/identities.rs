@@ -6,8 +6,8 @@
 //! finite difference of the placement).
 
 use dyngen_algo::{
-    aba, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, rnea, JointType, Multibody, ReferenceFrame,
-    Se3, Workspace,
+    aba, body_motions, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, joint_wrench_regressor, rnea,
+    JointType, Multibody, ReferenceFrame, Se3, Workspace,
 };
 use dyngen_model::{load_robot, load_urdf_options, LoadOptions};
 use rand::{Rng, SeedableRng};
@@ -110,10 +110,42 @@ fn the_algorithms_agree_with_each_other() {
                 max_diff(&ypi, &tau)
             );
 
+            // The wrench regressor times the parameters is every joint's wrench.
+            let mut w = vec![0.0; 6 * nb * 10 * nb];
+            joint_wrench_regressor(&body, &mut ws, &q, &v, &a, &mut w);
+            rnea(&body, &mut ws, &q, &v, &a, &params, &mut tau);
+            let wrenches: Vec<f64> = ws.force[1..].iter().flat_map(|f| f.to_array()).collect();
+            let wpi: Vec<f64> = (0..6 * nb)
+                .map(|r| (0..10 * nb).map(|c| w[r * 10 * nb + c] * params[c]).sum())
+                .collect();
+            assert!(
+                max_diff(&wpi, &wrenches) < 1e-10,
+                "{name}: W π = f: {:e}",
+                max_diff(&wpi, &wrenches)
+            );
+
+            // The LOCAL Jacobian maps q̇ to the body's own spatial velocity.
+            let mut jac = vec![0.0; 6 * nv];
+            body_motions(&body, &mut ws, &q, &v, &a);
+            frame_jacobian(
+                &body,
+                &ws,
+                nb,
+                &Se3::identity(0.0, 1.0),
+                ReferenceFrame::Local,
+                &mut jac,
+            );
+            let jv: Vec<f64> = (0..6).map(|r| (0..nv).map(|c| jac[r * nv + c] * v[c]).sum()).collect();
+            let own = ws.velocity[nb].to_array();
+            assert!(
+                max_diff(&jv, &own) < 1e-12,
+                "{name}: J v = v_body: {:e}",
+                max_diff(&jv, &own)
+            );
+
             // The LOCAL_WORLD_ALIGNED Jacobian's linear rows are the velocity of the
             // last body's origin: a central difference of its position along a step
             // of the configuration (positions moved by the joint's own rules).
-            let mut jac = vec![0.0; 6 * nv];
             forward_kinematics(&body, &mut ws, &q);
             frame_jacobian(
                 &body,

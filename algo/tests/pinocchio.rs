@@ -5,8 +5,8 @@
 //! frame Jacobians against Pinocchio's numbers.
 
 use dyngen_algo::{
-    aba, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, rnea, Multibody, ReferenceFrame, Se3,
-    Workspace,
+    aba, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, joint_wrench_regressor, rnea, Multibody,
+    ReferenceFrame, Se3, Workspace,
 };
 use dyngen_model::{load_urdf_options, LoadOptions, Model};
 use serde_json::Value;
@@ -124,6 +124,12 @@ fn check(name: &str) -> Worst {
         if let Some(f) = s.get("f") {
             let ours: Vec<f64> = ws.force[1..].iter().flat_map(|f| f.to_array()).collect();
             worst.add("joint wrenches", &ours, &nums(f));
+            let mut w = vec![0.0; 6 * nb * 10 * nb];
+            joint_wrench_regressor(&body, &mut ws, &q, &v, &a, &mut w);
+            let wpi: Vec<f64> = (0..6 * nb)
+                .map(|r| (0..10 * nb).map(|c| w[r * 10 * nb + c] * params[c]).sum())
+                .collect();
+            worst.add("joint wrench regressor · π", &wpi, &nums(f));
         }
         if let Some(theirs) = s.get("Y") {
             let mut y = vec![0.0; nv * 10 * nb];

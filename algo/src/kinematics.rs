@@ -9,7 +9,7 @@ use crate::Real;
 pub(crate) fn check_len<S>(what: &str, x: &[S], expected: usize) {
     assert!(
         x.len() == expected,
-        "`{what}` has {} entries; the multibody needs {expected}",
+        "`{what}` has {} entries; the model needs {expected}",
         x.len()
     );
 }

@@ -22,14 +22,14 @@ pub trait Dynamics: Sync {
     /// The checked model, gravity included: the description the algorithms use.
     fn model(&self) -> &Model;
 
-    /// Number of velocity (= position) coordinates `n`.
+    /// Number of velocity coordinates (`n` when every joint has one coordinate).
     fn nv(&self) -> usize {
-        self.model().dof()
+        self.model().nv()
     }
 
-    /// Number of standard parameters, `10 n`.
+    /// Number of standard parameters, 10 per moving body.
     fn nparams(&self) -> usize {
-        10 * self.nv()
+        10 * self.model().dof()
     }
 
     /// Inverse dynamics `tau = M(q) a + C(q, v) v + g(q)`. `q, v, a, tau`: `n`;

@@ -14,7 +14,7 @@
 //! [`Reference::body_resultants`] the right-hand side, computed literally from the
 //! graph matrices `S` and `c_ia` and the joint reactions of the RNEA.
 
-use super::spatial::{mat3, vec3, Transform};
+use super::spatial::{mat3, vec3};
 use super::Reference;
 use dyngen::Wrench;
 use dyngen_model::graph;
@@ -57,7 +57,7 @@ impl Reference {
         let poses = self.forward_kinematics(q);
         let motions = self.body_motions(q, v, a);
         let gravity = vec3(&self.model.gravity);
-        (0..self.nq())
+        (0..self.bodies())
             .map(|k| {
                 let frame = &self.frames[k];
                 // Body axes → principal axes.
@@ -112,7 +112,7 @@ impl Reference {
     /// wrench columns, `dyngen_identify::data`). Only `q` enters (the geometry). Panics if a
     /// length differs.
     pub fn resultants_of_joint_wrenches(&self, q: &[f64], wrenches: &[Wrench<f64>]) -> Vec<Wrench<f64>> {
-        assert_eq!(wrenches.len(), self.nq(), "one joint wrench per joint");
+        assert_eq!(wrenches.len(), self.bodies(), "one joint wrench per joint");
         let resultants = self.resultants_in_body_frames(q, wrenches);
         resultants[1..]
             .iter()
@@ -131,10 +131,18 @@ impl Reference {
     /// base included), in each body's own frame, moment about its centre of mass
     /// (about the base frame origin for body 0).
     fn resultants_in_body_frames(&self, q: &[f64], reactions: &[Wrench<f64>]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
-        let n = self.nq();
+        let n = self.bodies();
         let s = graph::incidence(&self.model);
         let c = graph::body_joint_vectors(&self.model);
-        let placements: Vec<Transform> = (1..=n).map(|j| self.joint_placement(j, q[j - 1])).collect();
+        let mut ws = dyngen_algo::Workspace::new(self.multibody(), ());
+        dyngen_algo::forward_kinematics(self.multibody(), &mut ws, q);
+        let placements: Vec<(Matrix3<f64>, Vector3<f64>)> = ws.placement[1..]
+            .iter()
+            .map(|p| {
+                let x = p.se3(0.0, 1.0);
+                (mat3(&x.rotation), vec3(&x.translation))
+            })
+            .collect();
 
         let mut resultants = vec![(Vector3::zeros(), Vector3::zeros()); n + 1];
         for (i, (force_i, moment_i)) in resultants.iter_mut().enumerate() {
@@ -148,11 +156,11 @@ impl Reference {
                 let (force, moment) = if i == joint {
                     (reaction.force, reaction.torque)
                 } else {
-                    let placement = &placements[joint - 1];
+                    let (rotation, translation) = &placements[joint - 1];
                     let inboard_point = vec3(&self.model.joints[joint - 1].origin.translation);
-                    let z = placement.translation - inboard_point;
-                    let force = placement.rotation * reaction.force;
-                    (force, placement.rotation * reaction.torque + z.cross(&force))
+                    let z = translation - inboard_point;
+                    let force = rotation * reaction.force;
+                    (force, rotation * reaction.torque + z.cross(&force))
                 };
                 let c_ia = vec3(&c[i][joint - 1]);
                 *force_i += sign * force;

@@ -636,7 +636,7 @@ fn perturbed_params_are_physically_consistent_and_centred_on_nominal() {
 // ---------------------------------------------------------------- misuse
 
 #[test]
-#[should_panic(expected = "`v` has length 1, the model needs 2")]
+#[should_panic(expected = "`v` has 1 entries; the model needs 2")]
 fn wrong_length_panics_with_the_argument_name() {
     let model = random_tree(1, &[0, 1]);
     let reference = Reference::new(&model);
@@ -644,7 +644,7 @@ fn wrong_length_panics_with_the_argument_name() {
 }
 
 #[test]
-#[should_panic(expected = "`params` has length 10, the model needs 20")]
+#[should_panic(expected = "`params` has 10 entries; the model needs 20")]
 fn wrong_parameter_count_panics() {
     let model = random_tree(1, &[0, 1]);
     let zero = [0.0, 0.0];

@@ -28,6 +28,7 @@ mod ir;
 pub mod joint_params;
 pub mod math;
 pub mod mjcf;
+mod mjcf_mesh;
 mod multibody;
 pub mod names;
 pub mod principal;

@@ -5,10 +5,11 @@
 //!
 //! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree
 //! inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia
-//! settotalmass>` (MuJoCo's default angle unit is the degree), `<option gravity>`
-//! and its `<flag gravity="disable">` (no gravity),
-//! `<default>` classes (nested, `class` on joints, geoms and sites, `childclass` on
-//! bodies) for joint, geom and site attributes, `<worldbody>` with nested `<body name
+//! settotalmass meshdir assetdir strippath>` (MuJoCo's default angle unit is the
+//! degree), `<option gravity>` and its `<flag gravity="disable">` (no gravity),
+//! `<default>` classes (nested, `class` on joints, geoms, sites and meshes,
+//! `childclass` on bodies) for joint, geom, site and mesh attributes, `<asset><mesh>`
+//! (below), `<worldbody>` with nested `<body name
 //! pos quat|euler|axisangle|xyaxes|zaxis>`, `<inertial pos mass diaginertia (with an
 //! orientation) | fullinertia (without one)>`, any number of `<joint
 //! type="hinge|slide|ball|free" pos axis range limited ref damping frictionloss
@@ -51,9 +52,11 @@
 //! (`size` r), capsule or cylinder (`size` r, half length; or `fromto` and r), box
 //! (half sizes; with `fromto`, `size[0]` for x and y and half the length for z) or
 //! ellipsoid (semi-axes, `fromto` as the box), at its `pos` and orientation (or
-//! `fromto`'s middle, `z` along it), combined about their common centre of mass.
-//! Mesh, sdf, plane and hfield geoms that would give a body its inertia, and
-//! `shellinertia="true"`, are refused naming the geom and line. Then each body's
+//! `fromto`'s middle, `z` along it), combined about their common centre of mass; or
+//! a mesh (below). Sdf, plane and hfield geoms that would give a body its inertia, a
+//! primitive geom naming a `mesh` (MuJoCo fits it to the mesh) and
+//! `shellinertia="true"` (which MuJoCo refuses on a mesh geom) are refused naming
+//! the geom and line. Then each body's
 //! mass is raised to `boundmass` and its principal moments to `boundinertia`
 //! (MuJoCo leaves a body without mass of its own with its inertial frame at the
 //! numbers of its `pos`, so the mass `boundmass` gives it sits there too); with
@@ -61,6 +64,39 @@
 //! mean; last, `settotalmass` scales every body's mass and inertia so that they add
 //! up to it. A moving body with no mass at all is left to the checks of
 //! [`Description::build_checked`].
+//!
+//! ## Meshes
+//!
+//! A `type="mesh"` geom gives the inertia of its `<asset><mesh>` (named by `name`,
+//! else by its file's name without folder and extension), as MuJoCo's compiler makes
+//! it (`mjCMesh::Process` in MuJoCo's `user_mesh.cc`, `mjCGeom::SetInertia` in
+//! `user_objects.cc`; the formulas are in `model/src/mjcf_mesh.rs`):
+//!
+//! - the triangles of `file`, a binary STL (an ASCII STL is refused, as MuJoCo refuses
+//!   it) or a Wavefront OBJ (its first object's triangles and quadrilaterals), found
+//!   at `meshdir` (else `assetdir`) joined with `file` (its folders dropped with
+//!   `strippath`), relative to the model file's folder and never outside it (the
+//!   `<include>` rule; MJCF text read without its file has no folder, so only inline
+//!   meshes); or `vertex` (and `face`, else the convex hull's triangles) inline;
+//! - the vertices in single precision, as MuJoCo keeps them, moved by `refpos`,
+//!   turned by `refquat`, scaled by `scale` (a mirroring scale reverses the
+//!   triangles);
+//! - `inertia="legacy"` (MuJoCo's default): tetrahedra from the triangles'
+//!   area-weighted centroid, their volumes taken positive (too much volume for a
+//!   non-convex mesh); `"convex"`: the same over the convex hull (`maxhullvert`,
+//!   which stops MuJoCo's hull early, is refused); `"exact"`: signed tetrahedra, for
+//!   a closed mesh with outward triangles; `"shell"`: unit surface density on the
+//!   triangles;
+//! - mass: the geom's `mass`, else `density` times the volume (area for a shell);
+//!   the inertia about the centre of mass through MuJoCo's eigen decomposition and
+//!   box of equal inertia; the geom's `pos` and orientation place the mesh frame.
+//!
+//! Refused, each naming the `<mesh>`, its line and the file as written: a file that
+//! is missing, unreadable, of another format (`.msh` included), an OBJ without faces
+//! or with faces of more than 4 vertices, a path out of the model's folder, and a
+//! mesh MuJoCo refuses (no area, no volume in a volume mode, inside out with
+//! `exact`, an inertia breaking the triangle inequality). A geom naming an unknown
+//! mesh is refused on its own line.
 //!
 //! # Sites
 //!
@@ -117,8 +153,10 @@
 //! the element and its line: each element of `<equality>` and `<tendon>` (the
 //! dynamics treat the joints as independent), a joint's `stiffness`, a ball joint's
 //! `range`, and every `<compiler>` attribute not read that is not known to leave the
-//! dynamics alone. Cameras, lights, assets, actuators, sensors, geoms of bodies with
-//! an `<inertial>` and the rest are skipped.
+//! dynamics alone (and `exactmeshinertia`, which MuJoCo 4 refuses). Cameras, lights,
+//! assets other than meshes (and meshes that no geom giving an inertia uses),
+//! actuators, sensors, geoms of bodies with an `<inertial>` and the rest are
+//! skipped.
 //!
 //! Siblings are numbered in declaration order, as MuJoCo numbers its bodies. An
 //! element with `name=""` is unnamed, as in MuJoCo (a body `body_ID`, a joint
@@ -147,6 +185,7 @@ use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptio
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math::{self, Mat3, Vec3};
+use crate::mjcf_mesh::{self, MeshInertia, MeshMass, TriMesh};
 use crate::urdf::MAX_FILE_BYTES;
 use crate::xml::{scan, SyntaxError, Tag};
 use std::collections::HashMap;
@@ -387,6 +426,7 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
     let main = path.and_then(|p| std::fs::canonicalize(p).ok());
     let root = includes.add(tags, 0, &mut main.into_iter().collect());
     let Includes {
+        top,
         tags,
         children,
         sources,
@@ -434,6 +474,12 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
         records: Vec::new(),
         sites: Vec::new(),
         uncounted: Vec::new(),
+        folder: top,
+        meshdir: None,
+        assetdir: None,
+        strippath: false,
+        meshes: HashMap::new(),
+        mesh_masses: HashMap::new(),
     };
     reader.errors = include_errors;
     reader.read_document(root);
@@ -456,6 +502,38 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
 
 /// Deepest nesting of `<include>`s: the top-level file's includes are at depth 1.
 pub const MAX_INCLUDE_DEPTH: usize = 8;
+
+/// Why a path named in the model does not name a file inside the model's folder.
+enum PathProblem {
+    /// More `..` than folders: out of the folder.
+    LeadsOut,
+    Absolute,
+    Empty,
+}
+
+/// `path` normalised (`.` dropped, `..` taking back a folder), if it stays inside
+/// the folder it is relative to (checked for links by the caller, on the canonical
+/// path).
+fn inside_folder(path: &Path) -> Result<std::path::PathBuf, PathProblem> {
+    use std::path::Component;
+    let mut relative = std::path::PathBuf::new();
+    for part in path.components() {
+        match part {
+            Component::Normal(p) => relative.push(p),
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !relative.pop() {
+                    return Err(PathProblem::LeadsOut);
+                }
+            }
+            Component::RootDir | Component::Prefix(_) => return Err(PathProblem::Absolute),
+        }
+    }
+    if relative.as_os_str().is_empty() {
+        return Err(PathProblem::Empty);
+    }
+    Ok(relative)
+}
 
 /// Scans MJCF text, its lines counted from `base` (see [`Source`]).
 fn scan_mjcf(text: &str, base: usize) -> Result<Vec<Tag>, Vec<ModelError>> {
@@ -571,33 +649,26 @@ impl Includes {
             return Err(fail(format!("{what} has child elements; an <include> must be empty")));
         }
         // The path, normalised, must stay inside the top-level file's folder.
-        let mut relative = std::path::PathBuf::new();
-        for part in Path::new(&file).components() {
-            use std::path::Component;
-            match part {
-                Component::Normal(p) => relative.push(p),
-                Component::CurDir => {}
-                Component::ParentDir => {
-                    if !relative.pop() {
-                        return Err(fail(format!(
-                            "{what} leads out of the top-level model file's folder; an included file must be in \
-                             that folder or below it, named by a relative path such as `common/materials.xml`"
-                        )));
-                    }
-                }
-                Component::RootDir | Component::Prefix(_) => {
-                    return Err(fail(format!(
-                        "{what} is an absolute path; name the included file by a path relative to the top-level \
-                         model file's folder, such as `common/materials.xml`"
-                    )))
-                }
+        let relative = match inside_folder(Path::new(&file)) {
+            Ok(relative) => relative,
+            Err(PathProblem::LeadsOut) => {
+                return Err(fail(format!(
+                    "{what} leads out of the top-level model file's folder; an included file must be in that \
+                     folder or below it, named by a relative path such as `common/materials.xml`"
+                )))
             }
-        }
-        if relative.as_os_str().is_empty() {
-            return Err(fail(format!(
-                "{what} names no file; name an XML file such as `common/materials.xml`"
-            )));
-        }
+            Err(PathProblem::Absolute) => {
+                return Err(fail(format!(
+                    "{what} is an absolute path; name the included file by a path relative to the top-level model \
+                     file's folder, such as `common/materials.xml`"
+                )))
+            }
+            Err(PathProblem::Empty) => {
+                return Err(fail(format!(
+                    "{what} names no file; name an XML file such as `common/materials.xml`"
+                )))
+            }
+        };
         let path = dir.join(&relative);
         let canonical =
             std::fs::canonicalize(&path).map_err(|e| fail(format!("{what}: cannot read `{}`: {e}", path.display())))?;
@@ -718,7 +789,7 @@ struct Class {
 }
 
 /// Elements whose attributes `<default>` classes give here.
-const CLASS_ELEMENTS: [&str; 3] = ["joint", "geom", "site"];
+const CLASS_ELEMENTS: [&str; 4] = ["joint", "geom", "site", "mesh"];
 
 /// `<compiler inertiafromgeom>`: whether a body's inertial comes from its geoms.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -803,9 +874,22 @@ struct Reader<'t> {
     records: Vec<BodyRecord>,
     /// Named sites with their lines, to tell a site named as a body.
     sites: Vec<(String, usize)>,
-    /// Bodies welded to the world whose geoms' inertia could not be computed (a
-    /// mesh): harmless unless `settotalmass` counts them.
+    /// Bodies welded to the world whose geoms' inertia could not be computed:
+    /// harmless unless `settotalmass` counts them.
     uncounted: Vec<(String, usize)>,
+    /// The top-level file's folder, as written and canonical (`None` for text):
+    /// mesh files are read from it or below it.
+    folder: Option<(std::path::PathBuf, std::path::PathBuf)>,
+    /// `<compiler meshdir>` and `assetdir` (the mesh folder when `meshdir` is not
+    /// given), relative to the model's folder.
+    meshdir: Option<String>,
+    assetdir: Option<String>,
+    /// `<compiler strippath>`: mesh files named without their folders.
+    strippath: bool,
+    /// `<asset><mesh>` elements by name (their tags).
+    meshes: HashMap<String, usize>,
+    /// The mass properties of the meshes computed so far, or why they are refused.
+    mesh_masses: HashMap<String, Result<MeshMass, ModelError>>,
 }
 
 impl<'t> Reader<'t> {
@@ -860,6 +944,11 @@ impl<'t> Reader<'t> {
         );
         for d in self.children_named(root, "default") {
             self.read_default(d, None);
+        }
+        for a in self.children_named(root, "asset") {
+            for m in self.children_named(a, "mesh") {
+                self.read_mesh_asset(m);
+            }
         }
         let world_line = self.children_named(root, "worldbody").first().map(|&w| tags[w].line);
         self.links.push(LinkDesc {
@@ -942,6 +1031,7 @@ impl<'t> Reader<'t> {
             ("autolimits", &mut self.autolimits),
             ("alignfree", &mut self.alignfree),
             ("balanceinertia", &mut balance),
+            ("strippath", &mut self.strippath),
         ] {
             match t.attr(attr) {
                 None => {}
@@ -957,6 +1047,23 @@ impl<'t> Reader<'t> {
             }
         }
         self.mass_rules.balance = balance;
+        if let Some(d) = t.attr("meshdir") {
+            self.meshdir = Some(d.to_string());
+        }
+        if let Some(d) = t.attr("assetdir") {
+            self.assetdir = Some(d.to_string());
+        }
+        if let Some(v) = t.attr("exactmeshinertia") {
+            self.warnings.push(ModelError {
+                element: Element::Robot,
+                line: Some(t.line),
+                kind: ErrorKind::Ignored(format!(
+                    "<compiler exactmeshinertia=\"{v}\"> is not read (MuJoCo 3 deprecated it and MuJoCo 4 refuses \
+                     it); each <mesh>'s `inertia` (convex, exact, legacy or shell; convex by default) says how its \
+                     inertia is computed"
+                )),
+            });
+        }
         match t.attr("inertiafromgeom") {
             None => {}
             Some("true") => self.from_geom = FromGeom::True,
@@ -1012,22 +1119,21 @@ impl<'t> Reader<'t> {
                 )),
             );
         }
-        // Attributes known not to change the dynamics of what is read here (meshes
-        // are refused where they would give an inertia).
-        const HARMLESS: [&str; 11] = [
-            "strippath",
-            "meshdir",
+        // Attributes known not to change the dynamics of what is read here.
+        const HARMLESS: [&str; 7] = [
             "texturedir",
-            "assetdir",
             "discardvisual",
             "usethread",
             "fusestatic",
             "saveinertial",
-            "exactmeshinertia",
             "fitaabb",
             "coordinate",
         ];
-        const READ: [&str; 10] = [
+        const READ: [&str; 14] = [
+            "strippath",
+            "meshdir",
+            "assetdir",
+            "exactmeshinertia",
             "angle",
             "eulerseq",
             "autolimits",
@@ -1819,6 +1925,30 @@ impl<'t> Reader<'t> {
             let geom = t
                 .attr("name")
                 .map_or_else(|| format!("<geom type=\"{kind}\">"), |n| format!("geom `{n}`"));
+            if kind == "mesh" && attr(self, "shellinertia").as_deref() == Some("true") {
+                // MuJoCo: "for mesh geoms, inertia should be specified in the mesh asset".
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} asks for shellinertia=\"true\", which MuJoCo refuses on a mesh geom; give the \
+                         <mesh> inertia=\"shell\" instead"
+                    )),
+                );
+                continue;
+            }
+            if kind != "mesh" && kind != "sdf" && attr(self, "mesh").is_some() {
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::NotSupported(format!(
+                        "{geom} of type `{kind}` names a mesh, which MuJoCo fits the {kind} to (its size and \
+                         placement from the mesh's inertia); that fitting is not done here: give the geom \
+                         type=\"mesh\", or its own size and no mesh"
+                    )),
+                );
+                continue;
+            }
             if attr(self, "shellinertia").as_deref() == Some("true") {
                 self.error(
                     el.clone(),
@@ -1863,6 +1993,15 @@ impl<'t> Reader<'t> {
                         "{geom} has a `fromto`, which only a capsule, cylinder, box or ellipsoid may have"
                     )),
                 );
+                continue;
+            }
+            if kind == "mesh" {
+                if let Some(part) = self.mesh_geom(t, &class, el, &geom, mass, density, (pos, rotation)) {
+                    total = Some(match total {
+                        Some(prev) => prev.combined(&part),
+                        None => part,
+                    });
+                }
                 continue;
             }
             // The half length along z given by fromto.
@@ -1919,7 +2058,7 @@ impl<'t> Reader<'t> {
                 }
                 other => {
                     let why = match other {
-                        "mesh" | "sdf" => "a mesh's inertia is not computed here",
+                        "sdf" => "the inertia of a signed distance field is not computed here",
                         "plane" | "hfield" => "it has no volume",
                         _ => "it is not an MJCF geom type",
                     };
@@ -1969,6 +2108,276 @@ impl<'t> Reader<'t> {
         total.map(symmetric)
     }
 
+    /// A mesh geom's inertial in the body frame: its mesh's volume (or area) and
+    /// inertia for its mass or density, placed by the geom's `pos` and orientation.
+    /// `None`, with the error, when the mesh cannot give it.
+    #[allow(clippy::too_many_arguments)]
+    fn mesh_geom(
+        &mut self,
+        t: &Tag,
+        class: &str,
+        el: &Element,
+        geom: &str,
+        mass: Option<f64>,
+        density: f64,
+        (pos, rotation): (Vec3, Mat3),
+    ) -> Option<Inertial> {
+        let Some(name) = self.class_attr(t, class, "geom", "mesh") else {
+            self.error(
+                el.clone(),
+                t.line,
+                ErrorKind::InvalidMjcf(format!(
+                    "{geom} of type `mesh` names no mesh; give it mesh=\"NAME\" of a <mesh> in <asset>"
+                )),
+            );
+            return None;
+        };
+        if !self.meshes.contains_key(&name) {
+            self.error(
+                el.clone(),
+                t.line,
+                ErrorKind::InvalidMjcf(format!(
+                    "{geom} names mesh `{name}`, which no <mesh> in <asset> defines (a mesh without a name is \
+                     named by its file, without folder and extension)"
+                )),
+            );
+            return None;
+        }
+        let props = match self.mesh_masses.get(&name) {
+            Some(r) => r.clone(),
+            None => {
+                let r = self.mesh_mass(&name);
+                self.mesh_masses.insert(name.clone(), r.clone());
+                r
+            }
+        };
+        let props = match props {
+            Ok(p) => p,
+            Err(e) => {
+                // Once, however many geoms use the mesh.
+                if !self.errors.contains(&e) {
+                    self.errors.push(e);
+                }
+                return None;
+            }
+        };
+        let m = mass.unwrap_or(density * props.measure);
+        let local = Inertial {
+            mass: m,
+            com: props.com,
+            inertia: from_principal(props.moments.map(|x| m * x), &props.axes),
+        };
+        Some(local.transformed(&Placement {
+            rotation,
+            translation: pos,
+        }))
+    }
+
+    /// Notes a `<mesh>` of `<asset>` under its name (its file's name without folder
+    /// and extension when it has none).
+    fn read_mesh_asset(&mut self, k: usize) {
+        let t = &self.tags[k];
+        let name = match (t.attr("name"), t.attr("file")) {
+            (Some(n), _) => n.to_string(),
+            (None, Some(f)) => {
+                let base = f.rsplit(['/', '\\']).next().unwrap_or(f);
+                base.rsplit_once('.').map_or(base, |(stem, _)| stem).to_string()
+            }
+            (None, None) => return,
+        };
+        if let Some(&earlier) = self.meshes.get(&name) {
+            let at = self.tags[earlier].line;
+            self.error(
+                Element::Robot,
+                t.line,
+                ErrorKind::InvalidMjcf(format!(
+                    "<mesh> `{name}` is defined twice (first on line {at}); MuJoCo refuses repeated names: rename one"
+                )),
+            );
+            return;
+        }
+        self.meshes.insert(name, k);
+    }
+
+    /// The mass properties of mesh `name`, as MuJoCo's compiler makes them, or why
+    /// they cannot be had (an error on the `<mesh>`'s line).
+    fn mesh_mass(&mut self, name: &str) -> Result<MeshMass, ModelError> {
+        let k = self.meshes[name];
+        let tags = self.tags;
+        let t = &tags[k];
+        let el = Element::Robot;
+        let class = match t.attr("class") {
+            Some(c) if self.classes.contains_key(c) => c.to_string(),
+            Some(c) => return Err(mesh_error(t.line, ErrorKind::UnknownClass(c.to_string()))),
+            None => "main".to_string(),
+        };
+        let file = t.attr("file");
+        let what = match file {
+            Some(f) => format!("<mesh name=\"{name}\" file=\"{f}\">"),
+            None => format!("<mesh name=\"{name}\">"),
+        };
+        let invalid = |message: String| mesh_error(t.line, ErrorKind::InvalidMjcf(format!("{what}: {message}")));
+        let mode = match self.class_attr(t, &class, "mesh", "inertia") {
+            None => MeshInertia::Legacy,
+            Some(v) => MeshInertia::parse(&v).ok_or_else(|| {
+                invalid(format!(
+                    "inertia=\"{v}\" is not `convex`, `exact`, `legacy` or `shell` (MuJoCo's mesh inertia rules)"
+                ))
+            })?,
+        };
+        let mut vector = |attr: &str, count: usize, default: &[f64]| -> Result<Vec<f64>, ModelError> {
+            match self.class_attr(t, &class, "mesh", attr) {
+                None => Ok(default.to_vec()),
+                Some(v) => {
+                    let before = self.errors.len();
+                    let parsed = self.parse_numbers(t, attr, &v, count, &el);
+                    match parsed {
+                        Some(x) if x.iter().all(|x| x.is_finite()) => Ok(x),
+                        _ => {
+                            let why = self.errors.drain(before..).next().map_or_else(
+                                || format!("{attr}=\"{v}\" is not {count} finite numbers"),
+                                |e| e.kind.to_string(),
+                            );
+                            Err(invalid(why))
+                        }
+                    }
+                }
+            }
+        };
+        let scale = vector("scale", 3, &[1.0; 3])?;
+        let refpos = vector("refpos", 3, &[0.0; 3])?;
+        let refquat = vector("refquat", 4, &[1.0, 0.0, 0.0, 0.0])?;
+        let scale = [scale[0], scale[1], scale[2]];
+        if refquat.iter().all(|&q| q == 0.0) {
+            return Err(invalid("refquat=\"0 0 0 0\" is not a rotation".into()));
+        }
+        // A mirroring scale turns the triangles inside out: MuJoCo reverses them as it reads them.
+        let flip = scale[0] * scale[1] * scale[2] < 0.0;
+        let inline = t.attr("vertex");
+        let mut mesh = match (file, inline) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "gives both `file` and `vertex` (MuJoCo refuses the repeated vertex specification); keep one"
+                        .into(),
+                ))
+            }
+            (None, None) => {
+                return Err(invalid(
+                    "has neither `file` nor `vertex`; name an STL or OBJ file, or give the vertices".into(),
+                ))
+            }
+            (Some(f), None) => self.mesh_file(f, flip).map_err(invalid)?,
+            (None, Some(v)) => inline_mesh(v, t.attr("face")).map_err(invalid)?,
+        };
+        if mode == MeshInertia::Convex {
+            if let Some(v) = self
+                .class_attr(t, &class, "mesh", "maxhullvert")
+                .filter(|v| v.trim() != "-1")
+            {
+                return Err(mesh_error(
+                    t.line,
+                    ErrorKind::NotSupported(format!(
+                        "{what}: maxhullvert=\"{v}\" stops MuJoCo's hull (qhull) early, which changes the inertia \
+                         of inertia=\"convex\" in a way not reproduced here; remove maxhullvert, or choose another \
+                         inertia"
+                    )),
+                ));
+            }
+        }
+        // No faces (vertices alone), or the convex mode: the convex hull, built on
+        // the vertices as read (as MuJoCo builds it) and turned outwards after the
+        // transformation (a mirroring scale turns it inside out).
+        let needs_hull = mode == MeshInertia::Convex || mesh.faces.is_empty();
+        let mut hull = if needs_hull {
+            Some(mjcf_mesh::convex_hull(&mesh.vertices).map_err(invalid)?)
+        } else {
+            None
+        };
+        mjcf_mesh::transform(
+            &mut mesh,
+            [refpos[0], refpos[1], refpos[2]],
+            [refquat[0], refquat[1], refquat[2], refquat[3]],
+            scale,
+        );
+        if flip {
+            for f in hull.iter_mut().flatten() {
+                f.swap(1, 2);
+            }
+        }
+        if mesh.faces.is_empty() {
+            mesh.faces = hull.clone().unwrap_or_default();
+        }
+        mjcf_mesh::mass_properties(&mesh, mode, hull.as_deref()).map_err(invalid)
+    }
+
+    /// Reads mesh file `file` (relative to `meshdir`, in the model's folder or below).
+    fn mesh_file(&self, file: &str, flip: bool) -> Result<TriMesh, String> {
+        let Some((dir, canonical_dir)) = self.folder.clone() else {
+            return Err(
+                "MJCF text read without its file has no folder to read the mesh file from; load the model from \
+                 its file (load_mjcf)"
+                    .into(),
+            );
+        };
+        let file = if self.strippath {
+            file.rsplit(['/', '\\']).next().unwrap_or(file)
+        } else {
+            file
+        };
+        let folder = self.meshdir.as_deref().or(self.assetdir.as_deref()).unwrap_or("");
+        let joined = Path::new(folder).join(file);
+        let shown = joined.display().to_string();
+        let relative = inside_folder(&joined).map_err(|p| match p {
+            PathProblem::LeadsOut => format!(
+                "`{shown}` leads out of the model file's folder; a mesh file must be in that folder or below it"
+            ),
+            PathProblem::Absolute => format!(
+                "`{shown}` is an absolute path; name the mesh file by a path relative to the model file's folder \
+                 (and <compiler meshdir>)"
+            ),
+            PathProblem::Empty => "names no file".to_string(),
+        })?;
+        let extension = relative
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if !matches!(extension.as_str(), "stl" | "obj") {
+            return Err(if extension == "msh" {
+                format!(
+                    "`{shown}` is in MuJoCo's own binary .msh format, which is not read here; convert it to STL or OBJ"
+                )
+            } else {
+                format!(
+                    "`{shown}` is not an STL or OBJ file (by its extension); MuJoCo reads .stl, .obj and .msh meshes"
+                )
+            });
+        }
+        let path = dir.join(&relative);
+        let canonical = std::fs::canonicalize(&path).map_err(|e| format!("cannot read `{shown}`: {e}"))?;
+        if !canonical.starts_with(&canonical_dir) {
+            return Err(format!(
+                "`{shown}` leads (through a link) out of the model file's folder; a mesh file must be in that folder \
+                 or below it"
+            ));
+        }
+        let mut bytes = Vec::new();
+        std::fs::File::open(&path)
+            .and_then(|f| f.take(mjcf_mesh::MAX_MESH_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| format!("cannot read `{shown}`: {e}"))?;
+        if bytes.len() as u64 > mjcf_mesh::MAX_MESH_BYTES {
+            return Err(format!(
+                "`{shown}` is larger than the {} MiB read for a mesh",
+                mjcf_mesh::MAX_MESH_BYTES >> 20
+            ));
+        }
+        let read = if extension == "stl" {
+            mjcf_mesh::read_stl(&bytes, flip)
+        } else {
+            mjcf_mesh::read_obj(&bytes, flip)
+        };
+        read.map_err(|e| format!("`{shown}`: {e}"))
+    }
+
     /// MuJoCo's `boundmass`, `boundinertia`, `balanceinertia` on each body's
     /// principal moments, then `settotalmass` over all bodies; each inertial then
     /// moved into its link frame.
@@ -2006,7 +2415,8 @@ impl<'t> Reader<'t> {
                     line: Some(*line),
                     kind: ErrorKind::NotSupported(format!(
                         "<compiler settotalmass> counts the mass of body `{body}`, whose geoms' inertia is not \
-                         computed here (a mesh); give the body an <inertial>"
+                         computed here (an sdf, plane or hfield geom, or a mesh that cannot be read); give the body \
+                         an <inertial>"
                     )),
                 });
             }
@@ -2130,4 +2540,47 @@ fn zaxis(z: &Vec3) -> Mat3 {
         };
     }
     axis_angle(&math::scale(1.0 / s, &axis), s.atan2(z[2]))
+}
+
+/// An error about a `<mesh>` asset, on its line.
+fn mesh_error(line: usize, kind: ErrorKind) -> ModelError {
+    ModelError {
+        element: Element::Robot,
+        line: Some(line),
+        kind,
+    }
+}
+
+/// A mesh given in the XML: `vertex` (three numbers a vertex, kept in single
+/// precision as MuJoCo keeps them) and, if given, `face` (three vertex indices a
+/// triangle); without faces MuJoCo takes the convex hull's.
+fn inline_mesh(vertex: &str, face: Option<&str>) -> Result<TriMesh, String> {
+    let numbers: Vec<Option<f32>> = vertex.split_whitespace().map(|w| w.parse().ok()).collect();
+    if numbers.iter().any(Option::is_none) || !numbers.len().is_multiple_of(3) || numbers.is_empty() {
+        return Err(format!(
+            "vertex=\"{vertex}\" is not a list of numbers, three for each vertex"
+        ));
+    }
+    let vertices: Vec<Vec3> = numbers
+        .chunks_exact(3)
+        .map(|c| [0, 1, 2].map(|i| f64::from(c[i].unwrap_or(0.0))))
+        .collect();
+    if vertices.iter().flatten().any(|x| !x.is_finite()) {
+        return Err("a vertex is not a finite number".into());
+    }
+    let mut faces = Vec::new();
+    if let Some(face) = face {
+        let indices: Vec<Option<usize>> = face.split_whitespace().map(|w| w.parse().ok()).collect();
+        if indices.iter().any(|i| !matches!(i, Some(i) if *i < vertices.len())) || !indices.len().is_multiple_of(3) {
+            return Err(format!(
+                "face=\"{face}\" is not a list of vertex indices (0 to {}), three for each triangle",
+                vertices.len().saturating_sub(1)
+            ));
+        }
+        faces = indices
+            .chunks_exact(3)
+            .map(|c| [c[0].unwrap_or(0), c[1].unwrap_or(0), c[2].unwrap_or(0)])
+            .collect();
+    }
+    Ok(TriMesh { vertices, faces })
 }

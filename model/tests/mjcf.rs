@@ -1550,11 +1550,18 @@ fn compiler_attributes_not_read_are_warned() {
 fn geoms_that_cannot_give_an_inertia_are_refused() {
     let body = |geom: &str| mjcf(&["<body name=\"a\">", "<joint name=\"j\"/>", geom, "</body>"]);
     only_error(
+        &body("<geom name=\"field\" type=\"sdf\" mesh=\"m\"/>"),
+        Element::Link("a".into()),
+        5,
+        "geom `field` of type `sdf` would give the body its inertia (<compiler inertiafromgeom>), but the \
+         inertia of a signed distance field is not computed here; give the body an <inertial>",
+    );
+    // A mesh's is (`tests/mjcf_mesh.rs`), from a <mesh> of <asset>.
+    only_error(
         &body("<geom name=\"shell\" type=\"mesh\" mesh=\"m\"/>"),
         Element::Link("a".into()),
         5,
-        "geom `shell` of type `mesh` would give the body its inertia (<compiler inertiafromgeom>), but a mesh's \
-         inertia is not computed here; give the body an <inertial>",
+        "geom `shell` names mesh `m`, which no <mesh> in <asset> defines",
     );
     only_error(
         &body("<geom type=\"box\" size=\"0.1 0.1 0.1\" shellinertia=\"true\"/>"),

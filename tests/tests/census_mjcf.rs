@@ -47,11 +47,11 @@ const FILES: [&str; 19] = [
 
 /// Files refused, with a part of the (first) error's message.
 const REFUSED: &[(&str, &str)] = &[
-    // The dog's bones are meshes whose inertia MuJoCo computes from the STL files
-    // (not copied here, and not read by dyngen).
+    // The dog's bones are meshes whose inertia MuJoCo computes from the STL files,
+    // which are not copied here.
     (
         "dog",
-        "line 343: link `L_1`: geom `L_1` of type `mesh` would give the body its inertia",
+        "line 166: robot: <mesh name=\"C_1\" file=\"BONEC_1.stl\">: cannot read `dog_assets/BONEC_1.stl`",
     ),
     // A template the Python task fills in: no body moves.
     ("lqr", "has no moving joint"),

@@ -1,0 +1,374 @@
+//! Inertia of MJCF mesh geoms: the models of `tests/fixtures/mjcf_mesh/` (binary STL
+//! and OBJ meshes in each of MuJoCo's `inertia` modes, scaled, moved, with `mass`,
+//! given inline) give MuJoCo's body masses, centres of mass and inertias and its mass
+//! matrix and bias forces (`scripts/make_mjcf_mesh_fixtures.py`), and each refused
+//! mesh names its element, line and file.
+
+use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
+use dyngen_model::{load_mjcf, parse_mjcf, Model};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/mjcf_mesh")
+        .join(name)
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    match v {
+        Value::Array(a) => a.iter().flat_map(numbers).collect(),
+        Value::Number(x) => vec![x.as_f64().unwrap()],
+        _ => panic!("not a number: {v}"),
+    }
+}
+
+/// Largest `|a - b|` over the largest `|b|`.
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
+}
+
+/// The largest relative difference from MuJoCo's of the bodies' masses, centres of
+/// mass and inertias, and of `M` and the bias over the fixture's states.
+fn against_mujoco(name: &str) -> (f64, f64) {
+    let model: Model = load_mjcf(&fixture(&format!("{name}.xml"))).unwrap();
+    let text = std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let mut inertial = 0.0f64;
+    for b in reference["bodies"].as_array().unwrap() {
+        let body = b["name"].as_str().unwrap();
+        let ours = &model.bodies.iter().find(|x| x.name == body).unwrap().inertial;
+        let mass = b["mass"].as_f64().unwrap();
+        let d = [
+            (ours.mass - mass).abs() / mass,
+            relative(&ours.com, &numbers(&b["com"])),
+            relative(&ours.inertia.concat(), &numbers(&b["inertia"])),
+        ];
+        eprintln!(
+            "{name}: {body}: mass {:.1e}, com {:.1e}, inertia {:.1e}",
+            d[0], d[1], d[2]
+        );
+        inertial = d.iter().fold(inertial, |m, x| m.max(*x));
+    }
+    let mut dynamics = 0.0f64;
+    for s in reference["samples"].as_array().unwrap() {
+        let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        let m: Vec<f64> = mass_matrix(&model, &q).unwrap().concat();
+        let bias = inverse_dynamics(&model, &q, &v, &vec![0.0; model.nv()]).unwrap();
+        dynamics = dynamics
+            .max(relative(&m, &numbers(&s["M"])))
+            .max(relative(&bias, &numbers(&s["bias"])));
+    }
+    eprintln!("{name}: inertials within {inertial:.1e}, M and bias within {dynamics:.1e} (relative)");
+    (inertial, dynamics)
+}
+
+#[test]
+fn each_inertia_mode_gives_mujocos_inertia() {
+    let (inertial, dynamics) = against_mujoco("modes");
+    assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
+}
+
+#[test]
+fn scaled_moved_weighed_and_inline_meshes_give_mujocos_inertia() {
+    let (inertial, dynamics) = against_mujoco("scaled");
+    assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
+}
+
+/// A folder of its own, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(format!("dyngen-mesh-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+
+    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
+        let path = self.0.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A model whose body `b` (on a hinge) has one mesh geom of the mesh given by the
+/// `<mesh>` element `mesh` (line 3 of `top.xml`; the geom is on line 7).
+fn model_with(mesh: &str) -> String {
+    format!(
+        "<mujoco model=\"t\">\n<asset>\n{mesh}\n</asset>\n<worldbody>\n<body name=\"b\"><joint name=\"j\"/>\n\
+         <geom type=\"mesh\" mesh=\"m\"/>\n</body>\n</worldbody>\n</mujoco>\n"
+    )
+}
+
+/// The refusal of the model in `dir`'s `top.xml`: its only error, on `line`, saying `says`.
+fn refusal(top: &Path, line: usize, says: &str) -> String {
+    let e = load_mjcf(top).expect_err("should be refused");
+    assert_eq!(e.errors.len(), 1, "{e}");
+    assert_eq!(e.errors[0].line, Some(line), "{e}");
+    let message = e.to_string();
+    assert!(message.contains(&format!("top.xml:{line}: ")), "{message}");
+    assert!(message.contains(says), "{message}");
+    message
+}
+
+fn box_stl() -> Vec<u8> {
+    std::fs::read(fixture("meshes/box.stl")).unwrap()
+}
+
+#[test]
+fn a_missing_mesh_file_is_refused_naming_it() {
+    let dir = TempDir::new("missing");
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"parts/gone.stl\"/>").as_bytes(),
+    );
+    refusal(
+        &top,
+        3,
+        "<mesh name=\"m\" file=\"parts/gone.stl\">: cannot read `parts/gone.stl`",
+    );
+    // With meshdir, the path as resolved against it.
+    let text =
+        model_with("<mesh name=\"m\" file=\"gone.stl\"/>").replace("<asset>", "<compiler meshdir=\"parts\"/><asset>");
+    let top = dir.write("top.xml", text.as_bytes());
+    refusal(&top, 3, "cannot read `parts/gone.stl`");
+}
+
+#[test]
+fn a_mesh_file_outside_the_models_folder_is_refused() {
+    let dir = TempDir::new("outside");
+    dir.write("box.stl", &box_stl());
+    let top = dir.write(
+        "model/top.xml",
+        model_with("<mesh name=\"m\" file=\"../box.stl\"/>").as_bytes(),
+    );
+    refusal(&top, 3, "`../box.stl` leads out of the model file's folder");
+    let text =
+        model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("<asset>", "<compiler meshdir=\"..\"/><asset>");
+    let top = dir.write("model/top.xml", text.as_bytes());
+    refusal(&top, 3, "`../box.stl` leads out of the model file's folder");
+    let absolute = dir.0.join("box.stl");
+    let text = model_with(&format!("<mesh name=\"m\" file=\"{}\"/>", absolute.display()));
+    let top = dir.write("model/top.xml", text.as_bytes());
+    refusal(&top, 3, "is an absolute path");
+    // Nor through a link.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.0.join("box.stl"), dir.0.join("model/link.stl")).unwrap();
+        let top = dir.write(
+            "model/top.xml",
+            model_with("<mesh name=\"m\" file=\"link.stl\"/>").as_bytes(),
+        );
+        refusal(
+            &top,
+            3,
+            "`link.stl` leads (through a link) out of the model file's folder",
+        );
+    }
+}
+
+#[test]
+fn a_corrupt_or_ascii_stl_is_refused() {
+    let dir = TempDir::new("corrupt");
+    let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"bad.stl\"/>").as_bytes());
+    // Cut short: the header's count of triangles does not fit the size.
+    let stl = box_stl();
+    dir.write("bad.stl", &stl[..stl.len() - 7]);
+    refusal(
+        &top,
+        3,
+        "`bad.stl`: its header counts 12 triangles, which take 684 bytes, but the file has 677",
+    );
+    dir.write("bad.stl", b"");
+    refusal(&top, 3, "`bad.stl`: the file is empty");
+    dir.write("bad.stl", &[0u8; 40]);
+    refusal(&top, 3, "shorter than the 84-byte header");
+    // MuJoCo reads no ASCII STL.
+    let ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n\
+                 endfacet\nendsolid t\n";
+    dir.write("bad.stl", ascii.as_bytes());
+    refusal(&top, 3, "an ASCII STL file, which MuJoCo does not read");
+}
+
+#[test]
+fn unsupported_mesh_formats_are_refused() {
+    let dir = TempDir::new("format");
+    dir.write("m.msh", &[0u8; 64]);
+    let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.msh\"/>").as_bytes());
+    refusal(
+        &top,
+        3,
+        "`m.msh` is in MuJoCo's own binary .msh format, which is not read here",
+    );
+    dir.write("m.ply", b"ply\n");
+    let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.ply\"/>").as_bytes());
+    refusal(&top, 3, "`m.ply` is not an STL or OBJ file");
+    dir.write("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n");
+    let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.obj\"/>").as_bytes());
+    refusal(&top, 3, "`m.obj`: it has no faces");
+    dir.write("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3 4 5\n");
+    refusal(
+        &top,
+        3,
+        "face 1 has 5 vertices; MuJoCo reads OBJ faces of 3 or 4 vertices only",
+    );
+}
+
+#[test]
+fn a_mesh_without_volume_is_refused_in_a_volume_mode() {
+    let dir = TempDir::new("flat");
+    // A single triangle: area, but no volume (and a flat hull).
+    let mut stl = vec![b' '; 80];
+    stl.extend(1u32.to_le_bytes());
+    for x in [0.0f32, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        stl.extend(x.to_le_bytes());
+    }
+    stl.extend([0, 0]);
+    dir.write("flat.stl", &stl);
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"flat.stl\" inertia=\"exact\"/>").as_bytes(),
+    );
+    refusal(&top, 3, "its volume is zero or too small");
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"flat.stl\" inertia=\"convex\"/>").as_bytes(),
+    );
+    refusal(&top, 3, "its convex hull needs at least 4 distinct vertices");
+    // MuJoCo's default (legacy) too.
+    let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"flat.stl\"/>").as_bytes());
+    refusal(&top, 3, "its volume is zero or too small");
+    // Inside out, in the exact mode.
+    let mut stl = box_stl();
+    for t in 0..12 {
+        let at = 84 + 50 * t + 24;
+        let second: Vec<u8> = stl[at..at + 12].to_vec();
+        let third: Vec<u8> = stl[at + 12..at + 24].to_vec();
+        stl[at..at + 12].copy_from_slice(&third);
+        stl[at + 12..at + 24].copy_from_slice(&second);
+    }
+    dir.write("inside_out.stl", &stl);
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"inside_out.stl\" inertia=\"exact\"/>").as_bytes(),
+    );
+    refusal(&top, 3, "its volume is negative");
+}
+
+#[test]
+fn mesh_attributes_and_geoms_are_checked() {
+    let dir = TempDir::new("attributes");
+    dir.write("box.stl", &box_stl());
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"box.stl\" inertia=\"solid\"/>").as_bytes(),
+    );
+    refusal(
+        &top,
+        3,
+        "inertia=\"solid\" is not `convex`, `exact`, `legacy` or `shell`",
+    );
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"m\" file=\"box.stl\" scale=\"1 2\"/>").as_bytes(),
+    );
+    refusal(&top, 3, "<mesh name=\"m\" file=\"box.stl\">: ");
+    let top = dir.write(
+        "top.xml",
+        model_with("<mesh name=\"other\" file=\"box.stl\"/>").as_bytes(),
+    );
+    refusal(&top, 7, "names mesh `m`, which no <mesh> in <asset> defines");
+    let text =
+        model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("mesh=\"m\"/>", "mesh=\"m\" shellinertia=\"true\"/>");
+    let top = dir.write("top.xml", text.as_bytes());
+    refusal(
+        &top,
+        7,
+        "which MuJoCo refuses on a mesh geom; give the <mesh> inertia=\"shell\" instead",
+    );
+    let text = model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("type=\"mesh\"", "type=\"box\"");
+    let top = dir.write("top.xml", text.as_bytes());
+    refusal(&top, 7, "of type `box` names a mesh, which MuJoCo fits the box to");
+    // Text without its file has no folder for the mesh file; an inline mesh needs none.
+    let e = parse_mjcf(&model_with("<mesh name=\"m\" file=\"box.stl\"/>")).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("line 3: robot: <mesh name=\"m\" file=\"box.stl\">: MJCF text read without its file"),
+        "{e}"
+    );
+    let inline = "<mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\"/>";
+    let model = parse_mjcf(&model_with(inline)).unwrap();
+    // The unit right tetrahedron: volume 1/6, centre at 1/4.
+    let i = &model.bodies[0].inertial;
+    assert!((i.mass - 1000.0 / 6.0).abs() < 1e-9, "{}", i.mass);
+    assert!(i.com.iter().all(|c| (c - 0.25).abs() < 1e-12), "{:?}", i.com);
+}
+
+#[test]
+fn a_mesh_in_an_included_file_is_read_from_the_models_folder() {
+    let dir = TempDir::new("include");
+    dir.write("meshes/box.stl", &box_stl());
+    dir.write(
+        "parts/assets.xml",
+        b"<mujoco>\n<asset>\n<mesh name=\"m\" file=\"meshes/box.stl\"/>\n<mesh name=\"n\" file=\"gone.stl\"/>\n</asset>\n</mujoco>\n",
+    );
+    let top = dir.write(
+        "top.xml",
+        b"<mujoco model=\"t\">\n<include file=\"parts/assets.xml\"/>\n<worldbody>\n<body name=\"b\"><joint name=\"j\"/>\n\
+          <geom type=\"mesh\" mesh=\"m\"/>\n</body>\n</worldbody>\n</mujoco>\n",
+    );
+    let model = load_mjcf(&top).unwrap();
+    // The box of sides 0.2, 0.4, 0.6.
+    assert!((model.bodies[0].inertial.mass - 48.0).abs() < 1e-4);
+    let text = std::fs::read_to_string(&top)
+        .unwrap()
+        .replace("mesh=\"m\"", "mesh=\"n\"");
+    let top = dir.write("top.xml", text.as_bytes());
+    let message = refusal(&top, 2, "cannot read `gone.stl`");
+    assert!(
+        message.contains("in `parts/assets.xml` line 4: <mesh name=\"n\" file=\"gone.stl\">"),
+        "{message}"
+    );
+}
+
+#[test]
+fn assetdir_strippath_and_exactmeshinertia_are_read() {
+    let dir = TempDir::new("compiler");
+    dir.write("parts/box.stl", &box_stl());
+    let box_mass = |text: &str| {
+        let top = dir.write("top.xml", text.as_bytes());
+        let model = load_mjcf(&top).unwrap();
+        (model.bodies[0].inertial.mass, model.warnings.len())
+    };
+    // `assetdir` is the mesh folder when `meshdir` is not given.
+    let text =
+        model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("<asset>", "<compiler assetdir=\"parts\"/><asset>");
+    let (mass, warnings) = box_mass(&text);
+    assert!((mass - 48.0).abs() < 1e-4 && warnings == 0, "{mass} {warnings}");
+    // `strippath` drops the folders the file names.
+    let text = model_with("<mesh name=\"m\" file=\"C:\\cad\\export\\box.stl\"/>")
+        .replace("<asset>", "<compiler meshdir=\"parts\" strippath=\"true\"/><asset>");
+    assert!((box_mass(&text).0 - 48.0).abs() < 1e-4);
+    // MuJoCo 4 no longer reads `exactmeshinertia`: a warning, the mesh's own rule kept.
+    let text = model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace(
+        "<asset>",
+        "<compiler meshdir=\"parts\" exactmeshinertia=\"true\"/><asset>",
+    );
+    let top = dir.write("top.xml", text.as_bytes());
+    let model = load_mjcf(&top).unwrap();
+    assert_eq!(model.warnings.len(), 1);
+    assert!(model.warnings[0]
+        .to_string()
+        .contains("<compiler exactmeshinertia=\"true\"> is not read"));
+}

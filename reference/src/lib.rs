@@ -57,6 +57,24 @@ pub struct Reference {
     /// Each moving body's centroidal principal frame (nominal centre of mass and
     /// principal axes), body 1 first.
     frames: Vec<PrincipalFrame>,
+    workspaces: Pool,
+}
+
+/// Workspaces made for this model, reused across calls (one per thread in use), so
+/// that a call allocates only its result.
+#[derive(Default)]
+struct Pool(std::sync::Mutex<Vec<Workspace<f64>>>);
+
+impl Clone for Pool {
+    fn clone(&self) -> Pool {
+        Pool::default()
+    }
+}
+
+impl std::fmt::Debug for Pool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Pool")
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,7 +100,6 @@ impl BodyMotion {
     }
 }
 
-
 impl Reference {
     /// The reference implementation of a generated robot, on the model it carries
     /// (`R::MODEL`: the generator's numbering, the gravity it was specialised for).
@@ -101,6 +118,7 @@ impl Reference {
             model: model.clone(),
             body,
             frames: dyngen_model::principal_frames(model),
+            workspaces: Pool::default(),
         }
     }
 
@@ -128,29 +146,37 @@ impl Reference {
         self.body.bodies()
     }
 
-    fn workspace(&self) -> Workspace<f64> {
-        Workspace::new(&self.body, ())
+    /// Runs `f` on a workspace of this model's, taken from the pool (or made) and
+    /// put back after.
+    pub(crate) fn with_workspace<T>(&self, f: impl FnOnce(&mut Workspace<f64>) -> T) -> T {
+        // A poisoned pool only lost workspaces; take it over as it is.
+        let taken = self.workspaces.0.lock().unwrap_or_else(|e| e.into_inner()).pop();
+        let mut ws = taken.unwrap_or_else(|| Workspace::new(&self.body, ()));
+        let out = f(&mut ws);
+        self.workspaces.0.lock().unwrap_or_else(|e| e.into_inner()).push(ws);
+        out
     }
 
     /// Every body's pose in the base frame, body 1 first:
     /// `⁰M_i = ⁰M_λ(i) · λ(i)M_i(q)`, so `x_base = R_i x_i + t_i`.
     pub fn forward_kinematics(&self, q: &[f64]) -> Vec<Pose<f64>> {
-        let mut ws = self.workspace();
-        dyngen_algo::forward_kinematics(&self.body, &mut ws, q);
-        ws.world[1..]
-            .iter()
-            .map(|t| Pose {
-                rotation: Matrix3::from_fn(|r, c| t.rotation[r][c]),
-                translation: Vector3::from(t.translation),
-            })
-            .collect()
+        self.with_workspace(|ws| {
+            dyngen_algo::forward_kinematics(&self.body, ws, q);
+            ws.world[1..]
+                .iter()
+                .map(|t| Pose {
+                    rotation: Matrix3::from_fn(|r, c| t.rotation[r][c]),
+                    translation: Vector3::from(t.translation),
+                })
+                .collect()
+        })
     }
 
     /// Inverse dynamics, `tau = M(q) a + C(q, v) v + g(q)` (`dyngen_algo::rnea`).
     /// Linear in `params`: this is `Y(q, v, a) · params`.
     pub fn rnea(&self, q: &[f64], v: &[f64], a: &[f64], params: &[f64]) -> Vec<f64> {
         let mut tau = vec![0.0; self.nv()];
-        dyngen_algo::rnea(&self.body, &mut self.workspace(), q, v, a, params, &mut tau);
+        self.with_workspace(|ws| dyngen_algo::rnea(&self.body, ws, q, v, a, params, &mut tau));
         tau
     }
 
@@ -171,34 +197,36 @@ impl Reference {
     /// `tau_i = S_iᵀ f_i`: `k · torque` for a revolute joint, `k · force` for a
     /// prismatic one.
     pub fn joint_wrenches(&self, q: &[f64], v: &[f64], a: &[f64], params: &[f64]) -> Vec<Wrench<f64>> {
-        let mut ws = self.workspace();
         let mut tau = vec![0.0; self.nv()];
-        dyngen_algo::rnea(&self.body, &mut ws, q, v, a, params, &mut tau);
-        ws.force[1..]
-            .iter()
-            .map(|f| Wrench {
-                force: Vector3::from(f.linear),
-                torque: Vector3::from(f.angular),
-            })
-            .collect()
+        self.with_workspace(|ws| {
+            dyngen_algo::rnea(&self.body, ws, q, v, a, params, &mut tau);
+            ws.force[1..]
+                .iter()
+                .map(|f| Wrench {
+                    force: Vector3::from(f.linear),
+                    torque: Vector3::from(f.angular),
+                })
+                .collect()
+        })
     }
 
     /// Every body's spatial velocity and gravity-free spatial acceleration in its own
     /// frame, body 1 first: Pinocchio's `data.v`, `data.a` after
     /// `forwardKinematics(q, v, a)`.
     pub fn body_motions(&self, q: &[f64], v: &[f64], a: &[f64]) -> Vec<BodyMotion> {
-        let mut ws = self.workspace();
-        dyngen_algo::body_motions(&self.body, &mut ws, q, v, a);
         let motion = |m: &dyngen_algo::Motion<f64>| Motion {
             linear: Vector3::from(m.linear),
             angular: Vector3::from(m.angular),
         };
-        (1..=self.bodies())
-            .map(|i| BodyMotion {
-                velocity: motion(&ws.velocity[i]),
-                acceleration: motion(&ws.acceleration[i]),
-            })
-            .collect()
+        self.with_workspace(|ws| {
+            dyngen_algo::body_motions(&self.body, ws, q, v, a);
+            (1..=self.bodies())
+                .map(|i| BodyMotion {
+                    velocity: motion(&ws.velocity[i]),
+                    acceleration: motion(&ws.acceleration[i]),
+                })
+                .collect()
+        })
     }
 
     /// The joint-space mass matrix `M(q)` (`nv × nv`, symmetric) by the composite
@@ -206,7 +234,7 @@ impl Reference {
     pub fn crba(&self, q: &[f64], params: &[f64]) -> DMatrix<f64> {
         let nv = self.nv();
         let mut m = vec![0.0; nv * nv];
-        dyngen_algo::crba(&self.body, &mut self.workspace(), q, params, &mut m);
+        self.with_workspace(|ws| dyngen_algo::crba(&self.body, ws, q, params, &mut m));
         DMatrix::from_row_slice(nv, nv, &m)
     }
 
@@ -220,7 +248,7 @@ impl Reference {
     /// singular (non-physical parameters, a massless tip) the result is not finite.
     pub fn aba(&self, q: &[f64], v: &[f64], tau: &[f64], params: &[f64]) -> Vec<f64> {
         let mut qdd = vec![0.0; self.nv()];
-        dyngen_algo::aba(&self.body, &mut self.workspace(), q, v, tau, params, &[], &mut qdd);
+        self.with_workspace(|ws| dyngen_algo::aba(&self.body, ws, q, v, tau, params, &[], &mut qdd));
         qdd
     }
 
@@ -229,7 +257,13 @@ impl Reference {
     /// without forming `M`. `None` when `M(q)` is not positive definite (never for
     /// physically consistent parameters).
     pub fn forward_dynamics(&self, q: &[f64], v: &[f64], tau: &[f64], params: &[f64]) -> Option<Vec<f64>> {
-        assert_eq!(tau.len(), self.nv(), "`tau` has {} entries; the model has {} velocities", tau.len(), self.nv());
+        assert_eq!(
+            tau.len(),
+            self.nv(),
+            "`tau` has {} entries; the model has {} velocities",
+            tau.len(),
+            self.nv()
+        );
         let bias = DVector::from_vec(self.nonlinear_effects(q, v, params));
         let rhs = DVector::from_column_slice(tau) - bias;
         let cholesky = self.crba(q, params).cholesky()?;

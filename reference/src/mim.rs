@@ -134,15 +134,16 @@ impl Reference {
         let n = self.bodies();
         let s = graph::incidence(&self.model);
         let c = graph::body_joint_vectors(&self.model);
-        let mut ws = dyngen_algo::Workspace::new(self.multibody(), ());
-        dyngen_algo::forward_kinematics(self.multibody(), &mut ws, q);
-        let placements: Vec<(Matrix3<f64>, Vector3<f64>)> = ws.placement[1..]
-            .iter()
-            .map(|p| {
-                let x = p.se3(0.0, 1.0);
-                (mat3(&x.rotation), vec3(&x.translation))
-            })
-            .collect();
+        let placements: Vec<(Matrix3<f64>, Vector3<f64>)> = self.with_workspace(|ws| {
+            dyngen_algo::forward_kinematics(self.multibody(), ws, q);
+            ws.placement[1..]
+                .iter()
+                .map(|p| {
+                    let x = p.se3(0.0, 1.0);
+                    (mat3(&x.rotation), vec3(&x.translation))
+                })
+                .collect()
+        });
 
         let mut resultants = vec![(Vector3::zeros(), Vector3::zeros()); n + 1];
         for (i, (force_i, moment_i)) in resultants.iter_mut().enumerate() {

@@ -6,7 +6,6 @@
 //! carried towards the base, one block per (joint, body) pair with `T_ji ≠ 0`.
 
 use super::Reference;
-use dyngen_algo::Workspace;
 use dyngen_model::{Model, PrincipalFrame};
 use nalgebra::{DMatrix, DVector};
 
@@ -20,7 +19,7 @@ impl Reference {
     pub fn joint_wrench_regressor(&self, q: &[f64], v: &[f64], a: &[f64]) -> DMatrix<f64> {
         let n = self.bodies();
         let mut w = vec![0.0; 60 * n * n];
-        dyngen_algo::joint_wrench_regressor(self.multibody(), &mut Workspace::new(self.multibody(), ()), q, v, a, &mut w);
+        self.with_workspace(|ws| dyngen_algo::joint_wrench_regressor(self.multibody(), ws, q, v, a, &mut w));
         DMatrix::from_row_slice(6 * n, 10 * n, &w)
     }
 
@@ -39,7 +38,7 @@ impl Reference {
     /// by `dyngen_algo::joint_torque_regressor`: the loop identification runs per
     /// sample.
     pub fn joint_torque_regressor_into(&self, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
-        dyngen_algo::joint_torque_regressor(self.multibody(), &mut Workspace::new(self.multibody(), ()), q, v, a, y);
+        self.with_workspace(|ws| dyngen_algo::joint_torque_regressor(self.multibody(), ws, q, v, a, y));
     }
 
     /// The regressor in the principal parameters `θ_i = (m, J1, J2, J3)` (`nv × 4n`):

@@ -8,11 +8,11 @@
 //! generated robot carries ([`RobotModel`]), the joint models beyond rigid bodies
 //! ([`JointParams`], [`Coulomb`]), the operations on configurations with a floating
 //! base or ball joints ([`configuration`]: integrate, difference, neutral, normalize,
-//! as Pinocchio's), and the [`robot!`] macro. `no_std`: maths come from the standard
+//! as Pinocchio's), and the `robot!` macro (feature `macros`). `no_std`: maths come from the standard
 //! library (feature `std`, the default) or from `libm` (feature `libm`).
 //!
-//! A robot comes from the [`robot!`] macro (inline graph-theoretic description, or a
-//! URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
+//! A robot comes from the `robot!` macro (feature `macros`: an inline graph-theoretic
+//! description, or a URDF file) or from `dyngen_codegen::compile_urdf` in `build.rs`; either way it is
 //! a type implementing [`Robot`]. The layers above (reference dynamics, identification,
 //! neural-network identification, the command line) are separate crates, so a crate
 //! that runs a robot in a control loop links only this one.
@@ -34,6 +34,7 @@ mod robot_model;
 mod scalar;
 
 pub use derivatives::{AbaDerivatives, Linearization, RneaDerivatives};
+#[cfg(feature = "macros")]
 pub use dyngen_macros::robot;
 pub use frames::{log3, FrameJacobian, FrameJacobianTimeVariation, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};

@@ -177,13 +177,16 @@ pub fn incidence(model: &Model) -> Vec<Vec<i8>> {
 }
 
 /// `T = S⁻¹` (n × n, rows joints, columns bodies): `T_ai = 1` iff joint `a` lies on
-/// the path from body `i` to the base.
+/// the path from body `i` to the base. Each body's path is walked once (`O(n ·
+/// depth)`, not a walk per entry).
 pub fn path_matrix(model: &Model) -> Vec<Vec<i8>> {
     let n = model.dof();
     let mut t = vec![vec![0i8; n]; n];
-    for (a, row) in t.iter_mut().enumerate() {
-        for (i, x) in row.iter_mut().enumerate() {
-            *x = i8::from(model.supports(a + 1, i + 1));
+    for i in 1..=n {
+        let mut a = i;
+        while a != 0 {
+            t[a - 1][i - 1] = 1;
+            a = model.parent(a);
         }
     }
     t

@@ -1,5 +1,6 @@
 //! Small fixed-size math on plain arrays: enough for placements, inertias and the
-//! graph-theoretic matrices, without pulling a linear-algebra crate into every build.
+//! graph-theoretic matrices. Dense matrices of any size (the stacked regressors of the
+//! base-parameter analysis) go to faer.
 
 /// A 3-vector.
 pub type Vec3 = [f64; 3];
@@ -235,128 +236,24 @@ pub fn det(a: &Mat3) -> f64 {
 }
 
 /// Singular values of a dense matrix given as rows (`m × p`, any shape), descending,
-/// by one-sided Jacobi (Hestenes): plane rotations of vector pairs until every pair
-/// is orthogonal to working precision; the singular values are then the vector
-/// norms. Unlike the eigenvalues of `AᵀA`, which square the condition number, small
-/// singular values come out with relative accuracy, which a rank test at `10⁻⁸ σ₁`
-/// needs. Rows of unequal length are read as zero-padded to the longest.
-///
-/// A tall matrix is first reduced to the `p × p` triangle `R` of its QR with column
-/// pivoting (`A Π = Q R`, so `A` and `R` have the same singular values), and Jacobi
-/// runs on the rows of `R`: `p` vectors of length `p` instead of `m`, and because
-/// pivoting grades the rows, in a few sweeps (Drmač & Veselić's preconditioned
-/// Jacobi SVD). On a 40-state stack of a 31-joint regressor (1480 × 468) that is
-/// about 6 times faster than Jacobi on the columns of `A`.
+/// `min(m, p)` of them (faer's SVD, singular values only). Rows of unequal length
+/// are read as zero-padded to the longest. Each value is accurate to a small multiple
+/// of `ε σ₁`, which a rank test at `10⁻⁸ σ₁` needs and no more.
 pub fn singular_values(rows: &[Vec<f64>]) -> Vec<f64> {
     let p = rows.iter().map(Vec::len).max().unwrap_or(0);
-    // Column-major copy: the reflectors and rotations work on whole columns.
-    let cols: Vec<Vec<f64>> = (0..p)
-        .map(|c| rows.iter().map(|r| r.get(c).copied().unwrap_or(0.0)).collect())
-        .collect();
-    let vectors = if rows.len() > p { rows_of_pivoted_r(cols) } else { cols };
-    jacobi_norms(vectors)
+    let a = faer::Mat::<f64>::from_fn(rows.len(), p, |i, j| rows[i].get(j).copied().unwrap_or(0.0));
+    singular_values_of(a.as_ref())
 }
 
-/// The rows of `R` in the QR with column pivoting of the matrix whose columns are
-/// `cols` (`m × p`, `m ≥ p`): Householder reflectors, the remaining column of
-/// largest norm brought forward at each step.
-fn rows_of_pivoted_r(mut cols: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
-    let p = cols.len();
-    let norm2 = |c: &[f64]| dot_slices(c, c);
-    for k in 0..p {
-        let Some((best, _)) = (k..p)
-            .map(|j| (j, norm2(&cols[j][k..])))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-        else {
-            break;
-        };
-        cols.swap(k, best);
-        let alpha = norm2(&cols[k][k..]).sqrt();
-        if alpha == 0.0 {
-            break; // the rest is exactly zero
-        }
-        reflect(&mut cols, k, k, alpha);
+/// [`singular_values`] of a faer matrix. faer reduces a tall matrix to the triangle
+/// of its QR first and bidiagonalises that; the decomposition does not converge only
+/// for non-finite input, which gives no singular values (NaN) here.
+pub fn singular_values_of(a: faer::MatRef<'_, f64>) -> Vec<f64> {
+    if a.nrows() == 0 || a.ncols() == 0 {
+        return Vec::new();
     }
-    (0..p)
-        .map(|i| (0..p).map(|j| if j >= i { cols[j][i] } else { 0.0 }).collect())
-        .collect()
-}
-
-/// Householder QR's step on a matrix held as columns: the reflector that zeroes
-/// column `c` below row `k` (`norm`: that column's norm from row `k` down), applied to
-/// it and to the columns after it.
-pub(crate) fn reflect(cols: &mut [Vec<f64>], c: usize, k: usize, norm: f64) {
-    let sign = if cols[c][k] >= 0.0 { 1.0 } else { -1.0 };
-    let mut v: Vec<f64> = cols[c][k..].to_vec();
-    v[0] += sign * norm;
-    let vnorm2: f64 = v.iter().map(|x| x * x).sum();
-    for col in cols[c..].iter_mut() {
-        let dot: f64 = v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum();
-        let f = 2.0 * dot / vnorm2;
-        for (x, vi) in col[k..].iter_mut().zip(&v) {
-            *x -= f * vi;
-        }
-    }
-}
-
-/// One-sided Jacobi on `vectors` (the columns of a matrix): their norms once they
-/// are mutually orthogonal, descending.
-fn jacobi_norms(mut vectors: Vec<Vec<f64>>) -> Vec<f64> {
-    let p = vectors.len();
-    for _sweep in 0..80 {
-        let mut rotated = false;
-        // Squared norms, computed anew each sweep and carried through its rotations
-        // (a rotation by `t` moves `t γ` from one to the other), so that a pair costs
-        // one product `γ` unless it is rotated.
-        let mut norms: Vec<f64> = vectors.iter().map(|x| dot_slices(x, x)).collect();
-        for i in 0..p {
-            for j in i + 1..p {
-                let (alpha, beta) = (norms[i], norms[j]);
-                let gamma = dot_slices(&vectors[i], &vectors[j]);
-                if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
-                    continue;
-                }
-                rotated = true;
-                // The rotation that diagonalises the 2×2 Gram matrix [[α, γ], [γ, β]].
-                let zeta = (beta - alpha) / (2.0 * gamma);
-                let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
-                let t = if zeta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (1.0 + t * t).sqrt();
-                let s = c * t;
-                let (left, right) = vectors.split_at_mut(j);
-                for (x, y) in left[i].iter_mut().zip(right[0].iter_mut()) {
-                    let (xi, yj) = (*x, *y);
-                    *x = c * xi - s * yj;
-                    *y = s * xi + c * yj;
-                }
-                norms[i] = alpha - t * gamma;
-                norms[j] = beta + t * gamma;
-            }
-        }
-        if !rotated {
-            break;
-        }
-    }
-    let mut values: Vec<f64> = vectors.iter().map(|c| dot_slices(c, c).sqrt()).collect();
-    values.sort_by(|a, b| b.total_cmp(a));
-    values
-}
-
-/// `Σ aᵢ bᵢ` over the shorter of the two, in four interleaved partial sums so that
-/// the additions pipeline instead of waiting on one another (the singular values of
-/// the base analysis spend most of their time here).
-fn dot_slices(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(x, y)| x * y).sum();
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    a.singular_values()
+        .unwrap_or_else(|_| vec![f64::NAN; a.nrows().min(a.ncols())])
 }
 
 #[cfg(test)]

@@ -295,24 +295,43 @@ fn body_wrench(m: &BodyMotion, pi: &[f64; 10]) -> (Vec3, Vec3) {
 }
 
 /// The torque regressor of the module docs; lengths are the caller's to check.
+/// `O(n · depth)` wrenches carried; the velocity offsets are taken once.
 pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Vec<f64>> {
     let n = model.dof();
     let motion = forward(model, q, v, a);
+    let offsets: Vec<usize> = model
+        .joints
+        .iter()
+        .scan(0, |o, j| {
+            let here = *o;
+            *o += j.kind.nv();
+            Some(here)
+        })
+        .collect();
     let mut y = vec![vec![0.0; STANDARD_PER_BODY * n]; model.nv()];
     for i in 1..=n {
         for k in 0..STANDARD_PER_BODY {
             let mut unit = [0.0; 10];
             unit[k] = 1.0;
             let (mut f, mut m) = body_wrench(&motion[i - 1], &unit);
+            let col = STANDARD_PER_BODY * (i - 1) + k;
             let mut j = i;
             while j != 0 {
-                for (r, x) in joint_rows(model, j, &f, &m).into_iter().enumerate() {
-                    y[model.v_offset(j) + r][STANDARD_PER_BODY * (i - 1) + k] = x;
+                let joint = &model.joints[j - 1];
+                let row = offsets[j - 1];
+                match joint.kind {
+                    JointKind::Revolute | JointKind::Continuous => y[row][col] = math::dot(&joint.axis, &m),
+                    JointKind::Prismatic => y[row][col] = math::dot(&joint.axis, &f),
+                    _ => {
+                        for (r, x) in joint_rows(model, j, &f, &m).into_iter().enumerate() {
+                            y[row + r][col] = x;
+                        }
+                    }
                 }
                 let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
                 f = math::mat_vec(r, &f);
                 m = math::add(&math::mat_vec(r, &m), &cross(p, &f));
-                j = model.joints[j - 1].parent;
+                j = joint.parent;
             }
         }
     }

@@ -12,6 +12,11 @@ use core::ops::Add;
 /// so a symbolic scalar records one program). A singular `D` gives non-finite
 /// entries, as the division by zero it is.
 fn invert<S: Real>(d: &[S; 36], n: usize, zero: S, one: S) -> [S; 36] {
+    if n == 1 {
+        let mut out = [zero; 36];
+        out[0] = one / d[0];
+        return out;
+    }
     let mut a = *d;
     let mut inv = [zero; 36];
     for r in 0..n {
@@ -107,7 +112,7 @@ pub fn aba<S: Real>(
         let (n, off) = (j.nv(), j.v_offset);
         let ia = workspace.articulated[i];
         for e in 0..n {
-            workspace.u[off + e] = ia.apply(j.column(c, e));
+            workspace.u[off + e] = j.apply_column(c, &ia, e);
         }
         for e in 0..n {
             j.project(c, &workspace.u[off + e], &mut projected[..n]);
@@ -144,7 +149,7 @@ pub fn aba<S: Real>(
         }
     }
     workspace.acceleration[0] = Motion {
-        linear: multibody.gravity.map(|x| S::constant(c, -x)),
+        linear: crate::joint::constant_vec(c, [-multibody.gravity[0], -multibody.gravity[1], -multibody.gravity[2]]),
         angular: [z; 3],
     };
     for (k, j) in multibody.joints.iter().enumerate() {

@@ -34,7 +34,7 @@ pub fn crba<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S
         let i = k + 1;
         for e in 0..j.nv() {
             let d = j.v_offset + e;
-            let mut f = workspace.inertia[i].apply(j.column(c, e));
+            let mut f = j.inertia_column(c, &workspace.inertia[i], e);
             let (mut body, mut joint) = (i, j);
             loop {
                 let rows = joint.nv();

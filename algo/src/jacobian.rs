@@ -38,10 +38,7 @@ pub fn frame_jacobian<S: Real>(
     assert!(body <= multibody.bodies(), "body {body} is not a body of the multibody");
     let c = workspace.context;
     jacobian.fill(workspace.zero());
-    let offset = Se3 {
-        rotation: frame.rotation.map(|r| r.map(|x| S::constant(c, x))),
-        translation: frame.translation.map(|x| S::constant(c, x)),
-    };
+    let offset: Se3<S> = crate::joint::constant_se3(c, frame);
     let placement = workspace.world[body].compose(&offset);
     let mut i = body;
     while i != 0 {
@@ -63,4 +60,45 @@ pub fn frame_jacobian<S: Real>(
         }
         i = j.parent;
     }
+}
+
+/// [`frame_jacobian`] from `q` alone: the placements of the bodies on the path from
+/// `body` to the base only (Pinocchio's `computeFrameJacobian`), then the Jacobian.
+/// Leaves `workspace.world` valid on that path.
+///
+/// # Panics
+/// As [`frame_jacobian`], or if `q` is not `nq` long.
+pub fn compute_frame_jacobian<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    body: usize,
+    frame: &Se3<f64>,
+    reference: ReferenceFrame,
+    jacobian: &mut [S],
+) {
+    check_len("q", q, multibody.nq());
+    assert!(body <= multibody.bodies(), "body {body} is not a body of the multibody");
+    let c = workspace.context;
+    let (z, o) = (workspace.zero(), S::constant(c, 1.0));
+    // The path, tip first, then placed from the base out.
+    let mut len = 0;
+    let mut i = body;
+    while i != 0 {
+        workspace.path[len] = i;
+        len += 1;
+        i = multibody.joints[i - 1].parent;
+    }
+    for k in (0..len).rev() {
+        let i = workspace.path[k];
+        let j = &multibody.joints[i - 1];
+        let local = j.placement(c, &q[j.q_offset..j.q_offset + j.nq()]);
+        workspace.placement[i] = local;
+        workspace.world[i] = if j.parent == 0 {
+            local.se3(z, o)
+        } else {
+            workspace.world[j.parent].compose(&local.se3(z, o))
+        };
+    }
+    frame_jacobian(multibody, workspace, body, frame, reference, jacobian);
 }

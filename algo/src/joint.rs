@@ -3,7 +3,9 @@
 //! frame for every type here, so the joint's bias acceleration `c_J` is zero) and
 //! `Sᵀ f`.
 
-use crate::spatial::{cross, mat_mul, mat_tr_vec, mat_vec, Force, Inertia, Mat3, Motion, Se3, SpatialMatrix, Vec3};
+use crate::spatial::{
+    cross, mat_mul, mat_tr_vec, mat_vec, Force, Inertia, Mat3, Motion, Rotate, Se3, SpatialMatrix, Vec3,
+};
 use crate::Real;
 
 /// What a joint allows.
@@ -181,17 +183,17 @@ pub struct Joint {
 }
 
 #[inline(always)]
-fn constant_se3<S: Real>(c: S::Context, x: &Se3<f64>) -> Se3<S> {
-    let k = |v: f64| S::constant(c, v);
+pub(crate) fn constant_se3<S: Real>(c: S::Context, x: &Se3<f64>) -> Se3<S> {
+    let r = &x.rotation;
     Se3 {
-        rotation: x.rotation.map(|r| r.map(k)),
-        translation: x.translation.map(k),
+        rotation: [constant_vec(c, r[0]), constant_vec(c, r[1]), constant_vec(c, r[2])],
+        translation: constant_vec(c, x.translation),
     }
 }
 
 #[inline(always)]
-fn constant_vec<S: Real>(c: S::Context, v: [f64; 3]) -> Vec3<S> {
-    v.map(|x| S::constant(c, x))
+pub(crate) fn constant_vec<S: Real>(c: S::Context, v: [f64; 3]) -> Vec3<S> {
+    [S::constant(c, v[0]), S::constant(c, v[1]), S::constant(c, v[2])]
 }
 
 impl Joint {
@@ -307,6 +309,87 @@ impl Joint {
         let mut e = [S::constant(c, 0.0); 6];
         e[k] = S::constant(c, 1.0);
         self.motion(c, &e)
+    }
+
+    /// `A S_e`, the operator `a` applied to column `e` of `S`: one column of `a`
+    /// where `S_e` is a coordinate axis, [`SpatialMatrix::apply`] otherwise.
+    #[inline(always)]
+    pub fn apply_column<S: Real>(&self, c: S::Context, a: &SpatialMatrix<S>, e: usize) -> Force<S> {
+        // Column k of [[a, b], [bᵀ, d]]: k < 3 linear (a's column, b's row), else
+        // angular (b's column, d's column).
+        let column = |k: usize| {
+            if k < 3 {
+                Force {
+                    linear: [a.a[0][k], a.a[1][k], a.a[2][k]],
+                    angular: a.b[k],
+                }
+            } else {
+                let k = k - 3;
+                Force {
+                    linear: [a.b[0][k], a.b[1][k], a.b[2][k]],
+                    angular: [a.d[0][k], a.d[1][k], a.d[2][k]],
+                }
+            }
+        };
+        let axis = match self.axis {
+            Axis::X => Some(0),
+            Axis::Y => Some(1),
+            Axis::Z => Some(2),
+            Axis::Other(_) => None,
+        };
+        match (self.kind, axis) {
+            (JointType::Revolute | JointType::Continuous, Some(k)) => column(3 + k),
+            (JointType::Prismatic, Some(k)) => column(k),
+            (JointType::Spherical, _) => column(3 + e),
+            (JointType::FreeFlyer, _) => column(e),
+            _ => a.apply(self.column(c, e)),
+        }
+    }
+
+    /// `I S_e` for a rigid-body inertia: the momentum of moving along column `e` of
+    /// `S`, read off `I`'s parameters where `S_e` is a coordinate axis.
+    #[inline(always)]
+    pub fn inertia_column<S: Real>(&self, c: S::Context, i: &Inertia<S>, e: usize) -> Force<S> {
+        let z = S::constant(c, 0.0);
+        let h = i.first_moment;
+        let r = &i.rotational;
+        // Unit motion k (< 3 linear, else angular): [m e_k; h × e_k] or
+        // [e_k × h; I e_k].
+        let column = |k: usize| {
+            let unit = |k: usize| {
+                let mut u = [z; 3];
+                u[k] = S::constant(c, 1.0);
+                u
+            };
+            if k < 3 {
+                let mut f = [z; 3];
+                f[k] = i.mass;
+                Force {
+                    linear: f,
+                    angular: cross(h, unit(k)),
+                }
+            } else {
+                let k = k - 3;
+                let sym = [[r[0], r[1], r[3]], [r[1], r[2], r[4]], [r[3], r[4], r[5]]];
+                Force {
+                    linear: cross(unit(k), h),
+                    angular: sym[k],
+                }
+            }
+        };
+        let axis = match self.axis {
+            Axis::X => Some(0),
+            Axis::Y => Some(1),
+            Axis::Z => Some(2),
+            Axis::Other(_) => None,
+        };
+        match (self.kind, axis) {
+            (JointType::Revolute | JointType::Continuous, Some(k)) => column(3 + k),
+            (JointType::Prismatic, Some(k)) => column(k),
+            (JointType::Spherical, _) => column(3 + e),
+            (JointType::FreeFlyer, _) => column(e),
+            _ => i.apply(self.column(c, e)),
+        }
     }
 
     /// `Sᵀ f` into `out` (its `nv` entries).
@@ -455,12 +538,19 @@ impl<S: Real> JointPlacement<S> {
     /// A child-frame inertia in the parent frame ([`Inertia::act`]).
     #[inline(always)]
     pub fn inertia_to_parent(&self, i: &Inertia<S>) -> Inertia<S> {
-        i.act_with(|x| self.to_parent(x), self.translation)
+        i.act_with(self, self.translation)
     }
 
     /// A child-frame articulated inertia in the parent frame ([`SpatialMatrix::act`]).
     #[inline(always)]
     pub fn matrix_to_parent(&self, a: &SpatialMatrix<S>) -> SpatialMatrix<S> {
-        a.act_with(|x| self.to_parent(x), self.translation)
+        a.act_with(self, self.translation)
+    }
+}
+
+impl<S: Real> Rotate<S> for JointPlacement<S> {
+    #[inline(always)]
+    fn rotate(&self, x: Vec3<S>) -> Vec3<S> {
+        self.to_parent(x)
     }
 }

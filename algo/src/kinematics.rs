@@ -85,7 +85,8 @@ pub(crate) fn newton_euler_pass<S: Real>(multibody: &Multibody, workspace: &mut 
     let z = workspace.zero();
     workspace.angular_velocity[0] = [z; 3];
     workspace.angular_acceleration[0] = [z; 3];
-    workspace.linear_acceleration[0] = multibody.gravity.map(|x| S::constant(c, -x));
+    workspace.linear_acceleration[0] =
+        crate::joint::constant_vec(c, [-multibody.gravity[0], -multibody.gravity[1], -multibody.gravity[2]]);
     for (k, j) in multibody.joints.iter().enumerate() {
         let i = k + 1;
         let range = j.v_offset..j.v_offset + j.nv();

@@ -17,7 +17,8 @@
 //! - [`aba`] (`aba.rs`): forward dynamics, with rotor inertia;
 //! - [`joint_torque_regressor`] (`regressor.rs`): `τ = Y π`, linear in the standard
 //!   parameters, and [`joint_wrench_regressor`], `6 n` rows of joint wrenches;
-//! - [`frame_jacobian`] (`jacobian.rs`): a frame's Jacobian in any [`ReferenceFrame`].
+//! - [`frame_jacobian`], [`compute_frame_jacobian`] (`jacobian.rs`): a frame's Jacobian
+//!   in any [`ReferenceFrame`].
 //!
 //! ```
 //! use dyngen_algo::{rnea, JointSpec, JointType, Multibody, Se3, Workspace};
@@ -54,11 +55,11 @@ pub mod spatial;
 
 pub use aba::aba;
 pub use crba::crba;
-pub use jacobian::{frame_jacobian, ReferenceFrame};
+pub use jacobian::{compute_frame_jacobian, frame_jacobian, ReferenceFrame};
 pub use joint::{quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
 pub use kinematics::{body_motions, forward_kinematics};
 pub use multibody::{JointSpec, Multibody, TreeError, Workspace, PARAMS_PER_BODY};
 pub use real::Real;
 pub use regressor::{force_regressor, joint_torque_regressor, joint_wrench_regressor};
 pub use rnea::rnea;
-pub use spatial::{Force, Inertia, Motion, Se3};
+pub use spatial::{Force, Inertia, Motion, Rotate, Se3};

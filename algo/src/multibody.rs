@@ -204,6 +204,8 @@ pub struct Workspace<S: Real> {
     /// Per body, the motion subspaces of the coordinates that move it, in its frame
     /// (the regressor), laid out as `Multibody::supports`.
     pub(crate) axes: Vec<Motion<S>>,
+    /// A body's path to the base (frame Jacobians).
+    pub(crate) path: Vec<usize>,
 }
 
 impl<S: Real> Workspace<S> {
@@ -236,6 +238,7 @@ impl<S: Real> Workspace<S> {
             u_torque: alloc::vec![z; multibody.nv()],
             d_inv: alloc::vec![[z; 36]; n],
             axes: alloc::vec![Motion::zero(z); multibody.supports.len()],
+            path: alloc::vec![0; multibody.bodies()],
         }
     }
 

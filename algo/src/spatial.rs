@@ -122,22 +122,43 @@ fn mul_skew<S: Real>(a: &Mat3<S>, p: Vec3<S>) -> Mat3<S> {
     [cross(a[0], p), cross(a[1], p), cross(a[2], p)]
 }
 
-/// `R X Rᵀ` for a rotation given by its action `rotate(x) = R x`: `R` applied to
-/// the columns of `X`, then to the rows of the result.
+/// A rotation by its action on vectors, so that a placement kept in factors
+/// ([`crate::JointPlacement`]) and a plain matrix rotate inertias alike.
+pub trait Rotate<S> {
+    /// `R x`.
+    fn rotate(&self, x: Vec3<S>) -> Vec3<S>;
+}
+
+impl<S: Real> Rotate<S> for Mat3<S> {
+    #[inline(always)]
+    fn rotate(&self, x: Vec3<S>) -> Vec3<S> {
+        mat_vec(self, x)
+    }
+}
+
+/// `R X Rᵀ`: `R` applied to the columns of `X`, then to the rows of the result.
 #[inline(always)]
-pub fn rotate_matrix<S: Real>(x: &Mat3<S>, rotate: impl Fn(Vec3<S>) -> Vec3<S>) -> Mat3<S> {
-    let c: [Vec3<S>; 3] = [0, 1, 2].map(|k| rotate([x[0][k], x[1][k], x[2][k]]));
-    // a = R X has columns c; (R X) Rᵀ has rows R (row r of a).
-    [0, 1, 2].map(|r| rotate([c[0][r], c[1][r], c[2][r]]))
+pub fn rotate_matrix<S: Real, R: Rotate<S>>(x: &Mat3<S>, r: &R) -> Mat3<S> {
+    let c0 = r.rotate([x[0][0], x[1][0], x[2][0]]);
+    let c1 = r.rotate([x[0][1], x[1][1], x[2][1]]);
+    let c2 = r.rotate([x[0][2], x[1][2], x[2][2]]);
+    // a = R X has columns c0, c1, c2; row k of (R X) Rᵀ is R (row k of a).
+    [
+        r.rotate([c0[0], c1[0], c2[0]]),
+        r.rotate([c0[1], c1[1], c2[1]]),
+        r.rotate([c0[2], c1[2], c2[2]]),
+    ]
 }
 
 /// [`rotate_matrix`] of a symmetric matrix stored `[xx, xy, yy, xz, yz, zz]`.
 #[inline(always)]
-pub fn rotate_symmetric<S: Real>(x: &[S; 6], rotate: impl Fn(Vec3<S>) -> Vec3<S>) -> [S; 6] {
-    let c: [Vec3<S>; 3] = [[x[0], x[1], x[3]], [x[1], x[2], x[4]], [x[3], x[4], x[5]]].map(&rotate);
-    let r0 = rotate([c[0][0], c[1][0], c[2][0]]);
-    let r1 = rotate([c[0][1], c[1][1], c[2][1]]);
-    let r2 = rotate([c[0][2], c[1][2], c[2][2]]);
+pub fn rotate_symmetric<S: Real, R: Rotate<S>>(x: &[S; 6], r: &R) -> [S; 6] {
+    let c0 = r.rotate([x[0], x[1], x[3]]);
+    let c1 = r.rotate([x[1], x[2], x[4]]);
+    let c2 = r.rotate([x[3], x[4], x[5]]);
+    let r0 = r.rotate([c0[0], c1[0], c2[0]]);
+    let r1 = r.rotate([c0[1], c1[1], c2[1]]);
+    let r2 = r.rotate([c0[2], c1[2], c2[2]]);
     // Rows 0, 1, 2 of the result; the lower triangle is the upper one.
     [r0[0], r0[1], r1[1], r0[2], r1[2], r2[2]]
 }
@@ -419,15 +440,14 @@ impl<S: Real> Inertia<S> {
     /// `I' = R I Rᵀ + m(|p|² E − p pᵀ) + 2(p·h_R) E − h_R pᵀ − p h_Rᵀ` with `h_R = R h`.
     #[inline(always)]
     pub fn act(&self, x: &Se3<S>) -> Inertia<S> {
-        self.act_with(|v| mat_vec(&x.rotation, v), x.translation)
+        self.act_with(&x.rotation, x.translation)
     }
 
-    /// [`Inertia::act`] for the placement of rotation `rotate(x) = R x` and
-    /// translation `p`.
+    /// [`Inertia::act`] for the placement of rotation `r` and translation `p`.
     #[inline(always)]
-    pub fn act_with(&self, rotate: impl Fn(Vec3<S>) -> Vec3<S>, p: Vec3<S>) -> Inertia<S> {
-        let h = rotate(self.first_moment);
-        let rot = rotate_symmetric(&self.rotational, &rotate);
+    pub fn act_with<R: Rotate<S>>(&self, r: &R, p: Vec3<S>) -> Inertia<S> {
+        let h = r.rotate(self.first_moment);
+        let rot = rotate_symmetric(&self.rotational, r);
         let e = |a: usize, b: usize| rot[[[0, 1, 3], [1, 2, 4], [3, 4, 5]][a][b]];
         // m(|p|² E − p pᵀ) + 2(p·h) E − h pᵀ − p hᵀ, with mp = m p:
         // diagonal a: m(|p|² − p_a²) + 2 p·h − 2 h_a p_a; off-diagonal: −m p_a p_b − h_a p_b − p_a h_b.
@@ -521,15 +541,17 @@ impl<S: Real> SpatialMatrix<S> {
     /// `[[B11, B12 − B11 P], [·, P B12 + B22 − (P B11 + B21) P]]`.
     #[inline(always)]
     pub fn act(&self, x: &Se3<S>) -> SpatialMatrix<S> {
-        self.act_with(|v| mat_vec(&x.rotation, v), x.translation)
+        self.act_with(&x.rotation, x.translation)
     }
 
-    /// [`SpatialMatrix::act`] for the placement of rotation `rotate(x) = R x` and
-    /// translation `p`.
+    /// [`SpatialMatrix::act`] for the placement of rotation `r` and translation `p`.
     #[inline(always)]
-    pub fn act_with(&self, rotate: impl Fn(Vec3<S>) -> Vec3<S>, p: Vec3<S>) -> SpatialMatrix<S> {
-        let rot = |m: &Mat3<S>| rotate_matrix(m, &rotate);
-        let (b11, b12, b22) = (rot(&self.a), rot(&self.b), rot(&self.d));
+    pub fn act_with<R: Rotate<S>>(&self, r: &R, p: Vec3<S>) -> SpatialMatrix<S> {
+        let (b11, b12, b22) = (
+            rotate_matrix(&self.a, r),
+            rotate_matrix(&self.b, r),
+            rotate_matrix(&self.d, r),
+        );
         let b21 = transpose(&b12);
         // (P B11 + B21) P, and P B12.
         let left = mat_add(&skew_mul(p, &b11), &b21);

@@ -6,8 +6,8 @@
 //! finite difference of the placement).
 
 use dyngen_algo::{
-    aba, body_motions, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, joint_wrench_regressor, rnea,
-    JointType, Multibody, ReferenceFrame, Se3, Workspace,
+    aba, body_motions, compute_frame_jacobian, crba, forward_kinematics, frame_jacobian, joint_torque_regressor,
+    joint_wrench_regressor, rnea, JointType, Multibody, ReferenceFrame, Se3, Workspace,
 };
 use dyngen_model::{load_robot, load_urdf_options, LoadOptions};
 use rand::{Rng, SeedableRng};

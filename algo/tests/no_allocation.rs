@@ -2,7 +2,10 @@
 //! made once. Counted by a global allocator on a free-flyer humanoid (31 joints
 //! under a free flyer: ball-free, but 6-coordinate root) and the planar mobile arm.
 
-use dyngen_algo::{aba, crba, forward_kinematics, frame_jacobian, rnea, ReferenceFrame, Se3, Workspace};
+use dyngen_algo::{
+    aba, compute_frame_jacobian, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, rnea,
+    ReferenceFrame, Se3, Workspace,
+};
 use dyngen_model::{load_urdf_options, LoadOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
@@ -44,6 +47,7 @@ fn no_algorithm_allocates_per_call() {
         let q = body.neutral();
         let (v, a) = (vec![0.3; nv], vec![-0.2; nv]);
         let (mut tau, mut qdd, mut m, mut jac) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv * nv], vec![0.0; 6 * nv]);
+        let mut y = vec![0.0; nv * 10 * body.bodies()];
         let params = body.params.clone();
         let armature = vec![0.01; nv];
         let frame = Se3::identity(0.0, 1.0);
@@ -55,6 +59,16 @@ fn no_algorithm_allocates_per_call() {
             aba(&body, &mut ws, &q, &v, &tau, &params, &armature, &mut qdd);
             forward_kinematics(&body, &mut ws, &q);
             frame_jacobian(&body, &ws, body.bodies(), &frame, ReferenceFrame::Local, &mut jac);
+            compute_frame_jacobian(
+                &body,
+                &mut ws,
+                &q,
+                body.bodies(),
+                &frame,
+                ReferenceFrame::World,
+                &mut jac,
+            );
+            joint_torque_regressor(&body, &mut ws, &q, &v, &a, &mut y);
         }
         let after = ALLOCATIONS.load(Ordering::SeqCst);
         assert_eq!(

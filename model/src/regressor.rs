@@ -37,9 +37,12 @@ pub const STANDARD_PER_BODY: usize = 10;
 /// Principal parameters per body: `θ = (m, J1, J2, J3)`.
 pub const PRINCIPAL_PER_BODY: usize = 4;
 
-/// A state that does not fit the model.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A state that does not fit the model, or a model that is not a tree.
+#[derive(Clone, Debug, PartialEq)]
 pub enum RegressorError {
+    /// The model's fields were edited into something that is not a tree in regular
+    /// labelling (a loaded model always is one).
+    Tree(dyngen_algo::TreeError),
     /// `argument` (`"q"`, `"v"` or `"a"`) has `found` entries; the model needs
     /// `expected` (`nq` positions for `q`, `nv` velocities for `v` and `a`).
     Length {
@@ -52,6 +55,7 @@ pub enum RegressorError {
 impl fmt::Display for RegressorError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            RegressorError::Tree(e) => write!(f, "{e}"),
             RegressorError::Length {
                 argument,
                 expected,
@@ -89,34 +93,40 @@ pub fn principal_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Re
     Ok(principal_from_standard(model, &torque_regressor(model, q, v, a)))
 }
 
-/// Inverse dynamics with the model's own (nominal) parameters: `τ = Y(q, v, a) π`.
+/// Inverse dynamics with the model's own (nominal) parameters, `τ = M(q) a + h(q, v)`
+/// (`dyngen_algo::rnea`).
 pub fn inverse_dynamics(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<f64>, RegressorError> {
-    let pi = model.standard_params();
-    Ok(joint_torque_regressor(model, q, v, a)?
-        .iter()
-        .map(|row| row.iter().zip(&pi).map(|(y, p)| y * p).sum())
-        .collect())
+    check_state(model, q, v, a)?;
+    let body = model.multibody().map_err(RegressorError::Tree)?;
+    let mut tau = vec![0.0; model.nv()];
+    dyngen_algo::rnea(
+        &body,
+        &mut dyngen_algo::Workspace::new(&body, ()),
+        q,
+        v,
+        a,
+        &body.params,
+        &mut tau,
+    );
+    Ok(tau)
 }
 
-/// The joint-space mass matrix `M(q)` of the model's own parameters, as rows: column
-/// `k` is `τ(q, 0, eₖ)` without gravity. `nv` regressor evaluations, so for checks
-/// and tests rather than loops.
+/// The joint-space mass matrix `M(q)` of the model's own parameters, as rows
+/// (`dyngen_algo::crba`).
 pub fn mass_matrix(model: &Model, q: &[f64]) -> Result<Vec<Vec<f64>>, RegressorError> {
-    let weightless = Model {
-        gravity: [0.0; 3],
-        ..model.clone()
-    };
+    let zero = vec![0.0; model.nv()];
+    check_state(model, q, &zero, &zero)?;
+    let body = model.multibody().map_err(RegressorError::Tree)?;
     let n = model.nv();
-    let zero = vec![0.0; n];
-    let mut m = vec![vec![0.0; n]; n];
-    for k in 0..n {
-        let mut e = zero.clone();
-        e[k] = 1.0;
-        for (row, x) in m.iter_mut().zip(inverse_dynamics(&weightless, q, &zero, &e)?) {
-            row[k] = x;
-        }
-    }
-    Ok(m)
+    let mut m = vec![0.0; n * n];
+    dyngen_algo::crba(
+        &body,
+        &mut dyngen_algo::Workspace::new(&body, ()),
+        q,
+        &body.params,
+        &mut m,
+    );
+    Ok(m.chunks(n).map(<[f64]>::to_vec).collect())
 }
 
 fn check_state(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Result<(), RegressorError> {

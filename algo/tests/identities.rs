@@ -142,6 +142,12 @@ fn the_algorithms_agree_with_each_other() {
                 "{name}: J v = v_body: {:e}",
                 max_diff(&jv, &own)
             );
+            // The same Jacobian from q alone, the path's kinematics only.
+            let mut fresh = Workspace::new(&body, ());
+            let mut jac2 = vec![0.0; 6 * nv];
+            let origin = Se3::identity(0.0, 1.0);
+            compute_frame_jacobian(&body, &mut fresh, &q, nb, &origin, ReferenceFrame::Local, &mut jac2);
+            assert_eq!(jac, jac2, "{name}: compute_frame_jacobian");
 
             // The LOCAL_WORLD_ALIGNED Jacobian's linear rows are the velocity of the
             // last body's origin: a central difference of its position along a step

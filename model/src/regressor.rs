@@ -1,35 +1,13 @@
-//! The joint torque regressor in plain `f64`: `τ = Y(q, v, a) π`, by the classical
-//! (Luh–Walker–Paul) Newton–Euler recursion on a checked [`Model`].
-//!
-//! Forward pass, body frames, body 0 the base with `ω₀ = ω̇₀ = 0` and `a₀ = −g` (so
-//! gravity comes in as an acceleration of the base). Joint `i` maps body `i`'s frame
-//! into its parent's by the rotation `R_i` and the translation `p_i` (its origin, plus
-//! `R_i z_i q_i` for a prismatic joint), with `z_i` its unit axis in body `i`'s frame:
-//!
-//! ```text
-//! revolute:  ω_i = R_iᵀ ω_λ + z_i v_i
-//!            ω̇_i = R_iᵀ ω̇_λ + (R_iᵀ ω_λ) × z_i v_i + z_i a_i
-//!            a_i = R_iᵀ (a_λ + ω̇_λ × p_i + ω_λ × (ω_λ × p_i))
-//! prismatic: ω_i = R_iᵀ ω_λ,  ω̇_i = R_iᵀ ω̇_λ
-//!            a_i = R_iᵀ (a_λ + ω̇_λ × p_i + ω_λ × (ω_λ × p_i)) + 2 ω_i × z_i v_i + z_i a_i
-//! ```
-//!
-//! With `π_i = [m, h, I]` (`h = m c`, `I` about the body origin), the net wrench on
-//! body `i` about its origin is linear in `π_i`:
-//!
-//! ```text
-//! f_i = m a_i + ω̇_i × h + ω_i × (ω_i × h)
-//! n_i = I ω̇_i + ω_i × (I ω_i) + h × a_i
-//! ```
-//!
-//! Column `k` of body `i`'s wrench regressor is that wrench with `π_i = e_k`. Joint `j`
-//! carries the wrenches of every body it supports, moved towards the base one joint at
-//! a time (`f ← R f`, `n ← R n + p × R f`), and `τ_j = z_jᵀ n` (revolute) or `z_jᵀ f`
-//! (prismatic).
+//! The regressors and the dynamics of a loaded [`Model`] as plain `f64` rows:
+//! `τ = Y(q, v, a) π`, the principal-parameter regressor `Y · blkdiag(P_i)`, and the
+//! model's own inverse dynamics and mass matrix. The algorithms are `dyngen_algo`'s
+//! (rnea, crba and the joint torque regressor, written once for every joint type);
+//! this module checks the state's lengths and shapes the results for the
+//! base-parameter analysis ([`crate::base`]) and the loader's checks.
 
-use crate::math::{self, Mat3, Vec3};
+use crate::math::Mat3;
 use crate::principal::PrincipalFrame;
-use crate::{JointKind, Model};
+use crate::Model;
 use std::fmt;
 
 /// Standard parameters per body: `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
@@ -165,207 +143,26 @@ pub(crate) fn principal_from_standard(model: &Model, y: &[Vec<f64>]) -> Vec<Vec<
         .collect()
 }
 
-/// Where a body is and how it moves: its joint's placement at `q` and the body's
-/// angular velocity, angular acceleration and origin acceleration (gravity included),
-/// in the body's own frame.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct BodyMotion {
-    /// Body frame → parent frame.
-    pub rotation: Mat3,
-    pub translation: Vec3,
-    pub omega: Vec3,
-    pub omega_dot: Vec3,
-    pub accel: Vec3,
-}
-
-/// Joint `j`'s placement at `q` (body frame → parent frame) and its relative
-/// motion in the body frame: angular and linear velocity, angular and linear
-/// acceleration, `(vq_w, vq_v, aq_w, aq_v)`.
-pub(crate) fn joint_state(model: &Model, j: usize, q: &[f64], v: &[f64], a: &[f64]) -> (Mat3, Vec3, [Vec3; 4]) {
-    let joint = &model.joints[j - 1];
-    let (qo, vo) = (model.q_offset(j), model.v_offset(j));
-    let origin = &joint.origin;
-    let z = joint.axis;
-    let v3 = |x: &[f64], o: usize| [x[o], x[o + 1], x[o + 2]];
-    let zero = [0.0; 3];
-    match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => (
-            math::mat_mul(&origin.rotation, &axis_rotation(&z, q[qo])),
-            origin.translation,
-            [math::scale(v[vo], &z), zero, math::scale(a[vo], &z), zero],
-        ),
-        JointKind::Prismatic => {
-            let slide = math::mat_vec(&origin.rotation, &math::scale(q[qo], &z));
-            (
-                origin.rotation,
-                math::add(&origin.translation, &slide),
-                [zero, math::scale(v[vo], &z), zero, math::scale(a[vo], &z)],
-            )
-        }
-        JointKind::Spherical => (
-            math::mat_mul(&origin.rotation, &quaternion_xyzw(&q[qo..qo + 4])),
-            origin.translation,
-            [v3(v, vo), zero, v3(a, vo), zero],
-        ),
-        JointKind::FreeFlyer => {
-            let slide = math::mat_vec(&origin.rotation, &v3(q, qo));
-            (
-                math::mat_mul(&origin.rotation, &quaternion_xyzw(&q[qo + 3..qo + 7])),
-                math::add(&origin.translation, &slide),
-                [v3(v, vo + 3), v3(v, vo), v3(a, vo + 3), v3(a, vo)],
-            )
-        }
-        JointKind::Planar => {
-            let (e1, e2) = math::plane_basis(&z);
-            let in_plane = |x: &[f64], o: usize| math::add(&math::scale(x[o], &e1), &math::scale(x[o + 1], &e2));
-            let slide = math::mat_vec(&origin.rotation, &in_plane(q, qo));
-            (
-                math::mat_mul(&origin.rotation, &axis_rotation(&z, q[qo + 2])),
-                math::add(&origin.translation, &slide),
-                [
-                    math::scale(v[vo + 2], &z),
-                    in_plane(v, vo),
-                    math::scale(a[vo + 2], &z),
-                    in_plane(a, vo),
-                ],
-            )
-        }
-    }
-}
-
 /// The rotation of a quaternion stored as Pinocchio stores it, `[x, y, z, w]`
 /// (not normalised: a configuration is expected to hold a unit quaternion).
 pub fn quaternion_xyzw(q: &[f64]) -> Mat3 {
-    math::quaternion_to_matrix([q[3], q[0], q[1], q[2]])
+    dyngen_algo::quaternion_rotation((), [q[0], q[1], q[2], q[3]])
 }
 
-/// The forward pass of the module docs, body 1 first, for any joint: with the
-/// joint's relative velocity `(ω_q, v_q)` and acceleration `(ω̇_q, a_q)` in body axes,
-/// `ω = ω_in + ω_q`, `ω̇ = ω̇_in + ω̇_q + ω_in × ω_q`, and the origin's acceleration
-/// `a = a_in + a_q + 2 ω_in × v_q + ω_q × v_q`. Lengths are the caller's to check.
-pub(crate) fn forward(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<BodyMotion> {
-    let mut out: Vec<BodyMotion> = Vec::with_capacity(model.dof());
-    for (k, joint) in model.joints.iter().enumerate() {
-        let (w_p, wd_p, a_p) = match joint.parent {
-            0 => ([0.0; 3], [0.0; 3], math::scale(-1.0, &model.gravity)),
-            p => (out[p - 1].omega, out[p - 1].omega_dot, out[p - 1].accel),
-        };
-        let (rotation, translation, [vq_w, vq_v, aq_w, aq_v]) = joint_state(model, k + 1, q, v, a);
-        let rt = math::transpose(&rotation);
-        let p = translation;
-        let carried = math::add(&math::add(&a_p, &cross(&wd_p, &p)), &cross(&w_p, &cross(&w_p, &p)));
-        let w_in = math::mat_vec(&rt, &w_p);
-        let wd_in = math::mat_vec(&rt, &wd_p);
-        let accel_in = math::mat_vec(&rt, &carried);
-        let coriolis = math::add(&math::scale(2.0, &cross(&w_in, &vq_v)), &cross(&vq_w, &vq_v));
-        out.push(BodyMotion {
-            rotation,
-            translation,
-            omega: math::add(&w_in, &vq_w),
-            omega_dot: math::add(&math::add(&wd_in, &cross(&w_in, &vq_w)), &aq_w),
-            accel: math::add(&math::add(&accel_in, &coriolis), &aq_v),
-        });
-    }
-    out
-}
-
-/// Joint `j`'s rows of `τ = Sᵀ [f; n]` for the wrench `(f, n)` in its body frame:
-/// one for a joint with an axis, `n` for a ball joint, `[f; n]` for a free flyer, the
-/// two in-plane forces and the torque about the normal for a planar joint.
-pub(crate) fn joint_rows(model: &Model, j: usize, f: &Vec3, n: &Vec3) -> Vec<f64> {
-    let joint = &model.joints[j - 1];
-    match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => vec![math::dot(&joint.axis, n)],
-        JointKind::Prismatic => vec![math::dot(&joint.axis, f)],
-        JointKind::Spherical => n.to_vec(),
-        JointKind::FreeFlyer => f.iter().chain(n).copied().collect(),
-        JointKind::Planar => {
-            let (e1, e2) = math::plane_basis(&joint.axis);
-            vec![math::dot(&e1, f), math::dot(&e2, f), math::dot(&joint.axis, n)]
-        }
-    }
-}
-
-/// The net wrench `(f, n)` on a body about its origin for standard parameters `pi`
-/// (linear in `pi`; see the module docs).
-fn body_wrench(m: &BodyMotion, pi: &[f64; 10]) -> (Vec3, Vec3) {
-    let mass = pi[0];
-    let h = [pi[1], pi[2], pi[3]];
-    let inertia = [[pi[4], pi[5], pi[7]], [pi[5], pi[6], pi[8]], [pi[7], pi[8], pi[9]]];
-    let (w, wd) = (&m.omega, &m.omega_dot);
-    let f = math::add(
-        &math::add(&math::scale(mass, &m.accel), &cross(wd, &h)),
-        &cross(w, &cross(w, &h)),
-    );
-    let n = math::add(
-        &math::add(&math::mat_vec(&inertia, wd), &cross(w, &math::mat_vec(&inertia, w))),
-        &cross(&h, &m.accel),
-    );
-    (f, n)
-}
-
-/// The torque regressor of the module docs; lengths are the caller's to check.
-/// `O(n · depth)` wrenches carried; the velocity offsets are taken once.
+/// The joint torque regressor as rows (`dyngen_algo::joint_torque_regressor`);
+/// lengths are the caller's to check.
+///
+/// # Panics
+/// If the model is not a tree in regular labelling, which only a model whose fields
+/// were edited by hand can be.
 pub(crate) fn torque_regressor(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<Vec<f64>> {
-    let n = model.dof();
-    let motion = forward(model, q, v, a);
-    let offsets: Vec<usize> = model
-        .joints
-        .iter()
-        .scan(0, |o, j| {
-            let here = *o;
-            *o += j.kind.nv();
-            Some(here)
-        })
-        .collect();
-    let mut y = vec![vec![0.0; STANDARD_PER_BODY * n]; model.nv()];
-    for i in 1..=n {
-        for k in 0..STANDARD_PER_BODY {
-            let mut unit = [0.0; 10];
-            unit[k] = 1.0;
-            let (mut f, mut m) = body_wrench(&motion[i - 1], &unit);
-            let col = STANDARD_PER_BODY * (i - 1) + k;
-            let mut j = i;
-            while j != 0 {
-                let joint = &model.joints[j - 1];
-                let row = offsets[j - 1];
-                match joint.kind {
-                    JointKind::Revolute | JointKind::Continuous => y[row][col] = math::dot(&joint.axis, &m),
-                    JointKind::Prismatic => y[row][col] = math::dot(&joint.axis, &f),
-                    _ => {
-                        for (r, x) in joint_rows(model, j, &f, &m).into_iter().enumerate() {
-                            y[row + r][col] = x;
-                        }
-                    }
-                }
-                let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
-                f = math::mat_vec(r, &f);
-                m = math::add(&math::mat_vec(r, &m), &cross(p, &f));
-                j = joint.parent;
-            }
-        }
-    }
-    y
-}
-
-fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// Rotation by `angle` about the unit `axis` (Rodrigues): `E + sin S(u) + (1 − cos) S(u)²`.
-fn axis_rotation(axis: &Vec3, angle: f64) -> Mat3 {
-    let (s, c) = angle.sin_cos();
-    let t = 1.0 - c;
-    let [x, y, z] = *axis;
-    [
-        [c + t * x * x, t * x * y - s * z, t * x * z + s * y],
-        [t * x * y + s * z, c + t * y * y, t * y * z - s * x],
-        [t * x * z - s * y, t * y * z + s * x, c + t * z * z],
-    ]
+    let body = model
+        .multibody()
+        .unwrap_or_else(|e| panic!("model `{}` is not a checked tree: {e}", model.name));
+    let cols = STANDARD_PER_BODY * body.bodies();
+    let mut y = vec![0.0; body.nv() * cols];
+    dyngen_algo::joint_torque_regressor(&body, &mut dyngen_algo::Workspace::new(&body, ()), q, v, a, &mut y);
+    y.chunks(cols).map(<[f64]>::to_vec).collect()
 }
 
 /// The robots with a Pinocchio fixture (`tests/fixtures/<name>.json`) and their
@@ -388,35 +185,41 @@ mod tests {
     use crate::Inertial;
 
     /// Inverse dynamics written another way: each body's wrench about its centre of
-    /// mass from its mass properties, shifted to the origin, and the children's
-    /// wrenches summed into the parent leaf first.
+    /// mass from its mass properties and its spatial motion (`dyngen_algo::body_motions`,
+    /// gravity added as an acceleration of every body), shifted to the origin, and
+    /// the children's wrenches summed into the parent leaf first.
     fn rnea(model: &Model, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
+        use crate::math::{add, dot, mat_vec, scale};
+        let cross = |a: &[f64; 3], b: &[f64; 3]| dyngen_algo::spatial::cross(*a, *b);
         let n = model.dof();
-        let motion = forward(model, q, v, a);
+        let body = model.multibody().unwrap();
+        let mut ws = dyngen_algo::Workspace::new(&body, ());
+        dyngen_algo::body_motions(&body, &mut ws, q, v, a);
         let mut f = vec![[0.0; 3]; n];
         let mut m = vec![[0.0; 3]; n];
-        for (i, (body, mo)) in model.bodies.iter().zip(&motion).enumerate() {
-            let Inertial { mass, com: c, inertia } = body.inertial;
-            let (w, wd) = (&mo.omega, &mo.omega_dot);
-            let a_c = math::add(&math::add(&mo.accel, &cross(wd, &c)), &cross(w, &cross(w, &c)));
-            f[i] = math::scale(mass, &a_c);
-            let about_c = math::add(&math::mat_vec(&inertia, wd), &cross(w, &math::mat_vec(&inertia, w)));
-            m[i] = math::add(&about_c, &cross(&c, &f[i]));
+        for (i, b) in model.bodies.iter().enumerate() {
+            let Inertial { mass, com: c, inertia } = b.inertial;
+            let (vel, acc, world) = (ws.velocity[i + 1], ws.acceleration[i + 1], ws.world[i + 1]);
+            let (w, wd) = (&vel.angular, &acc.angular);
+            // The classical acceleration of the centre of mass, gravity included.
+            let g = dyngen_algo::spatial::mat_tr_vec(&world.rotation, model.gravity);
+            let a_o = add(&acc.linear, &cross(w, &vel.linear));
+            let a_c = add(&add(&a_o, &cross(wd, &c)), &cross(w, &cross(w, &c)));
+            f[i] = scale(mass, &add(&a_c, &scale(-1.0, &g)));
+            let about_c = add(&mat_vec(&inertia, wd), &cross(w, &mat_vec(&inertia, w)));
+            m[i] = add(&about_c, &cross(&c, &f[i]));
         }
         let mut tau = vec![0.0; n];
         for j in (1..=n).rev() {
             let joint = &model.joints[j - 1];
-            tau[j - 1] = math::dot(
-                &joint.axis,
-                if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] },
-            );
+            tau[j - 1] = dot(&joint.axis, if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] });
             if joint.parent != 0 {
-                let (r, p) = (&motion[j - 1].rotation, &motion[j - 1].translation);
-                let fp = math::mat_vec(r, &f[j - 1]);
-                let mp = math::add(&math::mat_vec(r, &m[j - 1]), &cross(p, &fp));
+                let x = ws.placement[j].se3(0.0, 1.0);
+                let fp = mat_vec(&x.rotation, &f[j - 1]);
+                let mp = add(&mat_vec(&x.rotation, &m[j - 1]), &cross(&x.translation, &fp));
                 let k = joint.parent - 1;
-                f[k] = math::add(&f[k], &fp);
-                m[k] = math::add(&m[k], &mp);
+                f[k] = add(&f[k], &fp);
+                m[k] = add(&m[k], &mp);
             }
         }
         tau

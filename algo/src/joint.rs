@@ -52,6 +52,29 @@ impl JointType {
             JointType::FreeFlyer => 6,
         }
     }
+
+    /// A rotation about an axis (revolute or continuous).
+    pub const fn is_revolute(self) -> bool {
+        matches!(self, JointType::Revolute | JointType::Continuous)
+    }
+
+    /// Whether the joint has an axis: the axis of a one-coordinate joint, or the plane
+    /// normal of a planar joint. A ball joint and a free flyer have none.
+    pub const fn has_axis(self) -> bool {
+        self.nv() == 1 || matches!(self, JointType::Planar)
+    }
+
+    /// The URDF `type` attribute.
+    pub const fn urdf_name(self) -> &'static str {
+        match self {
+            JointType::Revolute => "revolute",
+            JointType::Continuous => "continuous",
+            JointType::Prismatic => "prismatic",
+            JointType::Spherical => "spherical",
+            JointType::FreeFlyer => "floating",
+            JointType::Planar => "planar",
+        }
+    }
 }
 
 /// A joint axis, with the coordinate axes told apart so that `f64` code does not

@@ -2,48 +2,8 @@
 //! checked model it was generated from, in the generator's numbering, so that nothing
 //! at run time re-parses a file or renumbers a joint.
 
-/// What a joint allows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum JointType {
-    /// Rotation about the axis, with position limits.
-    Revolute,
-    /// Rotation about the axis without limits; its coordinate is the angle.
-    Continuous,
-    /// Translation along the axis.
-    Prismatic,
-    /// A ball joint: 4 positions (unit quaternion `[x, y, z, w]`), 3 velocities (the
-    /// angular velocity in the child frame).
-    Spherical,
-    /// The free flyer of a floating base (joint 1 only): 7 positions `[p; x, y, z, w]`,
-    /// 6 velocities `[v; ω]` in the body frame, as Pinocchio's `JointModelFreeFlyer`.
-    FreeFlyer,
-    /// Motion in the plane normal to the axis: 3 positions `[x, y, θ]` (the child's
-    /// origin along the plane's axes, its turn about the normal), 3 velocities
-    /// `[vx, vy, ω]` in the child frame. Pinocchio's `JointModelPlanar` for the normal
-    /// `z`, with the angle in place of its `(cos θ, sin θ)`.
-    Planar,
-}
-
-impl JointType {
-    /// Number of position coordinates: 1, 3, 4 or 7.
-    pub const fn nq(self) -> usize {
-        match self {
-            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
-            JointType::Planar => 3,
-            JointType::Spherical => 4,
-            JointType::FreeFlyer => 7,
-        }
-    }
-
-    /// Number of velocity coordinates: 1, 3 or 6.
-    pub const fn nv(self) -> usize {
-        match self {
-            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
-            JointType::Spherical | JointType::Planar => 3,
-            JointType::FreeFlyer => 6,
-        }
-    }
-}
+/// What a joint allows: one enum for every layer, the algorithms' own.
+pub use dyngen_algo::JointType;
 
 /// Joint position, velocity and effort limits (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,78 +3,10 @@
 
 use crate::math::{self, Mat3, Vec3};
 
-/// What a joint allows. Fixed joints never reach the checked model: they are merged.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum JointKind {
-    /// Rotation about `axis`, with position limits.
-    Revolute,
-    /// Rotation about `axis` without limits (a URDF `continuous` joint). Its
-    /// coordinate is the angle, not Pinocchio's `(cos, sin)` pair.
-    Continuous,
-    /// Translation along `axis`.
-    Prismatic,
-    /// Free rotation about the joint-frame origin (a ball joint): 4 positions, the
-    /// unit quaternion `[x, y, z, w]` of the child in the joint frame; 3 velocities,
-    /// the angular velocity in the child frame. Pinocchio's `JointModelSpherical`.
-    Spherical,
-    /// The free flyer of a floating base, only as the joint of body 1 on the fixed
-    /// world: 7 positions `[p; x, y, z, w]` (position of the body in the world, unit
-    /// quaternion of its orientation), 6 velocities `[v; ω]`, the linear velocity of
-    /// the body-frame origin and the angular velocity, both in the body frame.
-    /// Pinocchio's `JointModelFreeFlyer`; its "torques" are the wrench on the base.
-    FreeFlyer,
-    /// Motion in the plane normal to `axis` (a URDF `planar` joint): 3 positions
-    /// `[x, y, θ]`, the child's origin in the plane and its turn about the normal; 3
-    /// velocities `[vx, vy, ω]` in the child frame. The plane's axes are
-    /// [`math::plane_basis`] of the normal (`x`, `y` for the normal `z`). With the normal
-    /// `z` this is Pinocchio's `JointModelPlanar` except that, as for a continuous joint,
-    /// the angle replaces Pinocchio's `(cos θ, sin θ)` pair.
-    Planar,
-}
-
-impl JointKind {
-    pub fn is_revolute(self) -> bool {
-        matches!(self, JointKind::Revolute | JointKind::Continuous)
-    }
-
-    /// Number of position coordinates: 1, 3 (planar), 4 (quaternion) or 7 (position,
-    /// quaternion).
-    pub fn nq(self) -> usize {
-        match self {
-            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
-            JointKind::Planar => 3,
-            JointKind::Spherical => 4,
-            JointKind::FreeFlyer => 7,
-        }
-    }
-
-    /// Number of velocity coordinates (degrees of freedom): 1, 3 or 6.
-    pub fn nv(self) -> usize {
-        match self {
-            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
-            JointKind::Spherical | JointKind::Planar => 3,
-            JointKind::FreeFlyer => 6,
-        }
-    }
-
-    /// Whether the joint has an axis: the axis of a one-degree-of-freedom joint, or the
-    /// plane normal of a planar joint. A ball joint and a free flyer have none.
-    pub fn has_axis(self) -> bool {
-        self.nv() == 1 || self == JointKind::Planar
-    }
-
-    /// The URDF `type` attribute.
-    pub fn urdf_name(self) -> &'static str {
-        match self {
-            JointKind::Revolute => "revolute",
-            JointKind::Continuous => "continuous",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Spherical => "spherical",
-            JointKind::FreeFlyer => "floating",
-            JointKind::Planar => "planar",
-        }
-    }
-}
+/// What a joint allows: the algorithms' joint type (`dyngen_algo::JointType`), one
+/// enum for every layer. Fixed joints never reach the checked model: they are merged.
+/// A planar joint's plane axes are [`math::plane_basis`] of its normal.
+pub type JointKind = dyngen_algo::JointType;
 
 /// A rigid placement: maps child coordinates to parent coordinates,
 /// `x_parent = rotation · x_child + translation`.

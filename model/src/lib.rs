@@ -49,7 +49,6 @@ pub use mjcf::{
     load_mjcf, load_mjcf_options, load_mjcf_with, load_robot, load_robot_options, load_robot_with, parse_mjcf,
     parse_mjcf_options, parse_mjcf_with,
 };
-pub use multibody::joint_type;
 pub use principal::{principal_frames, principal_params, PrincipalFrame};
 pub use urdf::{load_urdf, load_urdf_options, load_urdf_with, parse_urdf, parse_urdf_options, parse_urdf_with};
 pub use write::{inertial_element, to_urdf};

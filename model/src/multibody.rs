@@ -2,20 +2,8 @@
 //! `dyngen-algo`'s rnea, crba, aba and Jacobians run on at run time.
 
 use crate::math::plane_basis;
-use crate::{JointKind, Model};
-use dyngen_algo::{JointSpec, JointType, Multibody, Se3, TreeError};
-
-/// The algorithms' joint type of a model joint kind.
-pub fn joint_type(kind: JointKind) -> JointType {
-    match kind {
-        JointKind::Revolute => JointType::Revolute,
-        JointKind::Continuous => JointType::Continuous,
-        JointKind::Prismatic => JointType::Prismatic,
-        JointKind::Spherical => JointType::Spherical,
-        JointKind::FreeFlyer => JointType::FreeFlyer,
-        JointKind::Planar => JointType::Planar,
-    }
-}
+use crate::Model;
+use dyngen_algo::{JointSpec, Multibody, Se3, TreeError};
 
 impl Model {
     /// This model as the algorithms' [`Multibody`]: the same numbering, placements,
@@ -48,7 +36,7 @@ impl Model {
                 let mut p = [0.0; 10];
                 p.copy_from_slice(&params[10 * k..10 * k + 10]);
                 JointSpec {
-                    kind: joint_type(j.kind),
+                    kind: j.kind,
                     parent: j.parent,
                     origin: Se3 {
                         rotation: j.origin.rotation,

@@ -212,7 +212,10 @@ mod tests {
         let mut tau = vec![0.0; n];
         for j in (1..=n).rev() {
             let joint = &model.joints[j - 1];
-            tau[j - 1] = dot(&joint.axis, if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] });
+            tau[j - 1] = dot(
+                &joint.axis,
+                if joint.kind.is_revolute() { &m[j - 1] } else { &f[j - 1] },
+            );
             if joint.parent != 0 {
                 let x = ws.placement[j].se3(0.0, 1.0);
                 let fp = mat_vec(&x.rotation, &f[j - 1]);

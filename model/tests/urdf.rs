@@ -1381,7 +1381,7 @@ fn to_urdf_round_trips() {
     let model = parse_urdf(&branched_urdf()).unwrap();
     assert_eq!(model.dof(), 5);
     let kinds: Vec<JointKind> = model.joints.iter().map(|j| j.kind).collect();
-    use JointKind::*;
+    use dyngen_algo::JointType::*;
     assert_eq!(kinds, [Continuous, Revolute, Prismatic, Revolute, Prismatic]);
 
     let written = to_urdf(&model);

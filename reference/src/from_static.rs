@@ -2,8 +2,8 @@
 //! core crate) as the runtime's [`Model`]: no file is parsed and no joint renumbered,
 //! so the reference, identification and NIM see exactly the generator's numbering.
 
-use dyngen::{JointType, Robot, RobotModel};
-use dyngen_model::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+use dyngen::{Robot, RobotModel};
+use dyngen_model::{Body, Frame, Inertial, Joint, JointDynamics, Limits, Model, Placement};
 
 /// The runtime model of a generated robot's `MODEL`.
 pub fn model_from_static(m: &RobotModel) -> Model {
@@ -17,14 +17,7 @@ pub fn model_from_static(m: &RobotModel) -> Model {
             .iter()
             .map(|j| Joint {
                 name: j.name.to_string(),
-                kind: match j.kind {
-                    JointType::Revolute => JointKind::Revolute,
-                    JointType::Continuous => JointKind::Continuous,
-                    JointType::Prismatic => JointKind::Prismatic,
-                    JointType::Spherical => JointKind::Spherical,
-                    JointType::FreeFlyer => JointKind::FreeFlyer,
-                    JointType::Planar => JointKind::Planar,
-                },
+                kind: j.kind,
                 parent: j.parent,
                 origin: Placement {
                     rotation: j.rotation,

@@ -5,7 +5,7 @@
 //! ([`state_count`] of them, [`SAMPLES`] for every model up to
 //! [`ALL_SAMPLES_UP_TO`] columns), stacked (`W`), and factored by a QR that takes
 //! the columns in parameter order and sets aside every column already in the span of
-//! those kept (see [`ordered_qr`]). Kept columns are the base; every other column is
+//! those kept (see `ordered_qr`). Kept columns are the base; every other column is
 //! a fixed combination of them, `W_dep = W_ind R₁₁⁻¹ R₁₂`, so `Y π = Y_b β` with
 //!
 //! ```text
@@ -24,7 +24,7 @@
 //! second seed ([`BaseParams::confirmed`]), and the numerical rank of `W` is counted
 //! from its singular values ([`BaseParams::rank_check`]), which must equal the number
 //! of columns the QR kept (for large models by bounds that prove the count, see
-//! [`large_rank`]).
+//! `large_rank`).
 
 use crate::joint_params::{append_joint_columns, joint_param_names, Coulomb};
 #[cfg(test)]
@@ -174,7 +174,7 @@ impl fmt::Display for BaseParams {
 /// on the regressor stacked over [`state_count`] states from [`structure_states`]
 /// with `SEEDS[0]`, confirmed with `SEEDS[1]`, and the rank counted from the
 /// singular values of the same stacked matrix (above [`ALL_SAMPLES_UP_TO`] columns:
-/// proved equal by bounds, or counted on the factor, see [`large_rank`]).
+/// proved equal by bounds, or counted on the factor, see `large_rank`).
 pub fn analyse(model: &Model, parameterisation: Parameterisation) -> BaseParams {
     analysed(model, parameterisation, None)
 }
@@ -239,7 +239,7 @@ pub fn state_count(rows_per_state: usize, columns: usize) -> usize {
 /// by equation, then state (all states' rows of the first kept equation first): the
 /// columns of a body are zero in the equations of joints that do not support it, so
 /// in this order a chain's body `i` has its columns zero below the rows of joint `i`,
-/// which [`ordered_qr`] uses. The row order changes nothing else (the QR's decisions
+/// which `ordered_qr` uses. The row order changes nothing else (the QR's decisions
 /// depend only on the columns' inner products).
 fn stacked(model: &Model, parameterisation: Parameterisation, seed: u64, keep: Option<&[usize]>) -> Mat<f64> {
     let nv = model.nv();
@@ -277,7 +277,7 @@ fn from_stacked(rows: &[Vec<f64>], names: &[String]) -> BaseParams {
 
 /// The ordered QR of the module docs on a stacked regressor (factored in place)
 /// whose columns `names` names; `confirmed` and `rank_check` are left for the caller.
-/// The factorisation comes back too, for [`large_rank`].
+/// The factorisation comes back too, for `large_rank`.
 fn from_matrix(w: Mat<f64>, names: &[String]) -> (BaseParams, OrderedQr) {
     let p = names.len();
     let qr = ordered_qr(w);
@@ -403,12 +403,12 @@ fn format_coef(x: f64) -> String {
     t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
-/// Columns per panel of [`ordered_qr`]: the decisions within a panel are taken one
+/// Columns per panel of `ordered_qr`: the decisions within a panel are taken one
 /// column at a time, the panel's kept columns then update the rest in one blocked
 /// Householder product.
 const PANEL: usize = 32;
 
-/// What [`ordered_qr`] found.
+/// What `ordered_qr` found.
 struct OrderedQr {
     /// Kept columns, ascending (the base), and the columns set aside, ascending.
     kept: Vec<usize>,

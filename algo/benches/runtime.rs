@@ -7,8 +7,8 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use dyngen_algo::{
-    aba, compute_frame_jacobian, crba, forward_kinematics, joint_torque_regressor, rnea, JointType, Multibody,
-    ReferenceFrame, Se3, Workspace,
+    aba, compute_frame_jacobian, crba, forward_kinematics, joint_torque_regressor, rnea, Multibody, ReferenceFrame,
+    Se3, Workspace,
 };
 use dyngen_model::{load_urdf_options, LoadOptions};
 use rand::{Rng, SeedableRng};
@@ -25,15 +25,7 @@ fn states(body: &Multibody) -> Vec<State> {
     (0..1000)
         .map(|_| {
             let mut q: Vec<f64> = body.neutral().iter().map(|x| x + rng.gen_range(-1.0..1.0)).collect();
-            for j in &body.joints {
-                let k = match j.kind {
-                    JointType::Spherical => j.q_offset,
-                    JointType::FreeFlyer => j.q_offset + 3,
-                    _ => continue,
-                };
-                let n = q[k..k + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
-                q[k..k + 4].iter_mut().for_each(|x| *x /= n);
-            }
+            body.normalize(&mut q);
             let mut r = || (0..body.nv()).map(|_| rng.gen_range(-1.0..1.0)).collect();
             State { q, v: r(), a: r() }
         })

@@ -137,14 +137,8 @@ impl Axis {
         }
     }
 
-    /// The rotation by `angle` about the axis (Rodrigues, `R = c E + s [a]× + (1 − c) a aᵀ`).
-    #[inline(always)]
-    pub fn rotation<S: Real>(self, ctx: S::Context, angle: S) -> Mat3<S> {
-        let (s, c) = angle.sin_cos();
-        self.rotation_of(ctx, s, c)
-    }
-
-    /// [`Axis::rotation`] of the angle whose sine and cosine are `s` and `c`.
+    /// The rotation about the axis by the angle whose sine and cosine are `s` and
+    /// `c` (Rodrigues, `R = c E + s [a]× + (1 − c) a aᵀ`).
     #[inline(always)]
     pub fn rotation_of<S: Real>(self, ctx: S::Context, s: S, c: S) -> Mat3<S> {
         let (z, o) = (S::constant(ctx, 0.0), S::constant(ctx, 1.0));
@@ -334,6 +328,25 @@ impl Joint {
         self.motion(c, &e)
     }
 
+    /// The coordinate `k` of the spatial motion `[v; ω]` (0–2 linear, 3–5 angular)
+    /// when column `e` of `S` is the unit motion along it, `None` when it is not.
+    #[inline(always)]
+    fn unit_column(&self, e: usize) -> Option<usize> {
+        let axis = match self.axis {
+            Axis::X => Some(0),
+            Axis::Y => Some(1),
+            Axis::Z => Some(2),
+            Axis::Other(_) => None,
+        };
+        match self.kind {
+            JointType::Revolute | JointType::Continuous => axis.map(|k| 3 + k),
+            JointType::Prismatic => axis,
+            JointType::Spherical => Some(3 + e),
+            JointType::FreeFlyer => Some(e),
+            JointType::Planar => None,
+        }
+    }
+
     /// `A S_e`, the operator `a` applied to column `e` of `S`: one column of `a`
     /// where `S_e` is a coordinate axis, [`SpatialMatrix::apply`] otherwise.
     #[inline(always)]
@@ -354,18 +367,9 @@ impl Joint {
                 }
             }
         };
-        let axis = match self.axis {
-            Axis::X => Some(0),
-            Axis::Y => Some(1),
-            Axis::Z => Some(2),
-            Axis::Other(_) => None,
-        };
-        match (self.kind, axis) {
-            (JointType::Revolute | JointType::Continuous, Some(k)) => column(3 + k),
-            (JointType::Prismatic, Some(k)) => column(k),
-            (JointType::Spherical, _) => column(3 + e),
-            (JointType::FreeFlyer, _) => column(e),
-            _ => a.apply(self.column(c, e)),
+        match self.unit_column(e) {
+            Some(k) => column(k),
+            None => a.apply(self.column(c, e)),
         }
     }
 
@@ -400,18 +404,9 @@ impl Joint {
                 }
             }
         };
-        let axis = match self.axis {
-            Axis::X => Some(0),
-            Axis::Y => Some(1),
-            Axis::Z => Some(2),
-            Axis::Other(_) => None,
-        };
-        match (self.kind, axis) {
-            (JointType::Revolute | JointType::Continuous, Some(k)) => column(3 + k),
-            (JointType::Prismatic, Some(k)) => column(k),
-            (JointType::Spherical, _) => column(3 + e),
-            (JointType::FreeFlyer, _) => column(e),
-            _ => i.apply(self.column(c, e)),
+        match self.unit_column(e) {
+            Some(k) => column(k),
+            None => i.apply(self.column(c, e)),
         }
     }
 

@@ -21,9 +21,6 @@ pub struct Multibody {
     pub params: Vec<f64>,
     nq: usize,
     nv: usize,
-    /// Per velocity coordinate: the coordinate before it on the path to the base
-    /// (in its own joint, or the last of the parent joint's), `usize::MAX` at the base.
-    coordinate_parent: Vec<usize>,
     /// The velocity coordinates that move each body, root first: body `i`'s are
     /// `supports[support_offsets[i]..support_offsets[i + 1]]` (body 0 has none).
     pub(crate) supports: Vec<usize>,
@@ -78,7 +75,6 @@ impl Multibody {
         let (mut nq, mut nv) = (0, 0);
         let mut joints = Vec::with_capacity(specs.len());
         let mut params = Vec::with_capacity(PARAMS_PER_BODY * specs.len());
-        let mut coordinate_parent = Vec::new();
         for (i, s) in specs.iter().enumerate() {
             if s.parent > i {
                 return Err(TreeError::ParentNotBefore {
@@ -98,16 +94,6 @@ impl Multibody {
                 q_offset: nq,
                 v_offset: nv,
             };
-            for k in 0..s.kind.nv() {
-                coordinate_parent.push(if k > 0 {
-                    nv + k - 1
-                } else if s.parent == 0 {
-                    usize::MAX
-                } else {
-                    let p = &joints[s.parent - 1] as &Joint;
-                    p.v_offset + p.nv() - 1
-                });
-            }
             nq += s.kind.nq();
             nv += s.kind.nv();
             joints.push(joint);
@@ -128,7 +114,6 @@ impl Multibody {
             params,
             nq,
             nv,
-            coordinate_parent,
             supports,
             support_offsets,
         })
@@ -147,9 +132,24 @@ impl Multibody {
         self.nv
     }
 
-    /// The velocity coordinate before `d` on the path to the base, `None` at the base.
-    pub fn coordinate_parent(&self, d: usize) -> Option<usize> {
-        Some(self.coordinate_parent[d]).filter(|&p| p != usize::MAX)
+    /// Scales every quaternion of the configuration `q` to unit length (Pinocchio's
+    /// `normalize`); a zero quaternion is left as it is.
+    ///
+    /// # Panics
+    /// If `q` is not `nq` long.
+    pub fn normalize(&self, q: &mut [f64]) {
+        crate::kinematics::check_len("q", q, self.nq);
+        for j in &self.joints {
+            let k = match j.kind {
+                JointType::Spherical => j.q_offset,
+                JointType::FreeFlyer => j.q_offset + 3,
+                _ => continue,
+            };
+            let n = sqrt(q[k..k + 4].iter().map(|x| x * x).sum::<f64>());
+            if n > 0.0 {
+                q[k..k + 4].iter_mut().for_each(|x| *x /= n);
+            }
+        }
     }
 
     /// The neutral configuration: zero coordinates, identity quaternions.
@@ -245,4 +245,14 @@ impl<S: Real> Workspace<S> {
     pub(crate) fn zero(&self) -> S {
         S::constant(self.context, 0.0)
     }
+}
+
+#[cfg(feature = "std")]
+fn sqrt(x: f64) -> f64 {
+    x.sqrt()
+}
+
+#[cfg(all(not(feature = "std"), feature = "libm"))]
+fn sqrt(x: f64) -> f64 {
+    libm::sqrt(x)
 }

@@ -34,15 +34,7 @@ fn models() -> Vec<(&'static str, Multibody)> {
 
 fn random_q(body: &Multibody, rng: &mut impl Rng) -> Vec<f64> {
     let mut q: Vec<f64> = body.neutral().iter().map(|x| x + rng.gen_range(-1.0..1.0)).collect();
-    for j in &body.joints {
-        let k = match j.kind {
-            JointType::Spherical => j.q_offset,
-            JointType::FreeFlyer => j.q_offset + 3,
-            _ => continue,
-        };
-        let n = q[k..k + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
-        q[k..k + 4].iter_mut().for_each(|x| *x /= n);
-    }
+    body.normalize(&mut q);
     q
 }
 

@@ -92,15 +92,7 @@ fn the_algorithms_on_expressions_are_the_generators_functions() {
             (0..nv).map(|_| rng.gen_range(-1.0..1.0)).collect(),
             body.params.clone(),
         ];
-        for j in &body.joints {
-            let k = match j.kind {
-                dyngen_algo::JointType::Spherical => j.q_offset,
-                dyngen_algo::JointType::FreeFlyer => j.q_offset + 3,
-                _ => continue,
-            };
-            let n = state[0][k..k + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
-            state[0][k..k + 4].iter_mut().for_each(|x| *x /= n);
-        }
+        body.normalize(&mut state[0]);
         let read = |arg: u8, i: u32| state[arg as usize][i as usize];
         let mut line = Vec::new();
         for ((what, ours), (_, theirs)) in ours.iter().zip(&theirs) {

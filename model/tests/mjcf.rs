@@ -14,6 +14,9 @@
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
+mod common;
+
+use common::{load_error, TempDir};
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -371,49 +374,12 @@ fn include_in_text_is_refused() {
     );
 }
 
-/// A fresh folder under the temporary directory, named for the test and the process.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("dyngen-mjcf-include-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, text).unwrap();
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 const BODY_A: &str =
     "<body name=\"a\"><joint name=\"ja\"/><inertial pos=\"0 0 0\" mass=\"1\" diaginertia=\"0.1 0.1 0.1\"/></body>";
 
-/// The refusal of `load_mjcf(top)`: its only error, on `line` of the top-level file,
-/// saying `says`.
-fn load_error(top: &std::path::Path, line: usize, says: &str) -> String {
-    let e = load_mjcf(top).expect_err("should be refused");
-    assert_eq!(e.errors.len(), 1, "{e}");
-    assert_eq!(e.errors[0].line, Some(line), "{e}");
-    let message = e.to_string();
-    assert!(message.contains(&format!("top.xml:{line}: ")), "{message}");
-    assert!(message.contains(says), "{message}");
-    message
-}
-
 #[test]
 fn include_is_replaced_by_the_included_files_elements() {
-    let dir = TempDir::new("splice");
+    let dir = TempDir::new("mjcf-include-splice");
     // Paths relative to the top-level file's folder, nested includes too (MuJoCo's
     // rule: `sub/b.xml` includes `c.xml` of the top folder, not `sub/c.xml`).
     let top = dir.write(
@@ -427,7 +393,7 @@ fn include_is_replaced_by_the_included_files_elements() {
     dir.write("c.xml", "<mujoco><option gravity=\"0 0 -3\"/></mujoco>\n");
     dir.write(
         "arm.xml",
-        &format!("<mujoco>\n{BODY_A}\n<body name=\"b\"><joint name=\"jb\"/>{INERTIAL}</body>\n</mujoco>\n"),
+        format!("<mujoco>\n{BODY_A}\n<body name=\"b\"><joint name=\"jb\"/>{INERTIAL}</body>\n</mujoco>\n"),
     );
     let model = load_mjcf(&top).unwrap();
     assert_eq!(model.gravity, [0.0, 0.0, -3.0]);
@@ -438,7 +404,7 @@ fn include_is_replaced_by_the_included_files_elements() {
 
 #[test]
 fn errors_in_an_included_file_name_it_and_its_line() {
-    let dir = TempDir::new("inner");
+    let dir = TempDir::new("mjcf-include-inner");
     let top = dir.write(
         "top.xml",
         "<mujoco model=\"t\">\n<worldbody>\n<include file=\"parts/arm.xml\"/>\n</worldbody>\n</mujoco>\n",
@@ -471,7 +437,7 @@ fn errors_in_an_included_file_name_it_and_its_line() {
     dir.write("parts/arm.xml", "<mujoco>\n<body>\n</mujoco>\n");
     load_error(&top, 3, "in `parts/arm.xml` line 3: not valid XML");
     // Warnings too.
-    dir.write("parts/arm.xml", &format!("<mujoco>\n{BODY_A}\n</mujoco>\n"));
+    dir.write("parts/arm.xml", format!("<mujoco>\n{BODY_A}\n</mujoco>\n"));
     let top2 = dir.write(
         "top.xml",
         "<mujoco model=\"t\">\n<worldbody>\n<include file=\"parts/arm.xml\"/>\n</worldbody>\n\
@@ -495,11 +461,11 @@ fn errors_in_an_included_file_name_it_and_its_line() {
 
 #[test]
 fn include_errors_name_the_include_and_what_is_valid() {
-    let dir = TempDir::new("errors");
+    let dir = TempDir::new("mjcf-include-errors");
     let top_with = |include: &str| {
         dir.write(
             "top.xml",
-            &format!("<mujoco model=\"t\">\n<worldbody>\n{BODY_A}\n</worldbody>\n{include}\n</mujoco>\n"),
+            format!("<mujoco model=\"t\">\n<worldbody>\n{BODY_A}\n</worldbody>\n{include}\n</mujoco>\n"),
         )
     };
     let top = top_with("<include/>");
@@ -560,7 +526,7 @@ fn include_errors_name_the_include_and_what_is_valid() {
     for k in 0..10 {
         dir.write(
             &format!("d{k}.xml"),
-            &format!("<mujoco>\n<include file=\"d{}.xml\"/>\n</mujoco>", k + 1),
+            format!("<mujoco>\n<include file=\"d{}.xml\"/>\n</mujoco>", k + 1),
         );
     }
     dir.write("d10.xml", "<mujoco/>");

@@ -6,8 +6,11 @@
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, parse_mjcf, Model};
+mod common;
+
+use common::{load_error, TempDir};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -77,31 +80,6 @@ fn scaled_moved_weighed_and_inline_meshes_give_mujocos_inertia() {
     assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
 }
 
-/// A folder of its own, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("dyngen-mesh-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, bytes).unwrap();
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 /// A model whose body `b` (on a hinge) has one mesh geom of the mesh given by the
 /// `<mesh>` element `mesh` (line 3 of `top.xml`; the geom is on line 7).
 fn model_with(mesh: &str) -> String {
@@ -111,29 +89,18 @@ fn model_with(mesh: &str) -> String {
     )
 }
 
-/// The refusal of the model in `dir`'s `top.xml`: its only error, on `line`, saying `says`.
-fn refusal(top: &Path, line: usize, says: &str) -> String {
-    let e = load_mjcf(top).expect_err("should be refused");
-    assert_eq!(e.errors.len(), 1, "{e}");
-    assert_eq!(e.errors[0].line, Some(line), "{e}");
-    let message = e.to_string();
-    assert!(message.contains(&format!("top.xml:{line}: ")), "{message}");
-    assert!(message.contains(says), "{message}");
-    message
-}
-
 fn box_stl() -> Vec<u8> {
     std::fs::read(fixture("meshes/box.stl")).unwrap()
 }
 
 #[test]
 fn a_missing_mesh_file_is_refused_naming_it() {
-    let dir = TempDir::new("missing");
+    let dir = TempDir::new("mesh-missing");
     let top = dir.write(
         "top.xml",
         model_with("<mesh name=\"m\" file=\"parts/gone.stl\"/>").as_bytes(),
     );
-    refusal(
+    load_error(
         &top,
         3,
         "<mesh name=\"m\" file=\"parts/gone.stl\">: cannot read `parts/gone.stl`",
@@ -142,26 +109,26 @@ fn a_missing_mesh_file_is_refused_naming_it() {
     let text =
         model_with("<mesh name=\"m\" file=\"gone.stl\"/>").replace("<asset>", "<compiler meshdir=\"parts\"/><asset>");
     let top = dir.write("top.xml", text.as_bytes());
-    refusal(&top, 3, "cannot read `parts/gone.stl`");
+    load_error(&top, 3, "cannot read `parts/gone.stl`");
 }
 
 #[test]
 fn a_mesh_file_outside_the_models_folder_is_refused() {
-    let dir = TempDir::new("outside");
-    dir.write("box.stl", &box_stl());
+    let dir = TempDir::new("mesh-outside");
+    dir.write("box.stl", box_stl());
     let top = dir.write(
         "model/top.xml",
         model_with("<mesh name=\"m\" file=\"../box.stl\"/>").as_bytes(),
     );
-    refusal(&top, 3, "`../box.stl` leads out of the model file's folder");
+    load_error(&top, 3, "`../box.stl` leads out of the model file's folder");
     let text =
         model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("<asset>", "<compiler meshdir=\"..\"/><asset>");
     let top = dir.write("model/top.xml", text.as_bytes());
-    refusal(&top, 3, "`../box.stl` leads out of the model file's folder");
+    load_error(&top, 3, "`../box.stl` leads out of the model file's folder");
     let absolute = dir.0.join("box.stl");
     let text = model_with(&format!("<mesh name=\"m\" file=\"{}\"/>", absolute.display()));
     let top = dir.write("model/top.xml", text.as_bytes());
-    refusal(&top, 3, "is an absolute path");
+    load_error(&top, 3, "is an absolute path");
     // Nor through a link.
     #[cfg(unix)]
     {
@@ -170,7 +137,7 @@ fn a_mesh_file_outside_the_models_folder_is_refused() {
             "model/top.xml",
             model_with("<mesh name=\"m\" file=\"link.stl\"/>").as_bytes(),
         );
-        refusal(
+        load_error(
             &top,
             3,
             "`link.stl` leads (through a link) out of the model file's folder",
@@ -180,45 +147,45 @@ fn a_mesh_file_outside_the_models_folder_is_refused() {
 
 #[test]
 fn a_corrupt_or_ascii_stl_is_refused() {
-    let dir = TempDir::new("corrupt");
+    let dir = TempDir::new("mesh-corrupt");
     let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"bad.stl\"/>").as_bytes());
     // Cut short: the header's count of triangles does not fit the size.
     let stl = box_stl();
     dir.write("bad.stl", &stl[..stl.len() - 7]);
-    refusal(
+    load_error(
         &top,
         3,
         "`bad.stl`: its header counts 12 triangles, which take 684 bytes, but the file has 677",
     );
     dir.write("bad.stl", b"");
-    refusal(&top, 3, "`bad.stl`: the file is empty");
-    dir.write("bad.stl", &[0u8; 40]);
-    refusal(&top, 3, "shorter than the 84-byte header");
+    load_error(&top, 3, "`bad.stl`: the file is empty");
+    dir.write("bad.stl", [0u8; 40]);
+    load_error(&top, 3, "shorter than the 84-byte header");
     // MuJoCo reads no ASCII STL.
     let ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n\
                  endfacet\nendsolid t\n";
     dir.write("bad.stl", ascii.as_bytes());
-    refusal(&top, 3, "an ASCII STL file, which MuJoCo does not read");
+    load_error(&top, 3, "an ASCII STL file, which MuJoCo does not read");
 }
 
 #[test]
 fn unsupported_mesh_formats_are_refused() {
-    let dir = TempDir::new("format");
-    dir.write("m.msh", &[0u8; 64]);
+    let dir = TempDir::new("mesh-format");
+    dir.write("m.msh", [0u8; 64]);
     let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.msh\"/>").as_bytes());
-    refusal(
+    load_error(
         &top,
         3,
         "`m.msh` is in MuJoCo's own binary .msh format, which is not read here",
     );
     dir.write("m.ply", b"ply\n");
     let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.ply\"/>").as_bytes());
-    refusal(&top, 3, "`m.ply` is not an STL or OBJ file");
+    load_error(&top, 3, "`m.ply` is not an STL or OBJ file");
     dir.write("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n");
     let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"m.obj\"/>").as_bytes());
-    refusal(&top, 3, "`m.obj`: it has no faces");
+    load_error(&top, 3, "`m.obj`: it has no faces");
     dir.write("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3 4 5\n");
-    refusal(
+    load_error(
         &top,
         3,
         "face 1 has 5 vertices; MuJoCo reads OBJ faces of 3 or 4 vertices only",
@@ -227,7 +194,7 @@ fn unsupported_mesh_formats_are_refused() {
 
 #[test]
 fn a_mesh_without_volume_is_refused_in_a_volume_mode() {
-    let dir = TempDir::new("flat");
+    let dir = TempDir::new("mesh-flat");
     // A single triangle: area, but no volume (and a flat hull).
     let mut stl = vec![b' '; 80];
     stl.extend(1u32.to_le_bytes());
@@ -240,15 +207,15 @@ fn a_mesh_without_volume_is_refused_in_a_volume_mode() {
         "top.xml",
         model_with("<mesh name=\"m\" file=\"flat.stl\" inertia=\"exact\"/>").as_bytes(),
     );
-    refusal(&top, 3, "its volume is zero or too small");
+    load_error(&top, 3, "its volume is zero or too small");
     let top = dir.write(
         "top.xml",
         model_with("<mesh name=\"m\" file=\"flat.stl\" inertia=\"convex\"/>").as_bytes(),
     );
-    refusal(&top, 3, "its convex hull needs at least 4 distinct vertices");
+    load_error(&top, 3, "its convex hull needs at least 4 distinct vertices");
     // MuJoCo's default (legacy) too.
     let top = dir.write("top.xml", model_with("<mesh name=\"m\" file=\"flat.stl\"/>").as_bytes());
-    refusal(&top, 3, "its volume is zero or too small");
+    load_error(&top, 3, "its volume is zero or too small");
     // Inside out, in the exact mode.
     let mut stl = box_stl();
     for t in 0..12 {
@@ -263,18 +230,18 @@ fn a_mesh_without_volume_is_refused_in_a_volume_mode() {
         "top.xml",
         model_with("<mesh name=\"m\" file=\"inside_out.stl\" inertia=\"exact\"/>").as_bytes(),
     );
-    refusal(&top, 3, "its volume is negative");
+    load_error(&top, 3, "its volume is negative");
 }
 
 #[test]
 fn mesh_attributes_and_geoms_are_checked() {
-    let dir = TempDir::new("attributes");
-    dir.write("box.stl", &box_stl());
+    let dir = TempDir::new("mesh-attributes");
+    dir.write("box.stl", box_stl());
     let top = dir.write(
         "top.xml",
         model_with("<mesh name=\"m\" file=\"box.stl\" inertia=\"solid\"/>").as_bytes(),
     );
-    refusal(
+    load_error(
         &top,
         3,
         "inertia=\"solid\" is not `convex`, `exact`, `legacy` or `shell`",
@@ -283,23 +250,23 @@ fn mesh_attributes_and_geoms_are_checked() {
         "top.xml",
         model_with("<mesh name=\"m\" file=\"box.stl\" scale=\"1 2\"/>").as_bytes(),
     );
-    refusal(&top, 3, "<mesh name=\"m\" file=\"box.stl\">: ");
+    load_error(&top, 3, "<mesh name=\"m\" file=\"box.stl\">: ");
     let top = dir.write(
         "top.xml",
         model_with("<mesh name=\"other\" file=\"box.stl\"/>").as_bytes(),
     );
-    refusal(&top, 7, "names mesh `m`, which no <mesh> in <asset> defines");
+    load_error(&top, 7, "names mesh `m`, which no <mesh> in <asset> defines");
     let text =
         model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("mesh=\"m\"/>", "mesh=\"m\" shellinertia=\"true\"/>");
     let top = dir.write("top.xml", text.as_bytes());
-    refusal(
+    load_error(
         &top,
         7,
         "which MuJoCo refuses on a mesh geom; give the <mesh> inertia=\"shell\" instead",
     );
     let text = model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("type=\"mesh\"", "type=\"box\"");
     let top = dir.write("top.xml", text.as_bytes());
-    refusal(&top, 7, "of type `box` names a mesh, which MuJoCo fits the box to");
+    load_error(&top, 7, "of type `box` names a mesh, which MuJoCo fits the box to");
     // Text without its file has no folder for the mesh file; an inline mesh needs none.
     let e = parse_mjcf(&model_with("<mesh name=\"m\" file=\"box.stl\"/>")).unwrap_err();
     assert!(
@@ -317,8 +284,8 @@ fn mesh_attributes_and_geoms_are_checked() {
 
 #[test]
 fn a_mesh_in_an_included_file_is_read_from_the_models_folder() {
-    let dir = TempDir::new("include");
-    dir.write("meshes/box.stl", &box_stl());
+    let dir = TempDir::new("mesh-include");
+    dir.write("meshes/box.stl", box_stl());
     dir.write(
         "parts/assets.xml",
         b"<mujoco>\n<asset>\n<mesh name=\"m\" file=\"meshes/box.stl\"/>\n<mesh name=\"n\" file=\"gone.stl\"/>\n</asset>\n</mujoco>\n",
@@ -335,7 +302,7 @@ fn a_mesh_in_an_included_file_is_read_from_the_models_folder() {
         .unwrap()
         .replace("mesh=\"m\"", "mesh=\"n\"");
     let top = dir.write("top.xml", text.as_bytes());
-    let message = refusal(&top, 2, "cannot read `gone.stl`");
+    let message = load_error(&top, 2, "cannot read `gone.stl`");
     assert!(
         message.contains("in `parts/assets.xml` line 4: <mesh name=\"n\" file=\"gone.stl\">"),
         "{message}"
@@ -344,8 +311,8 @@ fn a_mesh_in_an_included_file_is_read_from_the_models_folder() {
 
 #[test]
 fn assetdir_strippath_and_exactmeshinertia_are_read() {
-    let dir = TempDir::new("compiler");
-    dir.write("parts/box.stl", &box_stl());
+    let dir = TempDir::new("mesh-compiler");
+    dir.write("parts/box.stl", box_stl());
     let box_mass = |text: &str| {
         let top = dir.write("top.xml", text.as_bytes());
         let model = load_mjcf(&top).unwrap();

@@ -11,16 +11,14 @@ use dyngen_identify::{
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, SymmetricEigen, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
 
 fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
 
 fn normal(r: &mut ChaCha8Rng) -> f64 {
-    // Box–Muller.
-    let u1: f64 = r.gen::<f64>().max(1e-300);
-    let u2: f64 = r.gen();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    r.sample(StandardNormal)
 }
 
 fn random_matrix(r: &mut ChaCha8Rng, m: usize, p: usize) -> Mat<f64> {

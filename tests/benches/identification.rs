@@ -22,8 +22,9 @@ use std::time::{Duration, Instant};
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use dyngen_identify::faer::MatRef;
+use dyngen_identify::simulate::Gaussian;
 use dyngen_identify::{Accumulation, Accumulator, Channels, Estimate};
-use dyngen_reference::{sample_states, SplitMix64};
+use dyngen_reference::sample_states;
 use robot_panda::Panda;
 
 const N: usize = 100_000;
@@ -48,17 +49,10 @@ fn to_array(x: &[f64]) -> [f64; NV] {
     x.try_into().expect("7 joints")
 }
 
-fn gaussian(rng: &mut SplitMix64) -> f64 {
-    // Box–Muller; 1 − u keeps the logarithm finite.
-    let u = 1.0 - rng.next_f64();
-    let w = rng.next_f64();
-    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * w).cos()
-}
-
 fn data() -> Data {
     let reference = Reference::of::<Panda>();
     let states = sample_states(reference.model(), N, SEED);
-    let mut rng = SplitMix64::new(SEED + 1);
+    let mut noise = Gaussian::new(SEED + 1);
     let mut d = Data {
         q: Vec::with_capacity(N),
         v: Vec::with_capacity(N),
@@ -70,7 +64,7 @@ fn data() -> Data {
         let (q, v, a) = (to_array(&s.q), to_array(&s.v), to_array(&s.a));
         let tau = Panda::rnea(&q, &v, &a, &Panda::NOMINAL_PARAMS);
         d.tau_true.extend_from_slice(&tau);
-        d.tau.extend(tau.iter().map(|t| t + NOISE_SIGMA * gaussian(&mut rng)));
+        d.tau.extend(tau.iter().map(|t| t + noise.normal(NOISE_SIGMA)));
         d.q.push(q);
         d.v.push(v);
         d.a.push(a);

@@ -3,7 +3,7 @@
 
 use crate::common::{check_overwrite, load_model, out, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
-use dyngen_codegen::Config;
+use dyngen_codegen::{Config, Selection};
 use std::path::PathBuf;
 
 pub const EXAMPLES: &str = "\
@@ -11,6 +11,7 @@ Examples:
   dyngen generate robots/ur5/ur5.urdf --name Ur5 -o src/ur5.rs
   dyngen generate arm.urdf --name Arm --max-statements 800 > arm.rs
   dyngen generate arm.urdf --name Arm -o arm.rs --force   # replace arm.rs
+  dyngen generate arm.urdf --name Arm -o arm.rs --functions rnea,crba,aba,frame_jacobian
 
 Use the file with `include!(\"arm.rs\");` in a crate that depends on `dyngen`.";
 
@@ -43,8 +44,20 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "N")]
     pub compose_above: Option<usize>,
 
+    /// Generate only these functions, comma-separated, by function name (rnea,
+    /// crba, aba, frame_jacobian, …) or group (inverse_dynamics, mass_matrix,
+    /// forward_dynamics, kinematics, regressors, joint_dynamics, frames, centroidal,
+    /// derivatives); each brings its whole group, the type implements that group's
+    /// trait of `dyngen`. Default: all.
+    #[arg(long, value_name = "LIST", value_parser = parse_functions)]
+    pub functions: Option<Selection>,
+
     #[command(flatten)]
     pub gravity: ModelArgs,
+}
+
+fn parse_functions(list: &str) -> std::result::Result<Selection, String> {
+    Selection::parse(list).map_err(|e| e.to_string())
 }
 
 pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
@@ -61,6 +74,9 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
     }
     if let Some(n) = args.compose_above {
         config.compose_above(n);
+    }
+    if let Some(functions) = args.functions {
+        config.functions(functions);
     }
     let source = args
         .urdf

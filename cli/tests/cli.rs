@@ -125,6 +125,42 @@ fn generate_composes_above_the_given_size() {
     assert!(composed.len() < own.len());
 }
 
+/// `--functions` generates the named functions' groups only, each as its `dyngen`
+/// trait; a name that is neither a function nor a group is refused with the valid ones.
+#[test]
+fn generate_selects_functions() {
+    let dir = temp_dir("dyngen-cli", "functions");
+    let (all, some) = (dir.join("all.rs"), dir.join("some.rs"));
+    assert_ok(&run!("generate", ur5(), "--name", "Ur5", "-o", all));
+    assert_ok(&run!(
+        "generate",
+        ur5(),
+        "--name",
+        "Ur5",
+        "-o",
+        some,
+        "--functions",
+        "rnea,aba"
+    ));
+    let (all, some) = (
+        std::fs::read_to_string(all).unwrap(),
+        std::fs::read_to_string(some).unwrap(),
+    );
+    for t in ["InverseDynamics", "ForwardDynamics", "RobotDescription"] {
+        assert!(some.contains(&format!("impl ::dyngen::{t} for Ur5")), "{t}");
+    }
+    for t in ["MassMatrix", "Regressors", "JointDynamics", "Frames", "Derivatives"] {
+        assert!(all.contains(&format!("impl ::dyngen::{t} for Ur5")), "{t}");
+        assert!(!some.contains(&format!("impl ::dyngen::{t} for Ur5")), "{t}");
+    }
+    assert!(!some.contains("pub fn crba<") && !some.contains("pub fn joint_torque_regressor<"));
+    assert!(some.len() * 4 < all.len(), "{} of {} bytes", some.len(), all.len());
+    let o = run!("generate", ur5(), "--name", "Ur5", "--functions", "rnea,cbra");
+    assert_error(&o, "unknown function or group `cbra`");
+    assert_eq!(o.status.code(), Some(2), "a usage error");
+    assert!(stderr(&o).contains("`mass_matrix`"), "{}", stderr(&o));
+}
+
 #[test]
 fn simulate_then_identify_recovers_the_torques() {
     let dir = temp_dir("dyngen-cli", "identify");

@@ -134,6 +134,19 @@ impl Config {
         self
     }
 
+    /// The functions to generate, by capability trait (default all): e.g.
+    /// `Selection::parse("rnea,crba,aba,frame_jacobian")` generates
+    /// `dyngen::InverseDynamics`, `MassMatrix`, `ForwardDynamics` and `Frames` (with
+    /// `Centroidal`, generated together), and nothing else: a controller that needs a
+    /// few functions does not compile the regressors and derivatives. What the selected
+    /// functions are built from comes with them ([`Selection::closure`](crate::Selection::closure)). The type then
+    /// implements `dyngen::RobotDescription` and the generated traits, not `dyngen::Robot`
+    /// (which needs all of them).
+    pub fn functions(&mut self, functions: crate::Selection) -> &mut Config {
+        self.options.functions = functions;
+        self
+    }
+
     /// Generates type `type_name` from the URDF at `urdf` (relative paths are taken
     /// from `CARGO_MANIFEST_DIR` when set) and writes it; returns the file written.
     pub fn compile_urdf(&self, urdf: impl AsRef<Path>, type_name: &str) -> Result<PathBuf, Error> {

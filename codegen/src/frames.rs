@@ -486,8 +486,10 @@ pub(crate) struct FrameFns {
     pub items: Vec<(String, TokenStream)>,
     /// The bodies of the generated functions ([`emit::Emitted`]), by name.
     pub bodies: Vec<(String, TokenStream)>,
-    /// `Robot` methods.
+    /// The `dyngen::Frames` methods.
     pub methods: TokenStream,
+    /// The `dyngen::Centroidal` methods.
+    pub centroidal_methods: TokenStream,
     pub reports: Vec<FnReport>,
 }
 
@@ -1002,6 +1004,8 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             use ::dyngen::__private::as_array;
             Some(Self::frame_motion(as_array(q, "q"), as_array(v, "v"), as_array(a, "a"), #fty::from_index(frame)?))
         }
+    };
+    let centroidal_methods = quote! {
         fn center_of_mass<S: ::dyngen::Scalar>(q: &[S], params: &[S]) -> [S; 3] {
             use ::dyngen::__private::as_array;
             Self::center_of_mass(as_array(q, "q"), as_array(params, "params"))
@@ -1028,6 +1032,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         items,
         bodies,
         methods,
+        centroidal_methods,
         reports,
     }
 }

@@ -3,10 +3,11 @@
 //! [`crate::base::analyse_model`] and then [`generate`].
 //!
 //! Every generated algorithm is one entry of [`ALGORITHMS`]: its inherent function,
-//! its `Robot` method and its line in `OP_COUNTS` are all made from that entry.
+//! its capability trait's method and its line in `OP_COUNTS` are all made from that entry.
 
 use crate::algo::{self, Force, Inputs, ARG_A, ARG_JOINT_PARAMS, ARG_PARAMS, ARG_Q, ARG_TAU, ARG_V};
 use crate::base::{BaseParams, Bases};
+use crate::capability::{Capability, Selection};
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
 use crate::sym::{Expr, Graph, NodeId};
 use dyngen_model::Model;
@@ -22,6 +23,9 @@ pub struct Options {
     /// other generated functions where a graph of their own would repeat another
     /// one's code ([`DEFAULT_COMPOSE_ABOVE_NV`]).
     pub compose_above_nv: usize,
+    /// The capability traits to generate (default all); what their functions are
+    /// built from comes with them ([`Selection::closure`]).
+    pub functions: Selection,
 }
 
 impl Default for Options {
@@ -29,6 +33,7 @@ impl Default for Options {
         Options {
             max_statements: emit::DEFAULT_MAX_STATEMENTS,
             compose_above_nv: DEFAULT_COMPOSE_ABOVE_NV,
+            functions: Selection::all(),
         }
     }
 }
@@ -318,7 +323,7 @@ enum Len {
 }
 
 /// An argument of a generated function (`&[S; len]` in the inherent function, `&[S]`
-/// in the `Robot` method).
+/// in the capability trait's method).
 #[derive(Clone, Copy)]
 enum In {
     Q,
@@ -401,7 +406,7 @@ impl Record {
     }
 }
 
-/// What a generated function hands back, and so how the `Robot` method's output
+/// What a generated function hands back, and so how the trait method's output
 /// slice maps onto it.
 #[derive(Clone, Copy)]
 enum Shape {
@@ -413,14 +418,16 @@ enum Shape {
     Matrix { rows: Len, cols: Len },
 }
 
-/// One generated algorithm: everything the inherent function, the `Robot` method
+/// One generated algorithm: everything the inherent function, the trait method
 /// and the operation counts are made from. Adding an algorithm is adding an entry
-/// to [`ALGORITHMS`] (and its method to the `Robot` trait).
+/// to [`ALGORITHMS`] (and its method to its capability trait in `dyngen`).
 struct Algorithm {
     name: &'static str,
+    /// The capability trait it belongs to.
+    capability: Capability,
     /// Arguments in signature order.
     args: &'static [In],
-    /// The name of the `Robot` method's output slice.
+    /// The name of the trait method's output slice.
     out: &'static str,
     shape: Shape,
     /// The doc text, one paragraph line per line.
@@ -454,6 +461,7 @@ const QVAP: &[In] = &[In::Q, In::V, In::A, In::Params];
 const ALGORITHMS: &[Algorithm] = &[
     Algorithm {
         name: "rnea",
+        capability: Capability::InverseDynamics,
         args: QVAP,
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -469,6 +477,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "nonlinear_effects",
+        capability: Capability::InverseDynamics,
         args: &[In::Q, In::V, In::Params],
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -488,6 +497,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "generalized_gravity",
+        capability: Capability::InverseDynamics,
         args: &[In::Q, In::Params],
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -502,6 +512,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "forward_kinematics",
+        capability: Capability::Kinematics,
         args: &[In::Q],
         out: "poses",
         shape: Shape::PerBody(Record::Pose),
@@ -520,6 +531,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_wrenches",
+        capability: Capability::InverseDynamics,
         args: QVAP,
         out: "wrenches",
         shape: Shape::PerBody(Record::Wrench),
@@ -533,6 +545,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "crba",
+        capability: Capability::MassMatrix,
         args: &[In::Q, In::Params],
         out: "m",
         shape: Shape::Matrix {
@@ -550,6 +563,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "aba",
+        capability: Capability::ForwardDynamics,
         args: &[In::Q, In::V, In::Tau, In::Params],
         out: "a",
         shape: Shape::Vector(Len::V),
@@ -569,6 +583,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_torque_regressor",
+        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -587,6 +602,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_regressor",
+        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -608,6 +624,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_regressor",
+        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -626,6 +643,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_base_regressor",
+        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -647,6 +665,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_wrench_regressor",
+        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -665,6 +684,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "body_regressors",
+        capability: Capability::Regressors,
         args: QVA,
         out: "out",
         shape: Shape::PerBody(Record::BodyRegressor),
@@ -683,6 +703,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "body_resultants",
+        capability: Capability::Regressors,
         args: QVAP,
         out: "out",
         shape: Shape::PerBody(Record::Wrench),
@@ -697,6 +718,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_params",
+        capability: Capability::Regressors,
         args: &[In::Params],
         out: "beta",
         shape: Shape::Vector(Len::Base),
@@ -711,6 +733,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_base_params",
+        capability: Capability::Regressors,
         args: &[In::Theta],
         out: "beta",
         shape: Shape::Vector(Len::PrincipalBase),
@@ -725,6 +748,7 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_params_joints",
+        capability: Capability::JointDynamics,
         args: &[In::Params, In::JointParams],
         out: "beta",
         shape: Shape::Vector(Len::BaseJoints),
@@ -776,7 +800,7 @@ impl Algorithm {
         }
     }
 
-    /// The `Robot` method: slices checked and viewed as the arrays of the inherent
+    /// The trait method: slices checked and viewed as the arrays of the inherent
     /// function.
     fn trait_method(&self, ty: &syn::Ident, sizes: &Sizes) -> TokenStream {
         let fname = format_ident!("{}", self.name);
@@ -924,14 +948,16 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     };
     let ty = format_ident!("{}", name);
     let home = emit::home(&ty);
+    let selected = options.functions.closure();
     let mut functions = Vec::new();
     let mut items = Vec::new();
     let mut bodies = Vec::new();
-    let mut methods = Vec::new();
-    for algorithm in ALGORITHMS {
+    // The capability traits' methods, by trait.
+    let mut methods: Vec<(Capability, TokenStream)> = Vec::new();
+    for algorithm in ALGORITHMS.iter().filter(|a| selected.contains(a.capability)) {
+        methods.push((algorithm.capability, algorithm.trait_method(&ty, &sizes)));
         if let Some(item) = composed(algorithm, model, &sizes, options.compose_above_nv) {
             items.push((algorithm.name.to_string(), item));
-            methods.push(algorithm.trait_method(&ty, &sizes));
             continue;
         }
         let g = Graph::new();
@@ -940,41 +966,50 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
         items.push((report.name.clone(), emitted.method));
         bodies.push((report.name.clone(), emitted.body));
         functions.push(report);
-        methods.push(algorithm.trait_method(&ty, &sizes));
     }
-    let joints = crate::joints::generate(
-        model,
-        bases,
-        &sizes,
-        options.max_statements,
-        options.compose_above_nv,
-        &home,
-    );
-    functions.extend(joints.reports);
-    items.extend(joints.items);
-    bodies.extend(joints.bodies);
-    methods.extend(joints.methods);
-    let derivatives = derivative_items(model, &sizes, options, &home);
-    functions.extend(derivatives.reports);
-    items.extend(derivatives.items);
-    bodies.extend(derivatives.bodies);
-    methods.push(derivative_methods(sizes.nv));
-    let frames = crate::frames::generate(model, &ty, &sizes, options);
-    functions.extend(frames.reports);
-    items.extend(frames.items);
-    bodies.extend(frames.bodies);
-    methods.push(frames.methods);
+    if selected.contains(Capability::JointDynamics) {
+        let joints = crate::joints::generate(
+            model,
+            bases,
+            &sizes,
+            options.max_statements,
+            options.compose_above_nv,
+            &home,
+        );
+        functions.extend(joints.reports);
+        items.extend(joints.items);
+        bodies.extend(joints.bodies);
+        methods.extend(joints.methods.into_iter().map(|m| (Capability::JointDynamics, m)));
+    }
+    if selected.contains(Capability::Derivatives) {
+        let derivatives = derivative_items(model, &sizes, options, &home);
+        functions.extend(derivatives.reports);
+        items.extend(derivatives.items);
+        bodies.extend(derivatives.bodies);
+        methods.push((Capability::Derivatives, derivative_methods(sizes.nv)));
+    }
+    let mut tail = TokenStream::new();
+    if selected.contains(Capability::Frames) {
+        // With the centroidal functions (`Capability::needs`).
+        let frames = crate::frames::generate(model, &ty, &sizes, options);
+        functions.extend(frames.reports);
+        items.extend(frames.items);
+        bodies.extend(frames.bodies);
+        methods.push((Capability::Frames, frames.methods));
+        methods.push((Capability::Centroidal, frames.centroidal_methods));
+        tail = frames.enum_item;
+    }
     let head = robot_type(model, &ty, bases, &functions, &items, &methods);
     let mut tokens = head.clone();
     tokens.extend(home_module(&home, bodies.iter().map(|(_, t)| t)));
-    tokens.extend(frames.enum_item.clone());
+    tokens.extend(tail.clone());
     GeneratedCode {
         tokens,
         functions,
         items,
         bodies,
         head,
-        tail: frames.enum_item,
+        tail,
         home,
     }
 }
@@ -1281,7 +1316,7 @@ fn times_minus_minv(model: &Model, dq: TokenStream, dv: TokenStream) -> TokenStr
     }
 }
 
-/// The `Robot` methods of [`derivative_items`].
+/// The `dyngen::Derivatives` methods of [`derivative_items`].
 fn derivative_methods(n: usize) -> TokenStream {
     let n_l = emit::usize_lit(n);
     quote! {
@@ -1439,14 +1474,14 @@ fn grouping_list(bp: &BaseParams) -> String {
         .collect()
 }
 
-/// The type, its constants, its functions and its `Robot` impl.
+/// The type, its constants, its functions, its `RobotDescription` impl and one impl per capability trait.
 fn robot_type(
     model: &Model,
     ty: &syn::Ident,
     bases: &Bases,
     functions: &[FnReport],
     items: &[(String, TokenStream)],
-    methods: &[TokenStream],
+    methods: &[(Capability, TokenStream)],
 ) -> TokenStream {
     let (base, pbase) = (&bases.standard, &bases.principal);
     let n = model.dof();
@@ -1514,6 +1549,20 @@ fn robot_type(
         model.base
     ));
     let robot_name = &model.name;
+    let impls = Capability::ALL.into_iter().filter_map(|c| {
+        let ms: Vec<&TokenStream> = methods.iter().filter(|(m, _)| *m == c).map(|(_, t)| t).collect();
+        if ms.is_empty() {
+            return None;
+        }
+        let name = format_ident!("{}", c.trait_name());
+        Some(quote! {
+            #[automatically_derived]
+            #[allow(clippy::all)]
+            impl ::dyngen::#name for #ty {
+                #(#ms)*
+            }
+        })
+    });
     quote! {
         #doc
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -1586,7 +1635,7 @@ fn robot_type(
 
         #[automatically_derived]
         #[allow(clippy::all)]
-        impl ::dyngen::Robot for #ty {
+        impl ::dyngen::RobotDescription for #ty {
             const NAME: &'static str = #robot_name;
             const NQ: usize = #nq_lit;
             const NV: usize = #nv_lit;
@@ -1615,15 +1664,41 @@ fn robot_type(
             fn base_joints_k() -> &'static [f64] { &Self::BASE_JOINTS_K }
             fn gravity() -> [f64; 3] { Self::GRAVITY }
             fn op_counts() -> &'static [(&'static str, ::dyngen::OpCount)] { &Self::OP_COUNTS }
-
-            #(#methods)*
         }
+
+        #(#impls)*
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A selection generates its groups (with what they are built from) and their
+    /// traits only: `joint_dynamics` brings `rnea`, `crba` and the regressors it calls.
+    #[test]
+    fn a_selection_generates_its_groups_only() {
+        let model = dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap();
+        let bases = crate::analyse_model(&model);
+        let options = Options {
+            functions: Selection::parse("joint_dynamics").unwrap(),
+            ..Options::default()
+        };
+        let g = generate(&model, "Ur5", &bases, &options);
+        let text = g.tokens.to_string();
+        let wanted = options.functions.closure();
+        for c in Capability::ALL {
+            let implemented = text.contains(&format!("impl :: dyngen :: {} for Ur5", c.trait_name()));
+            assert_eq!(implemented, wanted.contains(c), "{c}");
+        }
+        for f in &g.functions {
+            if let Some(group) = Capability::from_name(&f.name) {
+                assert!(wanted.contains(group), "{} generated", f.name);
+            }
+        }
+        assert!(g.functions.iter().any(|f| f.name == "aba_joints"));
+        assert!(!text.contains("fn aba <") && !text.contains("fn frame_jacobian <"));
+    }
 
     /// `pretty` formats the robot type, the frame enum and the bodies' module in pieces
     /// on threads of their own: the result is the file formatted whole, byte for byte,

@@ -22,7 +22,7 @@ pub(crate) struct JointFns {
     pub items: Vec<(String, TokenStream)>,
     /// The bodies of the generated functions ([`emit::Emitted`]), by name.
     pub bodies: Vec<(String, TokenStream)>,
-    /// `Robot` methods.
+    /// The `dyngen::JointDynamics` methods.
     pub methods: Vec<TokenStream>,
     /// The operation count of the generated forward dynamics, reported as `aba_joints`.
     pub reports: Vec<FnReport>,
@@ -36,7 +36,7 @@ fn doc(text: &str) -> TokenStream {
     quote!(#(#[doc = #lines])*)
 }
 
-/// The joint functions of the robot type and their `Robot` methods. On a robot of more
+/// The joint functions of the robot type and their `dyngen::JointDynamics` methods. On a robot of more
 /// than `compose_above` velocity coordinates `aba_joints` is composed of other
 /// functions rather than generated.
 pub(crate) fn generate(

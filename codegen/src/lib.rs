@@ -15,6 +15,7 @@
 pub mod algo;
 pub mod base;
 mod build;
+mod capability;
 pub mod derivatives;
 pub mod dsl;
 pub mod emit;
@@ -25,6 +26,7 @@ pub mod sym;
 
 pub use base::{analyse_model, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
+pub use capability::{Capability, Selection, UnknownCapability};
 pub use generate::{generate, is_type_name, GeneratedCode, Options, DEFAULT_COMPOSE_ABOVE_NV};
 
 use proc_macro2::TokenStream;
@@ -35,6 +37,8 @@ pub struct RobotInput {
     /// The type name to generate.
     pub name: syn::Ident,
     pub source: RobotSource,
+    /// `functions: [..]`, or all.
+    pub functions: Selection,
 }
 
 pub enum RobotSource {
@@ -64,7 +68,11 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
         }
     };
     let bases = base::analyse_model(&model);
-    let generated = generate(&model, &name, &bases, &Options::default());
+    let options = Options {
+        functions: input.functions,
+        ..Options::default()
+    };
+    let generated = generate(&model, &name, &bases, &options);
     let tokens = generated.tokens;
     let span = match &input.source {
         RobotSource::Urdf(lit) => lit.span(),

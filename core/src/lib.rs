@@ -1,6 +1,7 @@
 //! # dyngen
 //!
-//! What generated robot code needs, and nothing more: the [`Robot`] trait, the
+//! What generated robot code needs, and nothing more: the [`Robot`] trait (the
+//! capability traits [`InverseDynamics`], [`MassMatrix`], … over [`RobotDescription`]), the
 //! [`Scalar`] trait, the small spatial value types of the API ([`Pose`], [`Wrench`],
 //! [`BodyRegressor`]), what the control kernels return ([`FrameJacobian`],
 //! [`FrameMotion`], [`Motion`] in a [`ReferenceFrame`], [`RneaDerivatives`],
@@ -39,9 +40,21 @@ pub use dyngen_macros::robot;
 pub use frames::{log3, FrameJacobian, FrameJacobianTimeVariation, FrameMotion, Motion, ReferenceFrame};
 pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
-pub use robot::{BodyRegressor, OpCount, Pose, Robot, Wrench};
+pub use robot::{
+    BodyRegressor, Centroidal, Derivatives, ForwardDynamics, Frames, InverseDynamics, JointDynamics, Kinematics,
+    MassMatrix, OpCount, Pose, Regressors, Robot, RobotDescription, Wrench,
+};
 pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
 pub use scalar::Scalar;
+
+/// The traits a generated robot implements, to bring their methods into scope at
+/// once: `use dyngen::prelude::*;`.
+pub mod prelude {
+    pub use crate::{
+        Centroidal, Derivatives, ForwardDynamics, Frames, InverseDynamics, JointDynamics, Kinematics, MassMatrix,
+        Regressors, Robot, RobotDescription, Scalar,
+    };
+}
 
 /// Support for generated code; not a public API.
 #[doc(hidden)]

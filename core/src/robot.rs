@@ -1,5 +1,6 @@
-//! The [`Robot`] trait every generated robot type implements, and the small spatial
-//! types of its API.
+//! The traits every generated robot type implements ([`RobotDescription`], one
+//! capability trait per group of functions, and [`Robot`], all of them), and the small
+//! spatial types of their API.
 
 use crate::{Coulomb, FrameMotion, ReferenceFrame, RobotModel, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -65,18 +66,22 @@ impl<S: Scalar> Default for BodyRegressor<S> {
     }
 }
 
-/// A robot with generated dynamics. Implemented by the types `robot!` and
-/// `dyngen_codegen::compile_urdf` generate; runtime code is generic over it.
+/// What every generated robot type carries whatever functions were generated: its
+/// sizes, names, tree, nominal parameters, base-parameter maps and the operation
+/// counts of its functions. The functions themselves come in capability traits
+/// ([`InverseDynamics`], [`MassMatrix`], [`ForwardDynamics`], [`Kinematics`],
+/// [`Regressors`], [`JointDynamics`], [`Frames`], [`Centroidal`], [`Derivatives`]),
+/// each implemented when it was selected (all by default); [`Robot`] is all of them.
 ///
-/// Sizes follow Pinocchio: `NQ` positions, `NV` velocities (equal here: every joint
-/// has one coordinate, continuous joints included), `NBODIES` moving bodies. The
-/// standard parameters are 10 per body in Pinocchio's order
-/// `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`, inertia about the body-frame
-/// origin (`NPARAMS = 10 · NBODIES`).
+/// Sizes follow Pinocchio: `NQ` positions (a unit quaternion per ball joint and free
+/// flyer), `NV` velocities, `NBODIES` moving bodies. The standard parameters are 10
+/// per body in Pinocchio's order `[m, m·cx, m·cy, m·cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`,
+/// inertia about the body-frame origin (`NPARAMS = 10 · NBODIES`).
 ///
-/// The slice methods panic when a slice does not have the documented length, as
-/// indexing does; the generated inherent functions take fixed-size arrays instead.
-pub trait Robot {
+/// The capability traits' slice methods panic when a slice does not have the
+/// documented length, as indexing does; the generated inherent functions take
+/// fixed-size arrays instead.
+pub trait RobotDescription {
     const NAME: &'static str;
     const NQ: usize;
     const NV: usize;
@@ -132,27 +137,47 @@ pub trait Robot {
     fn gravity() -> [f64; 3];
     /// Operation counts of each generated function, by function name.
     fn op_counts() -> &'static [(&'static str, OpCount)];
+}
 
+/// Inverse dynamics: `rnea`, its special cases `nonlinear_effects` and
+/// `generalized_gravity`, and the joint reaction wrenches. Selected by `inverse_dynamics`.
+pub trait InverseDynamics: RobotDescription {
     /// Inverse dynamics by the generated Newton–Euler recursion:
     /// `tau = M(q) a + C(q, v) v + g(q)`. `q, v, a, tau`: `NV`; `params`: `NPARAMS`.
     fn rnea<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], tau: &mut [S]);
-
-    /// Every body's pose in the base frame at `q`. `poses`: `NBODIES`.
-    fn forward_kinematics<S: Scalar>(q: &[S], poses: &mut [Pose<S>]);
-
-    /// The wrench joint `j` applies to body `j` (force, and moment about the joint
-    /// frame origin), in body `j`'s frame: Pinocchio's `data.f[j]` after `rnea`.
-    /// `wrenches`: `NBODIES`.
-    fn joint_wrenches<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], wrenches: &mut [Wrench<S>]);
-
     /// `h(q, v) = rnea(q, v, 0)`. `tau`: `NV`.
     fn nonlinear_effects<S: Scalar>(q: &[S], v: &[S], params: &[S], tau: &mut [S]);
     /// `g(q) = rnea(q, 0, 0)`. `tau`: `NV`.
     fn generalized_gravity<S: Scalar>(q: &[S], params: &[S], tau: &mut [S]);
+    /// The wrench joint `j` applies to body `j` (force, and moment about the joint
+    /// frame origin), in body `j`'s frame: Pinocchio's `data.f[j]` after `rnea`.
+    /// `wrenches`: `NBODIES`.
+    fn joint_wrenches<S: Scalar>(q: &[S], v: &[S], a: &[S], params: &[S], wrenches: &mut [Wrench<S>]);
+}
+
+/// The joint-space inertia matrix by the composite-rigid-body algorithm. Selected by
+/// `mass_matrix`.
+pub trait MassMatrix: RobotDescription {
     /// Joint-space inertia matrix `M(q)`, row-major into `m` (`NV × NV`).
     fn crba<S: Scalar>(q: &[S], params: &[S], m: &mut [S]);
+}
+
+/// Forward dynamics by the articulated-body algorithm. Selected by `forward_dynamics`.
+pub trait ForwardDynamics: RobotDescription {
     /// Forward dynamics by the articulated-body algorithm: `a = M⁻¹ (tau − h)`.
     fn aba<S: Scalar>(q: &[S], v: &[S], tau: &[S], params: &[S], a: &mut [S]);
+}
+
+/// Every body's pose. Selected by `kinematics`.
+pub trait Kinematics: RobotDescription {
+    /// Every body's pose in the base frame at `q`. `poses`: `NBODIES`.
+    fn forward_kinematics<S: Scalar>(q: &[S], poses: &mut [Pose<S>]);
+}
+
+/// The regressors linear in the inertial parameters (standard, principal, base, the
+/// joint-wrench and per-body ones) and the maps to the base parameters. Selected by
+/// `regressors`.
+pub trait Regressors: RobotDescription {
     /// `Y` with `tau = Y π`, row-major into `y` (`NV × NPARAMS`).
     fn joint_torque_regressor<S: Scalar>(q: &[S], v: &[S], a: &[S], y: &mut [S]);
     /// Every joint's reaction wrench per parameter, row-major into `y`
@@ -173,10 +198,14 @@ pub trait Robot {
     fn base_params<S: Scalar>(params: &[S], beta: &mut [S]);
     /// `β_θ = K_θ θ`. `theta`: `NTHETA`; `beta`: `NBASE_PRINCIPAL`.
     fn principal_base_params<S: Scalar>(theta: &[S], beta: &mut [S]);
+}
 
+/// The dynamics with the joint models (rotor inertia, viscous and Coulomb friction,
+/// offset; [`crate::JointParams`]) and their regressors. Selected by `joint_dynamics`.
+pub trait JointDynamics: RobotDescription {
     /// Inverse dynamics with the joint models:
     /// `tau = rnea(q, v, a) + Ia·a + Fv·v + Fc·c(v) + F0` per joint.
-    /// `joint_params`: `NJOINT_PARAMS`; the rest as for [`Robot::rnea`].
+    /// `joint_params`: `NJOINT_PARAMS`; the rest as for [`InverseDynamics::rnea`].
     fn rnea_joints<S: Scalar>(
         q: &[S],
         v: &[S],
@@ -190,7 +219,7 @@ pub trait Robot {
     fn crba_joints<S: Scalar>(q: &[S], params: &[S], joint_params: &[S], m: &mut [S]);
     /// Forward dynamics with the joint models:
     /// `a = (M + diag(Ia))⁻¹ (tau − h − Fv·v − Fc·c(v) − F0)`, inverting
-    /// [`Robot::rnea_joints`].
+    /// [`JointDynamics::rnea_joints`].
     fn aba_joints<S: Scalar>(
         q: &[S],
         v: &[S],
@@ -200,7 +229,7 @@ pub trait Robot {
         coulomb: Coulomb<S>,
         a: &mut [S],
     );
-    /// `[Y | Y_j]` with `tau = [Y | Y_j] · [params; joint_params]` ([`Robot::rnea_joints`]),
+    /// `[Y | Y_j]` with `tau = [Y | Y_j] · [params; joint_params]` ([`JointDynamics::rnea_joints`]),
     /// row-major into `y` (`NV × (NPARAMS + NJOINT_PARAMS)`): row `j` has
     /// `[a_j, v_j, c(v_j), 1]` at columns `NPARAMS + 4j ..`.
     fn torque_regressor_joints<S: Scalar>(q: &[S], v: &[S], a: &[S], coulomb: Coulomb<S>, y: &mut [S]);
@@ -209,7 +238,11 @@ pub trait Robot {
     fn base_regressor_joints<S: Scalar>(q: &[S], v: &[S], a: &[S], coulomb: Coulomb<S>, y: &mut [S]);
     /// `β_j = K_j [params; joint_params]`. `beta`: `NBASE_JOINTS`.
     fn base_params_joints<S: Scalar>(params: &[S], joint_params: &[S], beta: &mut [S]);
+}
 
+/// Frame placements, Jacobians, their time variation and frame motions. Selected by
+/// `frames`.
+pub trait Frames: RobotDescription {
     /// Frame `frame`'s placement in the world (`frame` indexes `MODEL.frames`; the
     /// generated frame enum gives the same through `index()`); `None` when there is no
     /// such frame.
@@ -237,6 +270,11 @@ pub trait Robot {
     /// Frame `frame`'s placement, velocity and classical acceleration,
     /// `LOCAL_WORLD_ALIGNED`; `None` when there is no such frame.
     fn frame_motion<S: Scalar>(q: &[S], v: &[S], a: &[S], frame: usize) -> Option<FrameMotion<S>>;
+}
+
+/// Centre of mass, its Jacobian, and the centroidal momentum matrix. Selected by
+/// `centroidal`.
+pub trait Centroidal: RobotDescription {
     /// The centre of mass of the moving bodies in the world. `params`: `NPARAMS`.
     fn center_of_mass<S: Scalar>(q: &[S], params: &[S]) -> [S; 3];
     /// The centre of mass's Jacobian (3 × `NV`, world axes), row-major into `jacobian`.
@@ -247,7 +285,12 @@ pub trait Robot {
     /// `A_g` and its time derivative `Ȧ_g(q, v)` (each 6 × `NV`, row-major):
     /// `ḣ_g = A_g a + Ȧ_g v`.
     fn centroidal_map_time_variation<S: Scalar>(q: &[S], v: &[S], params: &[S], a_g: &mut [S], a_g_dot: &mut [S]);
-    /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`Robot::rnea`], each `NV × NV` row-major.
+}
+
+/// The derivatives of inverse and forward dynamics, and `M⁻¹`. Selected by
+/// `derivatives`.
+pub trait Derivatives: RobotDescription {
+    /// `∂τ/∂q`, `∂τ/∂v` and `∂τ/∂a = M` of [`InverseDynamics::rnea`], each `NV × NV` row-major.
     fn rnea_derivatives<S: Scalar>(
         q: &[S],
         v: &[S],
@@ -272,6 +315,39 @@ pub trait Robot {
     );
     /// `M(q)⁻¹`, row-major into `minv` (`NV × NV`).
     fn inverse_inertia<S: Scalar>(q: &[S], params: &[S], minv: &mut [S]);
+}
+
+/// A robot with every generated function (see [`RobotDescription`] for its sizes
+/// and conventions): implemented for every type that has all the capability traits,
+/// as the types `robot!` and `dyngen_codegen::compile_urdf` generate by default.
+/// Run-time code that needs the whole set (the reference wrapper, identification) is
+/// generic over it. A robot generated with a selection of functions implements
+/// [`RobotDescription`] and the selected traits only.
+pub trait Robot:
+    InverseDynamics
+    + MassMatrix
+    + ForwardDynamics
+    + Kinematics
+    + Regressors
+    + JointDynamics
+    + Frames
+    + Centroidal
+    + Derivatives
+{
+}
+
+impl<
+        T: InverseDynamics
+            + MassMatrix
+            + ForwardDynamics
+            + Kinematics
+            + Regressors
+            + JointDynamics
+            + Frames
+            + Centroidal
+            + Derivatives,
+    > Robot for T
+{
 }
 
 /// Operation counts of one generated function, as the generator measured them.

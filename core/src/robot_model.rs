@@ -1,4 +1,4 @@
-//! The robot description a generated type carries as Rust data (`Robot::MODEL`): the
+//! The robot description a generated type carries as Rust data (`RobotDescription::MODEL`): the
 //! checked model it was generated from, in the generator's numbering, so that nothing
 //! at run time re-parses a file or renumbers a joint.
 

@@ -519,7 +519,7 @@ pub fn whole_robot(
 }
 
 /// A regressor `(q, v, a, y)` with `y` row-major, such as
-/// [`Robot::principal_base_regressor`] for `f64`.
+/// [`dyngen::Regressors::principal_base_regressor`] for `f64`.
 pub type RegressorFn = fn(&[f64], &[f64], &[f64], &mut [f64]);
 
 /// The regressor a [`TorqueEstimate`] was computed with.
@@ -853,7 +853,7 @@ pub fn torque(
 
 /// MIM from joint torques through a generated robot's principal base regressor: the
 /// parameters are `R`'s principal base parameters, named by
-/// [`Robot::principal_base_groupings`], the truth `R::principal_base_params` of
+/// [`dyngen::RobotDescription::principal_base_groupings`], the truth `R::principal_base_params` of
 /// `R::nominal_theta()`. `dynamics` must be the same robot (e.g.
 /// [`dyngen_reference::Generated<R>`]).
 pub fn torque_principal_base<R: Robot>(

@@ -103,7 +103,7 @@ impl BodyMotion {
 impl Reference {
     /// The reference implementation of a generated robot, on the model it carries
     /// (`R::MODEL`: the generator's numbering, the gravity it was specialised for).
-    pub fn of<R: dyngen::Robot>() -> Reference {
+    pub fn of<R: dyngen::RobotDescription>() -> Reference {
         Reference::new(&model_from_static(&R::MODEL))
     }
 

@@ -5,7 +5,7 @@
 //! generated algorithm, the base rows included, frames and Jacobians, the centre of
 //! mass and the centroidal map. Then identities of the generated code itself.
 
-use dyngen::{ReferenceFrame, Robot};
+use dyngen::{Frames, InverseDynamics, JointDynamics, MassMatrix, ReferenceFrame, Robot, RobotDescription};
 use dyngen_tests::mobile_arm::MobileArm;
 use dyngen_tests::{json_numbers as nums, load_json, pose_vec, rel_err, Worst};
 use robot_humanoid31::Humanoid31;
@@ -184,8 +184,8 @@ fn quadruped12_identification_from_base_and_joint_rows() {
     use rand::{Rng, SeedableRng};
 
     type R = Quadruped12;
-    let nv = <R as Robot>::NV;
-    let model = dyngen_reference::model_from_static(&<R as Robot>::MODEL);
+    let nv = <R as RobotDescription>::NV;
+    let model = dyngen_reference::model_from_static(&<R as RobotDescription>::MODEL);
     let base_rows: Vec<usize> = (0..6).collect();
     let joint_rows: Vec<usize> = (6..nv).collect();
     let all_rows: Vec<usize> = (0..nv).collect();
@@ -197,7 +197,7 @@ fn quadruped12_identification_from_base_and_joint_rows() {
         from_base.count(),
         from_joints.count(),
         from_all.count(),
-        <R as Robot>::NPARAMS
+        <R as RobotDescription>::NPARAMS
     );
     // The base rows alone determine every base parameter; the joint torques alone do
     // not see the trunk (body 1) at all.
@@ -210,7 +210,7 @@ fn quadruped12_identification_from_base_and_joint_rows() {
     assert!(from_all.is_consistent() && from_base.is_consistent());
 
     // Simulated recording: random states, generalized forces from rnea plus noise.
-    let truth = <R as Robot>::nominal_params();
+    let truth = <R as RobotDescription>::nominal_params();
     let states = dyngen_model::sample::sample_states(&model, 400, 11);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let noise = 0.05;
@@ -219,7 +219,7 @@ fn quadruped12_identification_from_base_and_joint_rows() {
         let mut id = FloatingBase::<R>::new(rows).unwrap();
         for s in &states {
             let mut tau = vec![0.0; nv];
-            <R as Robot>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
+            <R as InverseDynamics>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
             for t in &mut tau {
                 *t += rng.gen_range(-noise..noise);
             }
@@ -253,17 +253,17 @@ fn quadruped12_identification_from_base_and_joint_rows() {
 
     // Contact wrenches instead of the base rows: a foot force on each foot frame,
     // mapped through the frames' Jacobians, gives the same data.
-    let feet: Vec<usize> = (0..<R as Robot>::MODEL.frames.len())
-        .filter(|&f| <R as Robot>::MODEL.frames[f].name.ends_with("foot"))
+    let feet: Vec<usize> = (0..<R as RobotDescription>::MODEL.frames.len())
+        .filter(|&f| <R as RobotDescription>::MODEL.frames[f].name.ends_with("foot"))
         .collect();
     assert_eq!(feet.len(), 4, "four feet");
     let s = &states[0];
     let mut tau = vec![0.0; nv];
-    <R as Robot>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
+    <R as InverseDynamics>::rnea(&s.q, &s.v, &s.a, truth, &mut tau);
     // One contact at a foot: the base rows of Jᵀ F carry the whole generalized force
     // on the base; choose F so that the dynamics hold, from the base rows.
     let mut jac = vec![0.0; 6 * nv];
-    <R as Robot>::frame_jacobian(&s.q, feet[0], ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
+    <R as Frames>::frame_jacobian(&s.q, feet[0], ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
     // J[:, 0..6] is invertible (a rigid transform of the base twist): solve Jbᵀ w = τ_base.
     let jb = nalgebra::Matrix6::from_fn(|r, c| jac[r * nv + c]);
     let w = jb
@@ -363,29 +363,29 @@ fn joint_models_invert_and_match_the_regressor_on_floating_robots() {
 }
 
 fn joint_models_invert_and_match_the_regressor<R: Robot>() {
-    let (nv, np) = (<R as Robot>::NV, <R as Robot>::NPARAMS);
-    let model = dyngen_reference::model_from_static(&<R as Robot>::MODEL);
-    let params = <R as Robot>::nominal_params();
+    let (nv, np) = (<R as RobotDescription>::NV, <R as RobotDescription>::NPARAMS);
+    let model = dyngen_reference::model_from_static(&<R as RobotDescription>::MODEL);
+    let params = <R as RobotDescription>::nominal_params();
     let joint_params: Vec<f64> = (0..nv)
         .flat_map(|d| [0.01 * (d + 1) as f64, 0.2, 0.3 + 0.01 * d as f64, -0.05])
         .collect();
-    assert_eq!(joint_params.len(), <R as Robot>::NJOINT_PARAMS);
+    assert_eq!(joint_params.len(), <R as RobotDescription>::NJOINT_PARAMS);
     let coulomb = dyngen::Coulomb::smooth(0.05).unwrap();
     for s in dyngen_model::sample::sample_states(&model, 4, 21) {
         let mut tau = vec![0.0; nv];
-        <R as Robot>::rnea_joints(&s.q, &s.v, &s.a, params, &joint_params, coulomb, &mut tau);
+        <R as JointDynamics>::rnea_joints(&s.q, &s.v, &s.a, params, &joint_params, coulomb, &mut tau);
         let mut back = vec![0.0; nv];
-        <R as Robot>::aba_joints(&s.q, &s.v, &tau, params, &joint_params, coulomb, &mut back);
+        <R as JointDynamics>::aba_joints(&s.q, &s.v, &tau, params, &joint_params, coulomb, &mut back);
         assert!(rel_err(&back, &s.a, 1.0) < 1e-12, "{back:?} vs {:?}", s.a);
         let (mut m, mut mj) = (vec![0.0; nv * nv], vec![0.0; nv * nv]);
-        <R as Robot>::crba(&s.q, params, &mut m);
-        <R as Robot>::crba_joints(&s.q, params, &joint_params, &mut mj);
+        <R as MassMatrix>::crba(&s.q, params, &mut m);
+        <R as JointDynamics>::crba_joints(&s.q, params, &joint_params, &mut mj);
         for d in 0..nv {
             m[d * nv + d] += joint_params[4 * d];
         }
         assert!(rel_err(&mj, &m, 1.0) < 1e-14);
         let mut y = vec![0.0; nv * (np + 4 * nv)];
-        <R as Robot>::torque_regressor_joints(&s.q, &s.v, &s.a, coulomb, &mut y);
+        <R as JointDynamics>::torque_regressor_joints(&s.q, &s.v, &s.a, coulomb, &mut y);
         let x: Vec<f64> = params.iter().chain(&joint_params).copied().collect();
         let from_y: Vec<f64> = (0..nv)
             .map(|r| (0..x.len()).map(|c| y[r * x.len() + c] * x[c]).sum())
@@ -406,7 +406,7 @@ fn joint_models_invert_and_match_the_regressor<R: Robot>() {
 fn humanoid31_aba_joints_derivatives_match_finite_differences() {
     type H = Humanoid31;
     const NV: usize = H::NV;
-    let model = dyngen_reference::model_from_static(&<H as Robot>::MODEL);
+    let model = dyngen_reference::model_from_static(&<H as RobotDescription>::MODEL);
     let params = H::NOMINAL_PARAMS;
     let mut jp = [0.0; 4 * NV];
     for j in 0..NV {
@@ -536,7 +536,7 @@ fn base_regressors_reproduce_rnea_on_floating_robots() {
 fn humanoid31_frame_motion_matches_differences() {
     type H = Humanoid31;
     const NV: usize = H::NV;
-    let model = dyngen_reference::model_from_static(&<H as Robot>::MODEL);
+    let model = dyngen_reference::model_from_static(&<H as RobotDescription>::MODEL);
     let s = &dyngen_model::sample::sample_states(&model, 1, 13)[0];
     let q: [f64; NV + 1] = s.q.clone().try_into().unwrap();
     let v: [f64; NV] = s.v.clone().try_into().unwrap();
@@ -544,7 +544,7 @@ fn humanoid31_frame_motion_matches_differences() {
     let at = |t: f64| -> [f64; NV + 1] {
         let step: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v * t + 0.5 * a * t * t).collect();
         let mut out = [0.0; NV + 1];
-        dyngen::configuration::integrate(&<H as Robot>::MODEL, &q, &step, &mut out).unwrap();
+        dyngen::configuration::integrate(&<H as RobotDescription>::MODEL, &q, &step, &mut out).unwrap();
         out
     };
     let h = 1e-4;
@@ -735,7 +735,7 @@ fn planar_joints_follow_the_configuration_manifold() {
     let n = [0.6, 0.0, 0.8];
     let (q0, q1) = ([0.0; 7], [0.7, -0.4, 1.1, 0.3, 0.0, 0.0, 0.0]);
     let body1 = Tilted::MODEL.frames.iter().position(|f| f.body == 1).unwrap();
-    let placement = |q: &[f64]| <Tilted as Robot>::frame_placement(q, body1).unwrap();
+    let placement = |q: &[f64]| <Tilted as Frames>::frame_placement(q, body1).unwrap();
     let (p0, p1) = (placement(&q0), placement(&q1));
     let d = p1.translation - p0.translation;
     assert!((d[0] * n[0] + d[1] * n[1] + d[2] * n[2]).abs() < 1e-15, "{d:?}");

@@ -1,7 +1,7 @@
 //! Generated code against the reference implementation on 1,000 random states per
 //! robot (fixed seeds), with nominal and with perturbed parameters.
 
-use dyngen::{BodyRegressor, Pose, Robot, Wrench};
+use dyngen::{BodyRegressor, InverseDynamics, Pose, Robot, Wrench};
 use dyngen_reference::Reference;
 use dyngen_reference::{perturbed_params, sample_states};
 use dyngen_tests::tree12::Tree12;
@@ -180,7 +180,7 @@ fn f32_instantiation_agrees() {
 #[should_panic(expected = "`q` has length 5, expected 6")]
 fn slice_api_names_wrong_length() {
     let mut tau = [0.0; 6];
-    <Ur5 as Robot>::rnea(&[0.0; 5], &[0.0; 6], &[0.0; 6], &Ur5::NOMINAL_PARAMS, &mut tau);
+    <Ur5 as InverseDynamics>::rnea(&[0.0; 5], &[0.0; 6], &[0.0; 6], &Ur5::NOMINAL_PARAMS, &mut tau);
 }
 
 #[test]

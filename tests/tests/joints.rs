@@ -5,7 +5,7 @@
 //! the identities between them (`[Y | Y_j] · [π; φ] = rnea_joints`,
 //! `Y_bj · β_j = rnea_joints`, `aba_joints(rnea_joints(a)) = a`).
 
-use dyngen::{Coulomb, Robot};
+use dyngen::{Coulomb, JointDynamics, Robot};
 use dyngen_identify::mim::TorqueRegressor;
 use dyngen_model::joint_params::Coulomb as ModelCoulomb;
 use dyngen_model::sample::SplitMix64;
@@ -298,7 +298,7 @@ fn armature_matches_pinocchio() {
 #[should_panic(expected = "`joint_params` has length 23, expected 24")]
 fn a_short_joint_parameter_vector_is_named() {
     let mut tau = [0.0; 6];
-    <Ur5 as Robot>::rnea_joints(
+    <Ur5 as JointDynamics>::rnea_joints(
         &[0.0; 6],
         &[0.0; 6],
         &[0.0; 6],

@@ -2,7 +2,7 @@
 //! noise-free and with 1 % noise, and joint-torque identification on ur5 and the
 //! 7-DOF panda validated on a separate trajectory.
 
-use dyngen::Robot;
+use dyngen::prelude::*;
 use dyngen_identify::mim::{self, MimEstimate, MimOptions, Verdict, Weighting};
 use dyngen_identify::simulate::{
     moment_sigma, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording,

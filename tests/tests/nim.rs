@@ -4,7 +4,7 @@
 //! the full dynamics; then a payload followed online against recursive least
 //! squares. Times are measured by the benchmarks and the demo, not here.
 
-use dyngen::Robot;
+use dyngen::prelude::*;
 use dyngen_identify::mim::Verdict;
 use dyngen_identify::simulate::{record, Criterion, ExcitationDesign, Experiment, Motion, NoiseModel, Recording};
 use dyngen_nim::online::{track, Tracking};

@@ -4,7 +4,7 @@
 //! carries its own model (`R::MODEL`), so the reference, MIM and NIM see the
 //! generator's numbering and attribute every measurement to the right body.
 
-use dyngen::Robot;
+use dyngen::prelude::*;
 use dyngen_identify::mim::{self, MimOptions};
 use dyngen_identify::simulate::{record, Experiment};
 use dyngen_model::principal_params;

@@ -17,6 +17,7 @@ pub struct Robot {
     pub body_joint_vectors: Attr<VectorTable>,
     pub bodies: Attr<BodyTable>,
     pub frames: Attr<FrameTable>,
+    pub functions: Attr<crate::Selection>,
 }
 
 /// One top-level `keyword: value`.

@@ -38,6 +38,8 @@
 //! ```text
 //! robot     := field (',' field)* ','?            each keyword at most once, any order
 //! field     := 'name' ':' IDENT | 'urdf' ':' STRING | 'gravity' ':' vec3
+//!            | 'functions' ':' '[' IDENT,* ']'    functions or groups to generate (both forms;
+//!                                                 default all; see dyngen_codegen::Capability)
 //!            | 'incidence' ':' '[' row,* ']'      row := '[' INTEGER,* ']'
 //!            | 'joints' ':' '[' joint,* ']'
 //!            | 'body_joint_vectors' ':' '{' ('(' INTEGER ',' INTEGER ')' ':' vec3),* '}'
@@ -126,10 +128,12 @@ pub fn parse(input: TokenStream) -> syn::Result<RobotInput> {
         )
     };
     let name = robot.name.value.clone().ok_or_else(internal)?;
+    let functions = robot.functions.value.unwrap_or_default();
     if let Some(path) = &robot.urdf.value {
         return Ok(RobotInput {
             name,
             source: RobotSource::Urdf(path.clone()),
+            functions,
         });
     }
     let tree = tree.ok_or_else(internal)?;
@@ -147,6 +151,7 @@ pub fn parse(input: TokenStream) -> syn::Result<RobotInput> {
     Ok(RobotInput {
         name,
         source: RobotSource::Dsl(Box::new(description)),
+        functions,
     })
 }
 

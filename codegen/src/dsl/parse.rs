@@ -27,6 +27,7 @@ pub fn robot(cx: &Ctxt, input: TokenStream) -> Robot {
         body_joint_vectors: Attr::none(symbol::BODY_JOINT_VECTORS),
         bodies: Attr::none(symbol::BODIES),
         frames: Attr::none(symbol::FRAMES),
+        functions: Attr::none(symbol::FUNCTIONS),
     };
     for piece in nonempty_pieces(cx, input, "`keyword: value`") {
         let Some(field) = report(cx, key_value(piece.tokens, "keyword", symbol::TOP_LEVEL)) else {
@@ -56,8 +57,9 @@ pub fn robot(cx: &Ctxt, input: TokenStream) -> Robot {
                 .body_joint_vectors
                 .set(cx, key, || body_joint_vectors(cx, value, loc)),
             symbol::BODIES => robot.bodies.set(cx, key, || bodies(cx, value, loc)),
-            // symbol::FRAMES, the last of TOP_LEVEL.
-            _ => robot.frames.set(cx, key, || frames(cx, value, loc)),
+            symbol::FRAMES => robot.frames.set(cx, key, || frames(cx, value, loc)),
+            // symbol::FUNCTIONS, the last of TOP_LEVEL.
+            _ => robot.functions.set(cx, key, || functions(cx, value, loc)),
         }
     }
     robot
@@ -361,6 +363,51 @@ fn joints(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<JointList> {
         joints,
         loc: Loc::at(g.span()),
     })
+}
+
+/// `[rnea, crba, frames]`: function or group names ([`crate::Capability::from_name`]).
+fn functions(cx: &Ctxt, tokens: TokenStream, end: Loc) -> Option<crate::Selection> {
+    let g = report(
+        cx,
+        single_group(
+            tokens,
+            Delimiter::Bracket,
+            "the functions to generate as a list, `[rnea, crba, aba, frame_jacobian]`",
+            end,
+        ),
+    )?;
+    let mut selection = crate::Selection::empty();
+    let mut valid = true;
+    for piece in nonempty_pieces(cx, g.stream(), "a function") {
+        let word = parse_all(piece.tokens, |input| {
+            input.call(syn::Ident::parse_any).map_err(|_| {
+                input.error(format!(
+                    "expected a function or group name; {}",
+                    crate::capability::valid_names()
+                ))
+            })
+        });
+        match report(cx, word) {
+            Some(ident) => match crate::Capability::from_name(&ident.to_string()) {
+                Some(c) => selection.insert(c),
+                None => {
+                    valid = false;
+                    cx.error_spanned_by(&ident, crate::UnknownCapability(ident.to_string()).to_string());
+                }
+            },
+            None => valid = false,
+        }
+    }
+    if valid && selection.is_empty() {
+        cx.error_spanned_by(
+            Loc::at(g.span()),
+            format!(
+                "no function selected; list at least one, or leave `functions` out for all: {}",
+                crate::capability::valid_names()
+            ),
+        );
+    }
+    valid.then_some(selection)
 }
 
 /// `revolute(AXIS, rest: [r, p, y], limits: [lo, hi])`.

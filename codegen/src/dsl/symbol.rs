@@ -16,6 +16,8 @@ pub const JOINTS: Symbol = Symbol("joints");
 pub const BODY_JOINT_VECTORS: Symbol = Symbol("body_joint_vectors");
 pub const BODIES: Symbol = Symbol("bodies");
 pub const FRAMES: Symbol = Symbol("frames");
+/// Which functions to generate, in either form.
+pub const FUNCTIONS: Symbol = Symbol("functions");
 
 /// All top-level keywords, in the order the docs present them.
 pub const TOP_LEVEL: &[Symbol] = &[
@@ -27,6 +29,7 @@ pub const TOP_LEVEL: &[Symbol] = &[
     BODY_JOINT_VECTORS,
     BODIES,
     FRAMES,
+    FUNCTIONS,
 ];
 /// What the inline form needs besides `name`.
 pub const INLINE_REQUIRED: &[Symbol] = &[INCIDENCE, JOINTS, BODY_JOINT_VECTORS, BODIES];

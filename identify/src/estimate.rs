@@ -26,6 +26,9 @@ pub enum Status {
     /// Physically consistent estimation: identifiable, but the value is shaped by
     /// the consistency constraints (an active bound, or a projected start), so no σ.
     Constrained,
+    /// Left out of the model by choice (a joint term not fitted): held at 0 in the
+    /// solution, not estimated. No value.
+    Excluded,
 }
 
 /// One parameter of an [`Estimate`].
@@ -467,6 +470,7 @@ impl fmt::Display for Table<'_> {
                     _ => "from the prior".to_string(),
                 },
                 Status::Constrained => "shaped by physical consistency".to_string(),
+                Status::Excluded => "left out of the model (held at 0)".to_string(),
             };
             writeln!(
                 f,

@@ -25,8 +25,8 @@
 use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
 use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
 use crate::report::{
-    self, CoulombReport, MergedLinks, NonPhysical, ParamStatus, ParameterReport, Parameterisation, PredictionModel,
-    Preprocessing, ReportError,
+    self, CoulombReport, JointParams, JointParamsFile, MergedLinks, NonPhysical, ParamReport, ParamStatus,
+    ParameterReport, Parameterisation, PredictionModel, Preprocessing, ReportError, JOINT_PARAMS_SCHEMA,
 };
 use crate::simulate::Recording;
 use crate::stribeck::StribeckFit;
@@ -90,8 +90,20 @@ pub enum JointTerms {
     /// [`SMOOTHING_SAMPLES`] samples spread over the recording).
     FrictionAuto,
     /// Friction and rotor inertia with the Coulomb term as given, and per joint a
-    /// Stribeck term: static friction `Fs` and Stribeck velocity `vs`
-    /// ([`crate::stribeck`]), fitted by nonlinear least squares from the linear fit.
+    /// Stribeck term: static friction `Fs ≥ 0` and Stribeck velocity `vs` within a
+    /// range from the joint's speeds ([`crate::stribeck`]), fitted by nonlinear
+    /// least squares from the linear fit. A joint keeps the term only where it
+    /// lowers the joint's error on held-out time blocks of the recording and stays
+    /// physical; the others fall back to the linear model
+    /// ([`crate::stribeck::JointChoice`]).
+    ///
+    /// With [`Estimator::Consistent`] the linear fit is the consistent one and the
+    /// refinement keeps its bounds: each joint's nonlinear fit holds `Ia, Fv, Fc ≥ 0`
+    /// (projected after every step) and every linear refit is the consistent
+    /// estimator's, so the result is physical and still never a worse fit than the
+    /// consistent linear start. (Without the bounds in the joint fits, a joint fit
+    /// that drives `Fc` below zero cannot be carried into the consistent refit, and
+    /// no round is ever accepted.)
     Stribeck(Coulomb),
 }
 
@@ -105,6 +117,14 @@ pub struct IdentifyOptions {
     pub estimator: Estimator,
     /// Friction and rotor inertia ([`Mode::Standard`] only).
     pub joints: JointTerms,
+    /// The rotor inertias `Ia` on their own ([`Mode::Standard`] only): `None` fits
+    /// them with the friction terms, as [`IdentifyOptions::joints`] says;
+    /// `Some(false)` leaves them out (friction without rotor inertia: the `Ia`
+    /// columns are held at 0); `Some(true)` fits them, and with
+    /// [`JointTerms::None`] alone (rotor inertia without friction: the `Fv`, `Fc`
+    /// and `F0` columns held at 0). Terms left out are reported
+    /// [`ParamStatus::Excluded`].
+    pub rotor_inertia: Option<bool>,
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
     /// Leave a joint's torque rows out of its equations at the samples where its
@@ -132,6 +152,7 @@ impl Default for IdentifyOptions {
             mode: Mode::Standard,
             estimator: Estimator::Ols,
             joints: JointTerms::None,
+            rotor_inertia: None,
             accumulation: Accumulation::Qr,
             exclude_below: None,
             cutoff_hz: 10.0,
@@ -167,6 +188,20 @@ impl IdentifyOptions {
         if self.joints != JointTerms::None && self.mode != Mode::Standard {
             return invalid(
                 "friction",
+                "applies to the standard mode (the joint terms enter the joint torques, not the body equations)".into(),
+            );
+        }
+        if self.rotor_inertia == Some(false) && self.joints == JointTerms::None {
+            return invalid(
+                "rotor-inertia",
+                "no has nothing to leave the rotor inertia out of without friction terms (the rigid bodies alone \
+                 have none); give friction terms, or drop it"
+                    .into(),
+            );
+        }
+        if self.rotor_inertia.is_some() && self.mode != Mode::Standard {
+            return invalid(
+                "rotor-inertia",
                 "applies to the standard mode (the joint terms enter the joint torques, not the body equations)".into(),
             );
         }
@@ -374,6 +409,9 @@ fn from_torques(
     let mut chosen_epsilon = None;
     let regressor = match (principal, options.joints) {
         (true, _) => TorqueRegressor::Principal,
+        (false, JointTerms::None) if options.rotor_inertia == Some(true) => {
+            TorqueRegressor::StandardAndJoints(Coulomb::Sign)
+        }
         (false, JointTerms::None) => TorqueRegressor::Standard,
         (false, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
             TorqueRegressor::StandardAndJoints(coulomb)
@@ -414,14 +452,29 @@ fn from_torques(
     if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
         nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
     }
-    let solve = |acc: &Accumulator| match options.estimator {
-        Estimator::Ols => acc.ols(opts),
-        Estimator::Wls => acc.wls(opts),
-        Estimator::Tls { column_scaling: true } => acc.tls(opts),
-        Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
-        Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
-        Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
-        Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n), opts),
+    let fitted = fitted_joint_terms(options);
+    let excluded = excluded_columns(regressor, n, fitted);
+    for &c in &excluded {
+        // Ridge pulls a term left out toward 0, where it is held.
+        nominal[c] = 0.0;
+    }
+    let solve = |acc: &Accumulator| {
+        let mut estimate = match options.estimator {
+            Estimator::Ols => acc.ols(opts),
+            Estimator::Wls => acc.wls(opts),
+            Estimator::Tls { column_scaling: true } => acc.tls(opts),
+            Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
+            Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
+            Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
+            Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n, fitted), opts),
+        }?;
+        // The columns held at 0 are no parameters of the model.
+        for &c in &excluded {
+            estimate.solution[c] = 0.0;
+            let p = &mut estimate.params[c];
+            (p.value, p.sigma, p.status) = (None, None, crate::Status::Excluded);
+        }
+        Ok::<_, IdentifyError>(estimate)
     };
     let estimate = solve(&acc)?;
     if !(estimate.solution.iter().all(|x| x.is_finite()) && estimate.residuals.rms.is_finite()) {
@@ -458,10 +511,22 @@ fn from_torques(
     }
     let (estimate, stribeck) = match options.joints {
         JointTerms::Stribeck(coulomb) if !principal => {
-            let (estimate, fit) = crate::stribeck::refine(dynamics, traj, coulomb, estimate, |t| {
+            let constraints = crate::stribeck::JointConstraints {
+                fitted,
+                nonnegative: options.estimator == Estimator::Consistent,
+            };
+            let (estimate, fit) = crate::stribeck::refine(dynamics, traj, coulomb, constraints, estimate, |t| {
                 let acc = accumulate(dynamics, t, regressor, 1, options)?;
                 Ok::<_, PipelineError>(solve(&acc)?)
             })?;
+            let finite = estimate.solution.iter().all(|x| x.is_finite())
+                && fit.joints.iter().all(|s| s.fs.is_finite() && s.vs.is_finite())
+                && fit.cost.is_finite();
+            if !finite {
+                return Err(PipelineError::NonFiniteEstimate {
+                    largest: largest_input(traj),
+                });
+            }
             (estimate, Some(fit))
         }
         _ => (estimate, None),
@@ -539,6 +604,7 @@ fn from_torques(
             coulomb_epsilon,
             epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
             exclude_below: options.exclude_below,
+            rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(_)).then_some(fitted[0]),
             ..Preprocessing::default()
         }),
         nonphysical,
@@ -611,12 +677,41 @@ fn largest_input(traj: &Trajectory) -> (f64, Location, &'static str) {
     best
 }
 
+/// Which of each joint's `[Ia, Fv, Fc, F0]` are fitted
+/// ([`IdentifyOptions::rotor_inertia`]); the others are held at 0.
+pub fn fitted_joint_terms(options: &IdentifyOptions) -> [bool; PER_JOINT] {
+    match (options.joints, options.rotor_inertia) {
+        (JointTerms::None, Some(true)) => [true, false, false, false],
+        (_, Some(false)) => [false, true, true, true],
+        _ => [true; PER_JOINT],
+    }
+}
+
+/// The columns of the joint terms held at 0 for `regressor` on `n` joints.
+fn excluded_columns(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_JOINT]) -> Vec<usize> {
+    match regressor {
+        TorqueRegressor::StandardAndJoints(_) => (0..n)
+            .flat_map(|j| {
+                (0..PER_JOINT)
+                    .filter(move |&k| !fitted[k])
+                    .map(move |k| 10 * n + PER_JOINT * j + k)
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
 /// The standard-form consistent estimator's options for `regressor` on `n` joints:
-/// `n` body blocks first, then per joint `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0`.
-fn consistent_options(regressor: TorqueRegressor, n: usize) -> StandardOptions {
+/// `n` body blocks first, then per joint `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0`
+/// (those fitted).
+fn consistent_options(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_JOINT]) -> StandardOptions {
     let nonnegative = match regressor {
         TorqueRegressor::StandardAndJoints(_) => (0..n)
-            .flat_map(|j| (0..3).map(move |k| 10 * n + PER_JOINT * j + k))
+            .flat_map(|j| {
+                (0..3)
+                    .filter(move |&k| fitted[k])
+                    .map(move |k| 10 * n + PER_JOINT * j + k)
+            })
             .collect(),
         _ => Vec::new(),
     };
@@ -639,7 +734,13 @@ fn accumulate(
     let n = dynamics.nv();
     let p = regressor.columns(n);
     let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
-    if let Some(support) = regressor.row_support(dynamics.model()) {
+    // Joint terms left out of the model: their columns are zeroed in every row and
+    // taken out of every row's support.
+    let excluded = excluded_columns(regressor, n, fitted_joint_terms(options));
+    if let Some(mut support) = regressor.row_support(dynamics.model()) {
+        for cols in &mut support {
+            cols.retain(|c| !excluded.contains(c));
+        }
         acc = acc.with_column_support(support)?;
     }
     // The samples are cut into a fixed number of contiguous parts, each accumulated
@@ -657,6 +758,11 @@ fn accumulate(
         for &k in part {
             let (q, v, a) = state(traj, k);
             regressor.eval(dynamics, q, v, a, &mut y);
+            for row in y.chunks_exact_mut(p) {
+                for &c in &excluded {
+                    row[c] = 0.0;
+                }
+            }
             let rows = faer::MatRef::from_row_major_slice(&y, n, p);
             match options.exclude_below {
                 Some(speed) => {
@@ -1027,6 +1133,11 @@ impl Identification {
                         joint.name.clone(),
                         format!("identified Fv {fv:.4}, Fc {fc:.4}: negative"),
                     )),
+                    _ if self.report.parameters.get(10 * n + 4 * j + 1).map(|p| p.status)
+                        == Some(ParamStatus::Excluded) =>
+                    {
+                        dynamics_kept.push((joint.name.clone(), "friction left out of the model".into()))
+                    }
                     _ => dynamics_kept.push((joint.name.clone(), "friction not identified alone".into())),
                 }
             }
@@ -1038,6 +1149,48 @@ impl Identification {
             kept,
             dynamics,
             dynamics_kept,
+        })
+    }
+}
+
+impl Identification {
+    /// Every identified joint term per joint ([`JointParamsFile`]): `Ia, Fv, Fc, F0`
+    /// and with Stribeck friction `Fs, vs`, as the parameter report has them.
+    /// `urdf`: the file name of the URDF it accompanies; `in_urdf`: the joints whose
+    /// `Fv` and `Fc` were written there ([`UrdfRewrite::dynamics`]). `None` without
+    /// joint terms.
+    pub fn joint_params_file(&self, model: &Model, urdf: Option<&str>, in_urdf: &[&str]) -> Option<JointParamsFile> {
+        let prediction = self.report.prediction.as_ref()?;
+        if self.report.parameterisation != Parameterisation::StandardAndJoints {
+            return None;
+        }
+        let coulomb = prediction.coulomb?;
+        let n = model.dof();
+        let params = &self.report.parameters;
+        let stribeck = self.stribeck.is_some() && params.len() >= 16 * n;
+        let joints = model
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(j, joint)| {
+                let mut parameters: Vec<ParamReport> =
+                    params[10 * n + PER_JOINT * j..10 * n + PER_JOINT * (j + 1)].to_vec();
+                if stribeck {
+                    parameters.extend_from_slice(&params[14 * n + 2 * j..14 * n + 2 * j + 2]);
+                }
+                JointParams {
+                    name: joint.name.clone(),
+                    in_urdf: in_urdf.contains(&joint.name.as_str()),
+                    parameters,
+                }
+            })
+            .collect();
+        Some(JointParamsFile {
+            schema: JOINT_PARAMS_SCHEMA.to_string(),
+            robot: model.name.clone(),
+            urdf: urdf.map(str::to_string),
+            coulomb,
+            joints,
         })
     }
 }

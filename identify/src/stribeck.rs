@@ -21,6 +21,14 @@
 //! again on the torques without the Stribeck term. Both steps only accept what lowers
 //! the sum of squared torque residuals, so the fit never gets worse than the linear
 //! start; the loop stops when a round gains less than [`REFINE_TOLERANCE`].
+//!
+//! Two more parameters per joint can fit noise instead of friction (a tiny `vs`
+//! fitting a few samples at the velocity reversals, a negative `Fc` under a large
+//! `Fs`), so the fit is bounded and checked: `Fs ≥ 0` and `vs` within a range from
+//! the joint's own speeds ([`velocity_range`]); each joint keeps its term only if it
+//! lowers the joint's error on held-out time blocks of the recording by
+//! [`MIN_GAIN`] and stays physical, and falls back to the linear model otherwise
+//! ([`JointChoice`], printed one line per joint).
 
 use crate::data::Trajectory;
 use crate::report::{ParamReport, ParamStatus};
@@ -28,7 +36,7 @@ use crate::Estimate;
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
 use dyngen_model::names::param_name;
 use dyngen_reference::Dynamics;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -135,8 +143,9 @@ impl Default for LmOptions {
 pub struct JointFit {
     pub linear: [f64; PER_JOINT],
     pub stribeck: Stribeck,
-    /// Standard deviations of `Fs` and `vs` from the Gauss–Newton curvature at the
-    /// solution, the rigid bodies taken as known; `None` where not determined.
+    /// Standard deviations of `Fs` and `vs` from the Gauss–Newton curvature `JᵀJ`
+    /// of the joint's residual at the solution (`σ² = cost / (rows − fitted)`), the
+    /// rigid bodies taken as known; `None` where not determined.
     pub sigma: [Option<f64>; 2],
     /// Sum of squared residuals at the start and at the end.
     pub initial_cost: f64,
@@ -144,53 +153,133 @@ pub struct JointFit {
     pub iterations: usize,
 }
 
-/// The bounds of `vs` for a joint whose largest speed is `v_max`: `vs` below
-/// `1e-4·v_max` acts on no sample, above `v_max` the term is a second Coulomb
-/// friction.
-pub fn velocity_bounds(v_max: f64) -> (f64, f64) {
-    (1e-4 * v_max, v_max)
+/// What the joint terms of a fit may do: which of `[Ia, Fv, Fc, F0]` are fitted
+/// (the others are held at 0: left out of the model), and whether `Ia`, `Fv` and
+/// `Fc` are held `≥ 0` (the physically consistent estimator). The static friction
+/// is always held `Fs ≥ 0`, and `vs` within its [`velocity_range`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JointConstraints {
+    pub fitted: [bool; PER_JOINT],
+    pub nonnegative: bool,
+}
+
+impl Default for JointConstraints {
+    fn default() -> Self {
+        JointConstraints {
+            fitted: [true; PER_JOINT],
+            nonnegative: false,
+        }
+    }
+}
+
+impl JointConstraints {
+    /// Per entry of `[Ia, Fv, Fc, Fs, F0, ln vs]`: held fixed.
+    fn fixed(&self) -> [bool; 6] {
+        let f = self.fitted;
+        [!f[0], !f[1], !f[2], false, !f[3], false]
+    }
+
+    /// Per entry of `[Ia, Fv, Fc, Fs, F0]`: held `≥ 0`.
+    fn bounded(&self) -> [bool; 5] {
+        let nn = self.nonnegative;
+        [nn, nn, nn, true, false]
+    }
+
+    /// `p` moved into the constraints, `ln vs` into `[u_lo, u_hi]`.
+    fn project(&self, p: &mut SVector<f64, 6>, (u_lo, u_hi): (f64, f64)) {
+        for (i, (fixed, bounded)) in self.fixed().iter().zip(self.bounded()).enumerate() {
+            if *fixed {
+                p[i] = 0.0;
+            } else if bounded {
+                p[i] = p[i].max(0.0);
+            }
+        }
+        p[5] = p[5].clamp(u_lo, u_hi);
+    }
+}
+
+/// `vs` is searched no lower than this fraction of the joint's speed range.
+pub const VS_LOW: f64 = 0.005;
+/// `vs` is searched no higher than this fraction of the joint's speed range.
+pub const VS_HIGH: f64 = 0.5;
+/// At least this fraction of the joint's samples must be slower than `vs`.
+pub const VS_SLOWEST: f64 = 0.01;
+/// The joint's speed range is this quantile of its `|q̇|` (a spike does not move it).
+pub const SPEED_QUANTILE: f64 = 0.99;
+
+/// The range `[lo, hi]` in which `vs` is searched for a joint with velocities `v`,
+/// from the data: with `v_r` the joint's speed range (the [`SPEED_QUANTILE`]
+/// quantile of `|q̇|`), `hi = VS_HIGH·v_r` (above it the term is a second Coulomb
+/// friction over most of the motion, not a static friction) and `lo` the larger of
+/// `VS_LOW·v_r` and the speed below which [`VS_SLOWEST`] of the samples lie (below
+/// it the term acts on a handful of samples around the velocity reversals and fits
+/// their noise). `None` for a joint that does not move, or whose slowest samples are
+/// already faster than `hi` (it never comes near rest: the data say nothing about
+/// its static friction).
+pub fn velocity_range(v: &[f64]) -> Option<(f64, f64)> {
+    let mut speed: Vec<f64> = v.iter().map(|x| x.abs()).filter(|x| x.is_finite()).collect();
+    if speed.len() < 2 {
+        return None;
+    }
+    speed.sort_unstable_by(f64::total_cmp);
+    let quantile = |q: f64| speed[((speed.len() - 1) as f64 * q).round() as usize];
+    let range = quantile(SPEED_QUANTILE);
+    if !(range > 0.0 && range.is_finite()) {
+        return None;
+    }
+    let (lo, hi) = ((VS_LOW * range).max(quantile(VS_SLOWEST)), VS_HIGH * range);
+    (lo > 0.0 && lo < hi).then_some((lo, hi))
 }
 
 /// One joint's `[Ia, Fv, Fc, Fs, F0]` and `vs` fitted by Levenberg–Marquardt to
 /// `target` (the joint's torque without its rigid-body part) at velocities `v` and
-/// accelerations `a`, from `start` (`[Ia, Fv, Fc, F0]`, Stribeck). `vs` is searched
-/// as `ln vs` within [`velocity_bounds`]; only steps that lower the sum of squared
-/// residuals are taken, so the result is never worse than the start. `starts`
-/// gives other values of `vs` to try first (each a linear fit of the other five
-/// parameters); the best of them replaces the start when it is better.
+/// accelerations `a`, from `start` (`[Ia, Fv, Fc, F0]`, Stribeck), within
+/// `constraints` (projected after every step) and with `vs` in `range` ([`velocity_range`];
+/// searched as `ln vs`). Only steps that lower the sum of squared residuals are
+/// taken, so the result is never worse than the (projected) start. `starts` gives
+/// other values of `vs` to try first (each a linear fit of the other five
+/// parameters within the constraints); the best of them replaces the start when it
+/// is better.
+#[allow(clippy::too_many_arguments)]
 pub fn fit_joint(
     v: &[f64],
     a: &[f64],
     target: &[f64],
     start: ([f64; PER_JOINT], Stribeck),
     coulomb: Coulomb,
+    range: (f64, f64),
+    constraints: JointConstraints,
     starts: Starts<'_>,
     options: &LmOptions,
 ) -> JointFit {
-    let v_max = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let (lo, hi) = velocity_bounds(v_max);
+    let (lo, hi) = range;
+    let (u_lo, u_hi) = (lo.ln(), hi.ln());
     let (linear, s) = start;
     let mut p = SVector::<f64, 6>::from([linear[0], linear[1], linear[2], s.fs, linear[3], s.vs.ln()]);
-    let mut cost = joint_cost(v, a, target, &p, coulomb);
-    let initial_cost = cost;
-    let out = |p: &SVector<f64, 6>, cost: f64, iterations: usize, sigma: [Option<f64>; 2]| JointFit {
-        linear: [p[0], p[1], p[2], p[4]],
-        stribeck: Stribeck {
-            fs: p[3],
-            vs: p[5].exp(),
-        },
-        sigma,
-        initial_cost,
-        cost,
-        iterations,
-    };
-    // A joint that never moves (or too few samples) says nothing about vs.
-    if !(v_max > 0.0 && v_max.is_finite()) || v.len() <= 6 {
+    let free = constraints.fixed().iter().filter(|f| !**f).count();
+    let out =
+        |p: &SVector<f64, 6>, initial_cost: f64, cost: f64, iterations: usize, sigma: [Option<f64>; 2]| JointFit {
+            linear: [p[0], p[1], p[2], p[4]],
+            stribeck: Stribeck {
+                fs: p[3],
+                vs: p[5].exp(),
+            },
+            sigma,
+            initial_cost,
+            cost,
+            iterations,
+        };
+    // Too few samples, or a range that is not one, say nothing about vs.
+    if !(lo > 0.0 && lo < hi && hi.is_finite()) || v.len() <= free + 1 {
+        let cost = joint_cost(v, a, target, &p, coulomb);
         return JointFit {
             stribeck: s,
-            ..out(&p, cost, 0, [None, None])
+            ..out(&p, cost, cost, 0, [None, None])
         };
     }
+    constraints.project(&mut p, (u_lo, u_hi));
+    let mut cost = joint_cost(v, a, target, &p, coulomb);
+    let initial_cost = cost;
     let candidates: Vec<f64> = match starts {
         Starts::None => Vec::new(),
         Starts::Grid => (0..=GRID)
@@ -198,24 +287,20 @@ pub fn fit_joint(
             .collect(),
         Starts::These(vs) => vs.iter().map(|v| v.clamp(lo, hi)).collect(),
     };
-    {
-        for vs in candidates {
-            if let Some(q) = linear_at(v, a, target, vs, coulomb) {
-                let c = joint_cost(v, a, target, &q, coulomb);
-                if c < cost {
-                    (p, cost) = (q, c);
-                }
+    for vs in candidates {
+        if let Some(q) = linear_at(v, a, target, vs, coulomb, constraints) {
+            let c = joint_cost(v, a, target, &q, coulomb);
+            if c < cost {
+                (p, cost) = (q, c);
             }
         }
     }
-    let (u_lo, u_hi) = (lo.ln(), hi.ln());
-    p[5] = p[5].clamp(u_lo, u_hi);
-    cost = cost.min(joint_cost(v, a, target, &p, coulomb));
     let mut lambda = 1e-3;
     let mut iterations = 0;
+    let fixed = constraints.fixed();
     while iterations < options.max_iterations {
         iterations += 1;
-        let (h, g) = normal_equations(v, a, target, &p, coulomb);
+        let (h, g) = normal_equations(v, a, target, &p, coulomb, fixed);
         let scale = h.diagonal().max().max(f64::MIN_POSITIVE);
         let mut damped = h;
         for i in 0..6 {
@@ -229,7 +314,7 @@ pub fn fit_joint(
             continue;
         };
         let mut trial = p + step;
-        trial[5] = trial[5].clamp(u_lo, u_hi);
+        constraints.project(&mut trial, (u_lo, u_hi));
         let c = joint_cost(v, a, target, &trial, coulomb);
         if c < cost {
             let gain = (cost - c) / cost.max(f64::MIN_POSITIVE);
@@ -245,9 +330,10 @@ pub fn fit_joint(
             }
         }
     }
-    // σ of Fs and vs = vs·σ(ln vs) from σ²·H⁻¹, σ² = cost / (rows − 6).
-    let (h, _) = normal_equations(v, a, target, &p, coulomb);
-    let dof = (v.len() - 6) as f64;
+    // σ of Fs and vs = vs·σ(ln vs) from σ²·(JᵀJ)⁻¹ over the fitted entries,
+    // σ² = cost / (rows − fitted).
+    let (h, _) = normal_equations(v, a, target, &p, coulomb, fixed);
+    let dof = (v.len() - free) as f64;
     let sigma = match h.try_inverse() {
         Some(inv) if inv[(3, 3)] >= 0.0 && inv[(5, 5)] >= 0.0 => {
             let s2 = cost / dof;
@@ -259,7 +345,7 @@ pub fn fit_joint(
         }
         _ => [None, None],
     };
-    out(&p, cost, iterations, sigma)
+    out(&p, initial_cost, cost, iterations, sigma)
 }
 
 /// Values of `vs` [`fit_joint`] tries before its Levenberg–Marquardt iterations.
@@ -267,13 +353,13 @@ pub fn fit_joint(
 pub enum Starts<'a> {
     /// Only the start.
     None,
-    /// A grid of 17 log-spaced values over [`velocity_bounds`].
+    /// A grid of 17 log-spaced values over the range.
     Grid,
-    /// These (clamped to [`velocity_bounds`]).
+    /// These (clamped to the range).
     These(&'a [f64]),
 }
 
-/// Points of the `vs` grid in [`fit_joint`], minus one (log-spaced over [`velocity_bounds`]).
+/// Points of the `vs` grid in [`fit_joint`], minus one (log-spaced over the range).
 const GRID: usize = 16;
 
 /// The model `[a, v, s(1−g), s·g, 1]·[Ia, Fv, Fc, Fs, F0]` with `g` the Stribeck
@@ -300,18 +386,25 @@ fn joint_cost(v: &[f64], a: &[f64], target: &[f64], p: &SVector<f64, 6>, coulomb
         .sum()
 }
 
-/// `JᵀJ` and `Jᵀr` of the residual `target − model` at `p`.
+/// `JᵀJ` and `Jᵀr` of the residual `target − model` at `p`, with the `fixed`
+/// entries' rows and columns replaced by the identity (no step along them).
 fn normal_equations(
     v: &[f64],
     a: &[f64],
     target: &[f64],
     p: &SVector<f64, 6>,
     coulomb: Coulomb,
+    fixed: [bool; 6],
 ) -> (SMatrix<f64, 6, 6>, SVector<f64, 6>) {
     let mut h = SMatrix::<f64, 6, 6>::zeros();
     let mut g = SVector::<f64, 6>::zeros();
     for k in 0..v.len() {
-        let (m, row) = model(v[k], a[k], p, coulomb);
+        let (m, mut row) = model(v[k], a[k], p, coulomb);
+        for (r, f) in row.iter_mut().zip(fixed) {
+            if f {
+                *r = 0.0;
+            }
+        }
         let r = target[k] - m;
         for i in 0..6 {
             g[i] += row[i] * r;
@@ -321,6 +414,9 @@ fn normal_equations(
         }
     }
     for i in 0..6 {
+        if fixed[i] {
+            h[(i, i)] = 1.0;
+        }
         for j in 0..i {
             h[(i, j)] = h[(j, i)];
         }
@@ -328,9 +424,54 @@ fn normal_equations(
     (h, g)
 }
 
-/// The best `[Ia, Fv, Fc, Fs, F0]` for a fixed `vs` (a linear least-squares fit;
-/// minimum norm where the columns are dependent), with `ln vs` as sixth entry.
-fn linear_at(v: &[f64], a: &[f64], target: &[f64], vs: f64, coulomb: Coulomb) -> Option<SVector<f64, 6>> {
+/// The least-squares solution of the normal equations `h x = g` with the `fixed`
+/// entries at 0 and the `bounded` ones `≥ 0`: an active set (each round fixes the
+/// most negative bounded entry at 0 and solves again; minimum norm where the free
+/// columns are dependent). `None` if not finite.
+fn bounded_solve<const M: usize>(
+    h: &SMatrix<f64, M, M>,
+    g: &SVector<f64, M>,
+    mut fixed: [bool; M],
+    bounded: [bool; M],
+) -> Option<SVector<f64, M>> {
+    loop {
+        let (mut hf, mut gf) = (*h, *g);
+        for i in (0..M).filter(|&i| fixed[i]) {
+            for j in 0..M {
+                hf[(i, j)] = 0.0;
+                hf[(j, i)] = 0.0;
+            }
+            gf[i] = 0.0;
+        }
+        let eps = 1e-12 * hf.diagonal().max();
+        let (hd, gd) = (
+            DMatrix::from_column_slice(M, M, hf.as_slice()),
+            DVector::from_column_slice(gf.as_slice()),
+        );
+        let x = SVector::<f64, M>::from_column_slice(hd.svd(true, true).solve(&gd, eps).ok()?.as_slice());
+        if !x.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let worst = (0..M)
+            .filter(|&i| bounded[i] && !fixed[i] && x[i] < 0.0)
+            .min_by(|&i, &j| x[i].total_cmp(&x[j]));
+        match worst {
+            Some(i) => fixed[i] = true,
+            None => return Some(x),
+        }
+    }
+}
+
+/// The best `[Ia, Fv, Fc, Fs, F0]` for a fixed `vs` within `constraints` (a linear
+/// least-squares fit, [`bounded_solve`]), with `ln vs` as sixth entry.
+fn linear_at(
+    v: &[f64],
+    a: &[f64],
+    target: &[f64],
+    vs: f64,
+    coulomb: Coulomb,
+    constraints: JointConstraints,
+) -> Option<SVector<f64, 6>> {
     let probe = SVector::<f64, 6>::from([0.0, 0.0, 0.0, 0.0, 0.0, vs.ln()]);
     let mut h = SMatrix::<f64, 5, 5>::zeros();
     let mut g = SVector::<f64, 5>::zeros();
@@ -343,11 +484,88 @@ fn linear_at(v: &[f64], a: &[f64], target: &[f64], vs: f64, coulomb: Coulomb) ->
             }
         }
     }
-    let eps = 1e-12 * h.diagonal().max();
-    let x = h.svd(true, true).solve(&g, eps).ok()?;
-    x.iter()
-        .all(|x| x.is_finite())
-        .then(|| SVector::<f64, 6>::from([x[0], x[1], x[2], x[3], x[4], vs.ln()]))
+    let fixed = constraints.fixed();
+    let x = bounded_solve(
+        &h,
+        &g,
+        [fixed[0], fixed[1], fixed[2], fixed[3], fixed[4]],
+        constraints.bounded(),
+    )?;
+    Some(SVector::<f64, 6>::from([x[0], x[1], x[2], x[3], x[4], vs.ln()]))
+}
+
+/// The linear model `[Ia, Fv, Fc, F0]` of one joint fitted to `target` within
+/// `constraints` (`Fc·s(q̇)`, no Stribeck term).
+fn linear_joint(v: &[f64], a: &[f64], target: &[f64], coulomb: Coulomb, c: JointConstraints) -> Option<[f64; 4]> {
+    let mut h = SMatrix::<f64, 4, 4>::zeros();
+    let mut g = SVector::<f64, 4>::zeros();
+    for k in 0..v.len() {
+        let row = [a[k], v[k], coulomb.eval(v[k]), 1.0];
+        for i in 0..4 {
+            g[i] += row[i] * target[k];
+            for j in 0..4 {
+                h[(i, j)] += row[i] * row[j];
+            }
+        }
+    }
+    let nn = c.nonnegative;
+    let f = c.fitted;
+    let x = bounded_solve(&h, &g, [!f[0], !f[1], !f[2], !f[3]], [nn, nn, nn, false])?;
+    Some([x[0], x[1], x[2], x[3]])
+}
+
+/// The time blocks of [`held_out`]: each is scored with the models fitted on the others.
+pub const BLOCKS: usize = 4;
+
+/// A Stribeck term is kept only if it lowers the joint's held-out sum of squares by
+/// at least this fraction: two more parameters must earn their place.
+pub const MIN_GAIN: f64 = 0.01;
+
+/// One joint's held-out sums of squared residuals `[sign, Stribeck]`: its samples
+/// cut into [`BLOCKS`] contiguous time blocks, each scored with the linear model
+/// and with the Stribeck model ([`fit_joint`] from a grid) fitted on the other
+/// blocks. Deterministic. `None` with too few samples per block.
+fn held_out(
+    v: &[f64],
+    a: &[f64],
+    target: &[f64],
+    coulomb: Coulomb,
+    range: (f64, f64),
+    constraints: JointConstraints,
+) -> Option<[f64; 2]> {
+    let len = v.len();
+    if len < 20 * BLOCKS {
+        return None;
+    }
+    let mut sse = [0.0; 2];
+    for b in 0..BLOCKS {
+        let (from, to) = (b * len / BLOCKS, (b + 1) * len / BLOCKS);
+        let train = |x: &[f64]| -> Vec<f64> { x[..from].iter().chain(&x[to..]).copied().collect() };
+        let (tv, ta, tt) = (train(v), train(a), train(target));
+        let sign = linear_joint(&tv, &ta, &tt, coulomb, constraints)?;
+        let fit = fit_joint(
+            &tv,
+            &ta,
+            &tt,
+            (
+                sign,
+                Stribeck {
+                    fs: sign[2].max(0.0),
+                    vs: (range.0 * range.1).sqrt(),
+                },
+            ),
+            coulomb,
+            range,
+            constraints,
+            Starts::Grid,
+            &ROUND_LM,
+        );
+        let as_p = |l: [f64; 4], s: Stribeck| SVector::<f64, 6>::from([l[0], l[1], l[2], s.fs, l[3], s.vs.ln()]);
+        let (hv, ha, ht) = (&v[from..to], &a[from..to], &target[from..to]);
+        sse[0] += joint_cost(hv, ha, ht, &as_p(sign, Stribeck { fs: sign[2], vs: 1.0 }), coulomb);
+        sse[1] += joint_cost(hv, ha, ht, &as_p(fit.linear, fit.stribeck), coulomb);
+    }
+    sse.iter().all(|x| x.is_finite()).then_some(sse)
 }
 
 /// Rounds of [`refine`], at most.
@@ -356,17 +574,83 @@ pub const MAX_ROUNDS: usize = 20;
 /// [`refine`] stops when a round lowers the cost by less than this fraction.
 pub const REFINE_TOLERANCE: f64 = 1e-5;
 
+/// Why a joint keeps its Stribeck term or falls back to the linear model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointChoice {
+    /// The Stribeck term is kept; otherwise the joint's friction is the linear
+    /// model's (`Fs = Fc`, no effect).
+    pub kept: bool,
+    /// The range `vs` was searched in ([`velocity_range`]).
+    pub range: Option<(f64, f64)>,
+    /// Held-out RMS torque residual `[sign, Stribeck]` of the joint ([`BLOCKS`]
+    /// time blocks, each predicted by the models fitted on the others).
+    pub held_out: Option<[f64; 2]>,
+    /// Why, in words.
+    pub reason: String,
+}
+
+impl JointChoice {
+    fn sign(range: Option<(f64, f64)>, held_out: Option<[f64; 2]>, reason: impl Into<String>) -> Self {
+        JointChoice {
+            kept: false,
+            range,
+            held_out,
+            reason: reason.into(),
+        }
+    }
+}
+
+impl JointChoice {
+    /// `Stribeck kept: why` or `{fallback} kept: why` (the linear model's Coulomb
+    /// term, `sign` or `tanh`), with the held-out errors and the range of `vs`.
+    pub fn line(&self, fallback: &str) -> String {
+        let held_out = self.held_out.map_or_else(String::new, |[sign, stribeck]| {
+            format!(
+                "held-out residual RMS {stribeck:.4e} with it against {sign:.4e} without ({:+.1} %)",
+                100.0 * (stribeck / sign - 1.0)
+            )
+        });
+        let range = self
+            .range
+            .map_or_else(String::new, |(lo, hi)| format!("vs searched in [{lo:.3e}, {hi:.3e}]"));
+        let mut text = if self.kept {
+            "Stribeck kept: ".to_string()
+        } else {
+            format!("{fallback} kept: ")
+        };
+        text.push_str(&self.reason);
+        for part in [held_out, range] {
+            if !part.is_empty() && !self.reason.contains(&part) {
+                text.push_str("; ");
+                text.push_str(&part);
+            }
+        }
+        text
+    }
+}
+
+impl fmt::Display for JointChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.line("sign"))
+    }
+}
+
 /// What [`refine`] found: per joint the Stribeck parameters and their fits, and the
 /// sum of squared torque residuals (all joints, N²·m²) of the linear start and of
 /// the result.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StribeckFit {
     pub coulomb: Coulomb,
+    /// Per joint `Fs` and `vs`; a joint that fell back to the linear model has
+    /// `Fs = Fc` (no effect, whatever `vs`).
     pub joints: Vec<Stribeck>,
     /// Per joint, the Coulomb friction `Fc` of the final linear fit.
     pub fc: Vec<f64>,
-    /// Per joint, σ of `Fs` and `vs` (see [`JointFit::sigma`]).
+    /// Per joint, σ of `Fs` and `vs` (see [`JointFit::sigma`]); `None` for a
+    /// joint without the term.
     pub sigma: Vec<[Option<f64>; 2]>,
+    /// Per joint, whether the term is kept and why.
+    pub choices: Vec<JointChoice>,
     /// Per joint, Levenberg–Marquardt iterations over all rounds.
     pub iterations: Vec<usize>,
     /// Alternating rounds run (each: the joints' nonlinear fits, then one linear fit).
@@ -385,22 +669,22 @@ impl StribeckFit {
     }
 
     /// `Fs1, vs1, Fs2, vs2, …` for the parameter report: identified with their σ,
-    /// or without a value (`no_effect`) for a joint whose fit found nothing to
-    /// improve (its prediction is the linear one whatever `vs` holds).
+    /// or `excluded` (no value) for a joint that fell back to the linear model.
     pub fn param_reports(&self) -> Vec<ParamReport> {
         let mut out = Vec::with_capacity(2 * self.joints.len());
         for (j, (s, sigma)) in self.joints.iter().zip(&self.sigma).enumerate() {
+            let kept = self.choices.get(j).is_some_and(|c| c.kept);
             for (name, value, sigma) in [("Fs", s.fs, sigma[0]), ("vs", s.vs, sigma[1])] {
-                let known = sigma.is_some();
+                let sigma = sigma.filter(|_| kept);
                 out.push(ParamReport {
                     name: param_name(name, j + 1),
-                    value: known.then_some(value),
+                    value: kept.then_some(value),
                     sigma,
                     sigma_percent: sigma.filter(|_| value != 0.0).map(|s| 100.0 * s / value.abs()),
-                    status: if known {
+                    status: if kept {
                         ParamStatus::Identified
                     } else {
-                        ParamStatus::NoEffect
+                        ParamStatus::Excluded
                     },
                 });
             }
@@ -424,18 +708,25 @@ impl fmt::Display for StribeckFit {
         )?;
         let cell = |x: Option<f64>| x.map_or_else(|| format!("{:>12}", "—"), |x| format!("{x:>12.5}"));
         for (j, (s, sigma)) in self.joints.iter().zip(&self.sigma).enumerate() {
-            let known = sigma[0].is_some();
+            let known = self.choices.get(j).is_some_and(|c| c.kept);
             writeln!(
                 f,
                 "{:>5} {:>11.5} {} {} {} {} {:>14}",
                 j + 1,
                 self.fc[j],
                 cell(known.then_some(s.fs)),
-                cell(sigma[0]),
+                cell(sigma[0].filter(|_| known)),
                 cell(known.then_some(s.vs)),
-                cell(sigma[1]),
+                cell(sigma[1].filter(|_| known)),
                 self.iterations[j]
             )?;
+        }
+        let fallback = match self.coulomb {
+            Coulomb::Sign => "sign",
+            Coulomb::Smooth { .. } => "tanh",
+        };
+        for (j, choice) in self.choices.iter().enumerate() {
+            writeln!(f, "joint {}: {}", j + 1, choice.line(fallback))?;
         }
         Ok(())
     }
@@ -443,53 +734,250 @@ impl fmt::Display for StribeckFit {
 
 /// The Stribeck model fitted from the linear fit `start` (whose solution is the
 /// `10n` standard parameters then `[Ia, Fv, Fc, F0]` per joint, Coulomb term
-/// `coulomb`) of `traj`'s torques; `linear_fit` redoes that linear fit on any
-/// trajectory (`traj`, a part of it, or either with the Stribeck term taken out of
-/// the torques). Returns the final linear fit (its solution holds the rigid-body
-/// parameters and `[Ia, Fv, Fc, F0]`; its residuals are those of the whole model)
-/// and the Stribeck parameters. `traj` must have velocities and accelerations.
+/// `coulomb`, within `constraints`) of `traj`'s torques; `linear_fit` redoes that
+/// linear fit on any trajectory (`traj`, a part of it, or either with the Stribeck
+/// term taken out of the torques). Returns the final linear fit (its solution holds
+/// the rigid-body parameters and `[Ia, Fv, Fc, F0]`; its residuals are those of the
+/// whole model) and the Stribeck parameters. `traj` must have velocities and
+/// accelerations.
 ///
-/// A long recording is fitted first on at most [`ROUND_SAMPLES`] samples spread
-/// over it (the rounds, each a linear fit, are then cheap), and the result carried
-/// to every sample by one linear fit and at most [`FINAL_ROUNDS`] more rounds; the
-/// result is accepted only where it lowers the cost over every sample, so it is
-/// never worse than `start`.
+/// Each joint first earns its term ([`JointChoice`]), with the rigid-body torques
+/// of `start` held: its `vs` range must exist ([`velocity_range`]); the term must
+/// lower the joint's held-out sum of squares by [`MIN_GAIN`] ([`BLOCKS`] time
+/// blocks, each predicted by the models fitted on the others: a term that fits the
+/// noise of a few velocity reversals does not predict the next ones); and fitted on
+/// all the samples it must stay physical (`Fs ≥ 0` is a bound; `Fc` and `Fv` must
+/// not turn negative) with a finite σ of `Fs` and `vs` and `σ(vs) < vs`. The
+/// other joints keep the linear model (`Fs = Fc`).
+///
+/// The kept terms are then refined with the whole fit. A long recording is fitted
+/// first on at most [`ROUND_SAMPLES`] samples spread over it (the rounds, each a
+/// linear fit, are then cheap), and the result carried to every sample by one
+/// linear fit and at most [`FINAL_ROUNDS`] more rounds; a round is accepted only
+/// where it lowers the cost over every sample, so the fit is never worse than
+/// `start`. A joint whose refined term fails the physical check falls back, and the
+/// refinement runs again without it.
 pub fn refine<E>(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
     coulomb: Coulomb,
+    constraints: JointConstraints,
     start: Estimate,
     mut linear_fit: impl FnMut(&Trajectory) -> Result<Estimate, E>,
 ) -> Result<(Estimate, StribeckFit), E> {
     let n = dynamics.nv();
     let full = Columns::new(traj, n);
-    // The start: Fs = Fc, vs a tenth of the joint's largest speed.
-    let first: Vec<Stribeck> = (0..n)
-        .map(|j| {
-            let v_max = full.v[j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            Stribeck {
-                fs: joint_linear(&start.solution, n, j)[2],
-                vs: if v_max > 0.0 && v_max.is_finite() {
-                    0.1 * v_max
-                } else {
-                    1.0
-                },
+    let ranges: Vec<Option<(f64, f64)>> = (0..n).map(|j| velocity_range(&full.v[j])).collect();
+    let (initial_cost, rigid) = total_cost(
+        dynamics,
+        traj,
+        &start.solution,
+        &no_effect(&start.solution, n, &ranges),
+        coulomb,
+    );
+    // Which joints earn the term, on at most ROUND_SAMPLES samples spread over the
+    // recording (in parallel).
+    let stride = traj.len().div_ceil(ROUND_SAMPLES).max(1);
+    let mut choices = in_parallel(n, |j| {
+        let pick = |x: &[f64]| -> Vec<f64> { x.iter().step_by(stride).copied().collect() };
+        let target: Vec<f64> = (0..traj.len())
+            .step_by(stride)
+            .map(|k| full.tau[j][k] - rigid[k * n + j])
+            .collect();
+        choose(
+            &pick(&full.v[j]),
+            &pick(&full.a[j]),
+            &target,
+            joint_linear(&start.solution, n, j),
+            coulomb,
+            ranges[j],
+            constraints,
+        )
+    });
+    loop {
+        let allowed: Vec<bool> = choices.iter().map(|c| c.kept).collect();
+        let (estimate, fit) = refine_allowed(
+            dynamics,
+            traj,
+            coulomb,
+            constraints,
+            &start,
+            &full,
+            &ranges,
+            &allowed,
+            (initial_cost, &rigid),
+            &mut linear_fit,
+        )?;
+        let mut dropped = false;
+        for j in (0..n).filter(|&j| allowed[j]) {
+            let linear = joint_linear(&estimate.solution, n, j);
+            if let Some(why) = unphysical(&linear, fit.joints[j], fit.sigma[j], constraints) {
+                choices[j] = JointChoice::sign(
+                    choices[j].range,
+                    choices[j].held_out,
+                    format!("refined with the whole model, {why}"),
+                );
+                dropped = true;
             }
+        }
+        if !dropped {
+            return Ok((estimate, StribeckFit { choices, ..fit }));
+        }
+    }
+}
+
+/// Whether joint terms `linear` with the Stribeck term `s` (σ `sigma`) are a
+/// physical, determined fit; `Some(why)` if not.
+fn unphysical(
+    linear: &[f64; PER_JOINT],
+    s: Stribeck,
+    sigma: [Option<f64>; 2],
+    constraints: JointConstraints,
+) -> Option<String> {
+    if s.fs < 0.0 {
+        return Some(format!("its static friction Fs = {:.4e} is negative", s.fs));
+    }
+    for (k, name, what) in [(2, "Fc", "Coulomb"), (1, "Fv", "viscous")] {
+        if constraints.fitted[k] && linear[k] < 0.0 {
+            return Some(format!(
+                "{name} = {:.4e} with it: a negative {what} friction is not physical",
+                linear[k]
+            ));
+        }
+    }
+    match sigma {
+        [Some(sf), Some(sv)] if sf.is_finite() && sv.is_finite() => {
+            (sv >= s.vs).then(|| format!("vs = {:.4e} is not determined by the data (σ(vs) = {sv:.3e})", s.vs))
+        }
+        _ => Some("Fs and vs are not determined by the data (no finite σ)".into()),
+    }
+}
+
+/// One joint's [`JointChoice`] from its velocities `v`, accelerations `a` and
+/// torque `target` without its rigid-body part, from the linear terms `linear`.
+fn choose(
+    v: &[f64],
+    a: &[f64],
+    target: &[f64],
+    linear: [f64; PER_JOINT],
+    coulomb: Coulomb,
+    range: Option<(f64, f64)>,
+    constraints: JointConstraints,
+) -> JointChoice {
+    let Some(range) = range else {
+        return JointChoice::sign(
+            None,
+            None,
+            "the joint does not move, or never comes near rest: the data say nothing about static friction",
+        );
+    };
+    let Some(sse) = held_out(v, a, target, coulomb, range, constraints) else {
+        return JointChoice::sign(Some(range), None, "too few samples to test the term on held-out data");
+    };
+    let rms = sse.map(|x| (x / v.len() as f64).sqrt());
+    if sse[1] >= (1.0 - MIN_GAIN) * sse[0] {
+        return JointChoice::sign(
+            Some(range),
+            Some(rms),
+            format!(
+                "the Stribeck term does not lower the held-out error by {:.0} %",
+                100.0 * MIN_GAIN
+            ),
+        );
+    }
+    let fit = fit_joint(
+        v,
+        a,
+        target,
+        (
+            linear,
+            Stribeck {
+                fs: linear[2].max(0.0),
+                vs: (range.0 * range.1).sqrt(),
+            },
+        ),
+        coulomb,
+        range,
+        constraints,
+        Starts::Grid,
+        &ROUND_LM,
+    );
+    if let Some(why) = unphysical(&fit.linear, fit.stribeck, fit.sigma, constraints) {
+        return JointChoice::sign(Some(range), Some(rms), format!("fitted on every sample, {why}"));
+    }
+    JointChoice {
+        kept: true,
+        range: Some(range),
+        held_out: Some(rms),
+        reason: "it lowers the held-out error".into(),
+    }
+}
+
+/// `f(j)` for every joint, in parallel, in joint order.
+fn in_parallel<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = crate::accumulate::cores().clamp(1, n.max(1));
+    let mut out: Vec<(usize, T)> = std::thread::scope(|s| {
+        let f = &f;
+        let handles: Vec<_> = (0..threads)
+            .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, f(j))).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    out.sort_by_key(|(j, _)| *j);
+    out.into_iter().map(|(_, x)| x).collect()
+}
+
+/// Per joint a Stribeck term without effect (`Fs = Fc` of `x`), `vs` inside its range.
+fn no_effect(x: &[f64], n: usize, ranges: &[Option<(f64, f64)>]) -> Vec<Stribeck> {
+    (0..n)
+        .map(|j| Stribeck {
+            fs: joint_linear(x, n, j)[2],
+            vs: ranges[j].map_or(1.0, |(lo, hi)| (lo * hi).sqrt()),
         })
-        .collect();
-    let (initial_cost, rigid) = total_cost(dynamics, traj, &start.solution, &first, coulomb);
+        .collect()
+}
+
+/// [`refine`]'s rounds with the Stribeck term on the `allowed` joints only (the
+/// others held at `Fs = Fc`); `initial` is the cost of `start` and its rigid-body
+/// torques.
+#[allow(clippy::too_many_arguments)]
+fn refine_allowed<E>(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    coulomb: Coulomb,
+    constraints: JointConstraints,
+    start: &Estimate,
+    full: &Columns,
+    ranges: &[Option<(f64, f64)>],
+    allowed: &[bool],
+    initial: (f64, &[f64]),
+    linear_fit: &mut impl FnMut(&Trajectory) -> Result<Estimate, E>,
+) -> Result<(Estimate, StribeckFit), E> {
+    let n = dynamics.nv();
+    let (initial_cost, rigid) = initial;
     let mut state = State {
-        estimate: start,
-        stribeck: first,
+        estimate: start.clone(),
+        stribeck: no_effect(&start.solution, n, ranges),
         sigma: vec![[None, None]; n],
         iterations: vec![0; n],
         rounds: 0,
         cost: initial_cost,
-        rigid,
+        rigid: rigid.to_vec(),
+    };
+    let setup = Setup {
+        coulomb,
+        constraints,
+        ranges,
+        allowed,
     };
     let stride = traj.len().div_ceil(ROUND_SAMPLES).max(1);
-    if stride == 1 {
-        state = rounds(dynamics, traj, &full, coulomb, state, None, MAX_ROUNDS, &mut linear_fit)?;
+    if !allowed.iter().any(|&a| a) {
+        // Nothing to refine: the linear fit as it is.
+    } else if stride == 1 {
+        state = rounds(dynamics, traj, full, &setup, state, None, MAX_ROUNDS, linear_fit)?;
     } else if let Some(part) = every(traj, stride) {
         let columns = Columns::new(&part, n);
         let estimate = linear_fit(&part)?;
@@ -498,7 +986,7 @@ pub fn refine<E>(
             dynamics,
             &part,
             &columns,
-            coulomb,
+            &setup,
             State {
                 estimate,
                 cost,
@@ -507,26 +995,23 @@ pub fn refine<E>(
             },
             None,
             MAX_ROUNDS,
-            &mut linear_fit,
+            linear_fit,
         )?;
         // Each joint's vs carried to every sample: the first round there starts
         // from it (Fs and the linear terms fitted for it), rounds counted on.
         let vs: Vec<f64> = found.stribeck.iter().map(|s| s.vs).collect();
         state.rounds = found.rounds;
         state.iterations = found.iterations;
-        state = rounds(
-            dynamics,
-            traj,
-            &full,
-            coulomb,
-            state,
-            Some(&vs),
-            FINAL_ROUNDS,
-            &mut linear_fit,
-        )?;
+        state = rounds(dynamics, traj, full, &setup, state, Some(&vs), FINAL_ROUNDS, linear_fit)?;
     }
     let fc = (0..n)
         .map(|j| joint_linear(&state.estimate.solution, n, j)[2])
+        .collect();
+    let sigma = state
+        .sigma
+        .iter()
+        .zip(allowed)
+        .map(|(s, &a)| if a { *s } else { [None, None] })
         .collect();
     Ok((
         state.estimate,
@@ -534,7 +1019,8 @@ pub fn refine<E>(
             coulomb,
             joints: state.stribeck,
             fc,
-            sigma: state.sigma,
+            sigma,
+            choices: Vec::new(),
             iterations: state.iterations,
             rounds: state.rounds,
             initial_cost,
@@ -542,6 +1028,14 @@ pub fn refine<E>(
             rows: traj.len() * n,
         },
     ))
+}
+
+/// What every round of [`refine`] works with besides the data.
+struct Setup<'a> {
+    coulomb: Coulomb,
+    constraints: JointConstraints,
+    ranges: &'a [Option<(f64, f64)>],
+    allowed: &'a [bool],
 }
 
 /// Samples the rounds of [`refine`] run on, at most.
@@ -643,7 +1137,7 @@ fn rounds<E>(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
     columns: &Columns,
-    coulomb: Coulomb,
+    setup: &Setup<'_>,
     mut state: State,
     hint: Option<&[f64]>,
     max: usize,
@@ -651,38 +1145,48 @@ fn rounds<E>(
 ) -> Result<State, E> {
     let n = dynamics.nv();
     let len = traj.len();
+    let coulomb = setup.coulomb;
     for round in 0..max {
         let before = state.cost;
-        // (1) Every joint on its own (in parallel), the rigid-body torques held.
-        let fit = |j: usize| {
+        // (1) Every joint with the term on its own (in parallel), the rigid-body
+        // torques held; the others as they are, without it.
+        let fits = in_parallel(n, |j| {
             let target: Vec<f64> = (0..len).map(|k| columns.tau[j][k] - state.rigid[k * n + j]).collect();
-            fit_joint(
-                &columns.v[j],
-                &columns.a[j],
-                &target,
-                (joint_linear(&state.estimate.solution, n, j), state.stribeck[j]),
-                coulomb,
-                match (round, hint) {
-                    (0, None) => Starts::Grid,
-                    (0, Some(vs)) => Starts::These(&vs[j..j + 1]),
-                    _ => Starts::None,
-                },
-                &ROUND_LM,
-            )
-        };
-        let threads = crate::accumulate::cores().clamp(1, n.max(1));
-        let mut fits: Vec<(usize, JointFit)> = std::thread::scope(|s| {
-            let fit = &fit;
-            let handles: Vec<_> = (0..threads)
-                .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, fit(j))).collect::<Vec<_>>()))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .collect()
+            let linear = joint_linear(&state.estimate.solution, n, j);
+            match (setup.allowed[j], setup.ranges[j]) {
+                (true, Some(range)) => fit_joint(
+                    &columns.v[j],
+                    &columns.a[j],
+                    &target,
+                    (linear, state.stribeck[j]),
+                    coulomb,
+                    range,
+                    setup.constraints,
+                    match (round, hint) {
+                        (0, None) => Starts::Grid,
+                        (0, Some(vs)) => Starts::These(&vs[j..j + 1]),
+                        _ => Starts::None,
+                    },
+                    &ROUND_LM,
+                ),
+                _ => {
+                    let s = Stribeck {
+                        fs: linear[2],
+                        vs: state.stribeck[j].vs,
+                    };
+                    let p = SVector::<f64, 6>::from([linear[0], linear[1], linear[2], s.fs, linear[3], s.vs.ln()]);
+                    let cost = joint_cost(&columns.v[j], &columns.a[j], &target, &p, coulomb);
+                    JointFit {
+                        linear,
+                        stribeck: s,
+                        sigma: [None, None],
+                        initial_cost: cost,
+                        cost,
+                        iterations: 0,
+                    }
+                }
+            }
         });
-        fits.sort_by_key(|(j, _)| *j);
-        let fits: Vec<JointFit> = fits.into_iter().map(|(_, f)| f).collect();
         for (count, f) in state.iterations.iter_mut().zip(&fits) {
             *count += f.iterations;
         }
@@ -793,7 +1297,19 @@ mod tests {
         let truth = ([0.3, 2.0, 4.0, 0.1], Stribeck { fs: 6.0, vs: 0.05 });
         let (v, a, tau) = joint_data(truth, 0.02, 3);
         let start = ([0.0, 0.0, 0.0, 0.0], Stribeck { fs: 0.0, vs: 0.08 });
-        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, Starts::Grid, &LmOptions::default());
+        let range = velocity_range(&v).unwrap();
+        let c = JointConstraints::default();
+        let fit = fit_joint(
+            &v,
+            &a,
+            &tau,
+            start,
+            Coulomb::Sign,
+            range,
+            c,
+            Starts::Grid,
+            &LmOptions::default(),
+        );
         assert!(fit.cost < fit.initial_cost);
         assert!((fit.stribeck.fs / 6.0 - 1.0).abs() < 0.01, "{fit:?}");
         assert!((fit.stribeck.vs / 0.05 - 1.0).abs() < 0.02, "{fit:?}");
@@ -813,25 +1329,141 @@ mod tests {
         let truth = ([0.0, 1.0, 2.0, 0.0], Stribeck { fs: 2.0, vs: 0.1 });
         let (v, a, tau) = joint_data(truth, 0.05, 5);
         let start = (truth.0, truth.1);
-        let fit = fit_joint(&v, &a, &tau, start, Coulomb::Sign, Starts::Grid, &LmOptions::default());
+        let range = velocity_range(&v).unwrap();
+        let c = JointConstraints::default();
+        let fit = fit_joint(
+            &v,
+            &a,
+            &tau,
+            start,
+            Coulomb::Sign,
+            range,
+            c,
+            Starts::Grid,
+            &LmOptions::default(),
+        );
         assert!(fit.cost <= fit.initial_cost);
-        let (lo, hi) = velocity_bounds(v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        let (lo, hi) = range;
         assert!(
             fit.stribeck.vs >= lo * (1.0 - 1e-12) && fit.stribeck.vs <= hi * (1.0 + 1e-12),
             "{fit:?}"
         );
         assert!(fit.stribeck.fs.is_finite());
-        // A joint that never moves keeps its start.
-        let fit = fit_joint(
-            &[0.0; 10],
-            &[0.0; 10],
-            &[1.0; 10],
-            start,
-            Coulomb::Sign,
-            Starts::Grid,
-            &LmOptions::default(),
+        // A joint that never moves has no range for vs.
+        assert_eq!(velocity_range(&[0.0; 10]), None);
+    }
+
+    /// 60 s at 100 Hz of one joint sweeping back and forth (velocity reversals every
+    /// few seconds) with friction `truth`, noise of `noise` and, at every reversal
+    /// of the first 15 s, a burst of `spike` N·m with the sign of the velocity (a
+    /// glitch the later reversals do not repeat).
+    fn sweeps(truth: ([f64; 4], Stribeck), noise: f64, spike: f64, seed: u64) -> [Vec<f64>; 3] {
+        let mut rng = SplitMix64::new(seed);
+        let (mut v, mut a, mut tau) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..6000 {
+            let t = k as f64 * 0.01;
+            let (vk, ak) = (
+                0.5 * (0.9 * t).sin() + 0.15 * (2.1 * t).cos(),
+                0.45 * (0.9 * t).cos() - 0.315 * (2.1 * t).sin(),
+            );
+            let [ia, fv, fc, f0] = truth.0;
+            let mut x = ia * ak + fv * vk + fc * vk.signum() + f0 + excess_torque(fc, truth.1, vk, Coulomb::Sign);
+            x += noise * rng.uniform(-1.0, 1.0);
+            if k < 1500 && vk.abs() < 2e-3 {
+                x += spike * vk.signum();
+            }
+            v.push(vk);
+            a.push(ak);
+            tau.push(x);
+        }
+        [v, a, tau]
+    }
+
+    fn choice(data: &[Vec<f64>; 3], linear: [f64; 4]) -> JointChoice {
+        let [v, a, tau] = data;
+        let range = velocity_range(v);
+        let c = choose(v, a, tau, linear, Coulomb::Sign, range, JointConstraints::default());
+        println!("{c}");
+        c
+    }
+
+    #[test]
+    fn the_velocity_range_comes_from_the_data() {
+        // A sine of amplitude 2: the 99 % quantile of |v| is about 2, and 1 % of the
+        // samples are slower than 2·sin(π/2·0.01) ≈ 0.031.
+        let v: Vec<f64> = (0..10_000).map(|k| 2.0 * (k as f64 * 1e-3).sin()).collect();
+        let (lo, hi) = velocity_range(&v).unwrap();
+        assert!((hi - 0.5 * 2.0).abs() < 0.01, "{hi}");
+        assert!(
+            (lo - 2.0 * (0.005f64 * std::f64::consts::PI).sin()).abs() < 3e-3,
+            "{lo}"
         );
-        assert_eq!((fit.stribeck, fit.iterations), (truth.1, 0));
+        // Never near rest (1.5 ± 0.5): nothing to say about static friction.
+        let fast: Vec<f64> = (0..1000).map(|k| 1.5 + 0.5 * (k as f64 * 0.01).sin()).collect();
+        assert_eq!(velocity_range(&fast), None);
+        assert_eq!(velocity_range(&[f64::NAN; 10]), None);
+    }
+
+    #[test]
+    fn a_joint_keeps_the_term_only_where_it_predicts_held_out_data_and_is_physical() {
+        let linear = [0.3, 2.0, 4.0, 0.1];
+        // A real Stribeck effect: kept, and the held-out error falls.
+        let real = sweeps((linear, Stribeck { fs: 6.0, vs: 0.05 }), 0.05, 0.0, 1);
+        let c = choice(&real, linear);
+        let [sign, stribeck] = c.held_out.unwrap();
+        assert!(c.kept && stribeck < 0.5 * sign, "{c}");
+        // Sign friction and noise only: the term fits nothing that comes back.
+        let none = sweeps((linear, Stribeck { fs: 4.0, vs: 0.05 }), 0.05, 0.0, 2);
+        let c = choice(&none, linear);
+        assert!(!c.kept && c.reason.contains("does not lower the held-out error"), "{c}");
+        // Glitches at the reversals of the first 15 s only: a small vs fits them
+        // in training, and predicts the rest no better.
+        let glitches = sweeps((linear, Stribeck { fs: 4.0, vs: 0.05 }), 0.05, 30.0, 3);
+        let c = choice(&glitches, linear);
+        assert!(!c.kept, "{c}");
+        // A static friction with a negative Coulomb friction under it: the term
+        // predicts, but is not physical.
+        let negative = ([0.3, 2.0, -1.0, 0.1], Stribeck { fs: 3.0, vs: 0.05 });
+        let c = choice(&sweeps(negative, 0.05, 0.0, 4), negative.0);
+        assert!(!c.kept && c.reason.contains("Fc = -"), "{c}");
+        assert!(
+            c.to_string().starts_with("sign kept: fitted on every sample, Fc = -"),
+            "{c}"
+        );
+    }
+
+    #[test]
+    fn bounds_hold_in_the_fit() {
+        // Fs ≥ 0 and, constrained, Ia, Fv, Fc ≥ 0; a term not fitted stays 0.
+        let truth = ([-0.2, 2.0, -1.0, 0.1], Stribeck { fs: -2.0, vs: 0.05 });
+        let [v, a, tau] = sweeps(truth, 0.01, 0.0, 5);
+        let range = velocity_range(&v).unwrap();
+        let start = ([0.0; 4], Stribeck { fs: 0.0, vs: 0.1 });
+        for constraints in [
+            JointConstraints::default(),
+            JointConstraints {
+                fitted: [false, true, true, true],
+                nonnegative: true,
+            },
+        ] {
+            let fit = fit_joint(
+                &v,
+                &a,
+                &tau,
+                start,
+                Coulomb::Sign,
+                range,
+                constraints,
+                Starts::Grid,
+                &ROUND_LM,
+            );
+            assert!(fit.stribeck.fs >= 0.0, "{fit:?}");
+            assert!(fit.stribeck.vs >= range.0 && fit.stribeck.vs <= range.1, "{fit:?}");
+            if constraints.nonnegative {
+                assert!(fit.linear[..3].iter().all(|x| *x >= 0.0), "{fit:?}");
+                assert_eq!(fit.linear[0], 0.0);
+            }
+        }
     }
 
     #[test]

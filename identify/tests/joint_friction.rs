@@ -11,7 +11,7 @@ use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
 use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, PipelineError, Prediction};
-use dyngen_identify::report::MergedLinks;
+use dyngen_identify::report::{MergedLinks, ParamReport, ParamStatus, Parameterisation};
 use dyngen_identify::simulate::{add_joint_terms, record_trajectory, Gaussian, Logger, Recording};
 use dyngen_identify::validate::Validation;
 use dyngen_identify::{Accumulator, Channels, Method, Options, Status};
@@ -418,4 +418,98 @@ fn rows_below_a_speed_are_left_out_and_counted() {
         ..IdentifyOptions::default()
     };
     assert!(mim.check().unwrap_err().to_string().contains("MIM uses every sample"));
+}
+
+/// The rotor inertia on its own (`IdentifyOptions::rotor_inertia`): friction without
+/// it on a robot whose drives have none, rotor inertia without friction on a robot
+/// whose joints have no friction; each recovers what is in the data, reports the
+/// terms left out as `excluded` (0 in the solution); bad combinations are refused
+/// by name.
+#[test]
+fn rotor_inertia_is_fitted_or_left_out_on_its_own() {
+    let robot = ur5();
+    let truth = joint_truth();
+    let only = |keep: [bool; 4]| -> Vec<f64> {
+        truth
+            .iter()
+            .enumerate()
+            .map(|(i, x)| if keep[i % 4] { *x } else { 0.0 })
+            .collect()
+    };
+    let terms = |id: &pipeline::Identification| -> Vec<ParamReport> { id.report.parameters[60..84].to_vec() };
+    // Friction without rotor inertia.
+    let joints = only([false, true, true, true]);
+    let traj = noisy_trajectory(&robot, &joints, 1, 3);
+    let options = IdentifyOptions {
+        rotor_inertia: Some(false),
+        ..with_friction(Estimator::Ols)
+    };
+    let id = pipeline::identify(&robot, &traj, &options).unwrap();
+    let solution = match &id.prediction {
+        Prediction::Regressor(t) => t.estimate.solution.clone(),
+        Prediction::Parameters(_) => panic!("a torque estimate"),
+    };
+    for (i, p) in terms(&id).iter().enumerate() {
+        if i % 4 == 0 {
+            assert_eq!((p.value, p.status), (None, ParamStatus::Excluded), "{p:?}");
+            assert_eq!(solution[60 + i], 0.0);
+        } else {
+            let (v, sigma) = (p.value.unwrap(), p.sigma.unwrap());
+            assert!((v - joints[i]).abs() < 4.0 * sigma, "{p:?} vs {}", joints[i]);
+        }
+    }
+    let pre = id.report.prediction.as_ref().unwrap().preprocessing.as_ref().unwrap();
+    assert_eq!(pre.rotor_inertia, Some(false));
+    // Rotor inertia without friction: Ia of joints 3–6 (1 and 2 group with Izz).
+    let joints = only([true, false, false, false]);
+    let traj = noisy_trajectory(&robot, &joints, 2, 4);
+    let options = IdentifyOptions {
+        rotor_inertia: Some(true),
+        ..IdentifyOptions::default()
+    };
+    let id = pipeline::identify(&robot, &traj, &options).unwrap();
+    assert_eq!(id.report.parameterisation, Parameterisation::StandardAndJoints);
+    for (i, p) in terms(&id).iter().enumerate() {
+        match (i % 4, i / 4) {
+            (0, j) if j >= 2 => {
+                let (v, sigma) = (p.value.unwrap(), p.sigma.unwrap());
+                assert!((v - IA[j]).abs() < 4.0 * sigma && sigma < 0.25 * IA[j], "{p:?}");
+            }
+            (0, _) => assert_eq!(p.status, ParamStatus::InCombination, "{p:?}"),
+            _ => assert_eq!((p.value, p.status), (None, ParamStatus::Excluded), "{p:?}"),
+        }
+    }
+    // The friction terms left out of the model are not friction to write.
+    let urdf = include_str!("../../robots/ur5/ur5.urdf");
+    let rewrite = id.rewrite_urdf(urdf, robot.model(), MergedLinks::Lump).unwrap();
+    assert!(rewrite.dynamics.is_empty());
+    assert!(rewrite
+        .dynamics_kept
+        .iter()
+        .all(|(_, why)| why == "friction left out of the model"));
+    // Leaving it out without friction terms, or outside the standard mode: refused.
+    for bad in [
+        IdentifyOptions {
+            rotor_inertia: Some(false),
+            ..IdentifyOptions::default()
+        },
+        IdentifyOptions {
+            rotor_inertia: Some(true),
+            mode: pipeline::Mode::Principal,
+            ..IdentifyOptions::default()
+        },
+    ] {
+        let e = pipeline::identify(&robot, &traj, &bad).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                PipelineError::InvalidOption {
+                    option: "rotor-inertia",
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(e.to_string().starts_with("rotor-inertia "), "{e}");
+    }
 }

@@ -32,9 +32,11 @@
 //!
 //! `status` is one of `identified` (value and σ from the data), `in_combination`
 //! (no value: only enters the listed combinations), `no_effect` (no value: the data
-//! carry nothing about it), `from_prior` (ridge: value mostly from the prior) and
-//! `constrained` (value shaped by physical-consistency constraints, no σ) and
-//! `not_significant` (MIM: the estimate is below 3σ, so no value). A
+//! carry nothing about it), `from_prior` (ridge: value mostly from the prior),
+//! `constrained` (value shaped by physical-consistency constraints, no σ),
+//! `not_significant` (MIM: the estimate is below 3σ, so no value) and `excluded`
+//! (left out of the model by choice: a joint term not fitted, or a Stribeck term
+//! that fell back to the linear model; no value, no effect on the prediction). A
 //! parameter without a value is `null`, never a number. `combinations` lists only
 //! combinations of two or more parameters. Floats round-trip exactly.
 
@@ -135,6 +137,9 @@ pub struct Preprocessing {
     pub epsilon_auto: Option<bool>,
     /// Rows of a joint slower than this (rad/s) left out of the fit.
     pub exclude_below: Option<f64>,
+    /// Whether the rotor inertias `Ia` were fitted (`false`: left out, 0), when
+    /// joint terms were.
+    pub rotor_inertia: Option<bool>,
 }
 
 /// Which samples of which file an identification used.
@@ -176,6 +181,9 @@ pub enum ParamStatus {
     /// ([`crate::mim::Verdict::NotSignificant`]), without a value; joint torques,
     /// `|x̂| < σ̂`, with its value and σ for the record.
     NotSignificant,
+    /// Left out of the model by choice (a joint term not fitted, a Stribeck term
+    /// that fell back to the linear model): no value.
+    Excluded,
 }
 
 impl From<Status> for ParamStatus {
@@ -186,6 +194,7 @@ impl From<Status> for ParamStatus {
             Status::NoEffect => ParamStatus::NoEffect,
             Status::FromPrior => ParamStatus::FromPrior,
             Status::Constrained => ParamStatus::Constrained,
+            Status::Excluded => ParamStatus::Excluded,
         }
     }
 }

@@ -1,17 +1,20 @@
 //! What identification hands to people and to other tools: the parameters as JSON
 //! ([`ParameterReport`]), the URDF rewritten with identified inertials
-//! ([`rewrite_urdf_inertials`]). SVG charts are drawn by the command line.
+//! ([`rewrite_urdf_inertials`]), and beside it the joint terms a URDF cannot hold
+//! ([`JointParamsFile`]). SVG charts are drawn by the command line.
 //!
 //! Each output is built as a string with no I/O; [`write_new`] writes it and never
 //! replaces an existing file unless asked to.
 
 mod chart;
 mod error;
+mod joint_params;
 mod json;
 mod urdf;
 
 pub use chart::{Corner, LineChart};
 pub use error::ReportError;
+pub use joint_params::{JointParams, JointParamsFile, JOINT_PARAMS_SCHEMA};
 pub use json::{
     CombinationReport, CoulombReport, DataSpan, NonPhysical, ParamReport, ParamStatus, ParameterReport,
     Parameterisation, PredictionModel, Preprocessing, Term, SCHEMA,

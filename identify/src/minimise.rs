@@ -17,10 +17,13 @@ pub(crate) struct Minimum {
     pub evaluations: usize,
 }
 
+/// The function minimised.
+type Function<'f> = &'f mut dyn FnMut(&[f64]) -> f64;
+
 /// The objective, counted: past the budget it returns `+∞` without calling `f`, and a
 /// NaN counts as `+∞`.
 struct Counted<'f> {
-    f: RefCell<&'f mut dyn FnMut(&[f64]) -> f64>,
+    f: RefCell<Function<'f>>,
     spent: Cell<usize>,
     budget: usize,
 }

@@ -674,7 +674,7 @@ fn stacked_condition(dynamics: &dyn Dynamics, base: &[usize], trajectory: &dyn J
     let (max, min) = s
         .iter()
         .fold((0.0f64, f64::INFINITY), |(hi, lo), &x| (hi.max(x), lo.min(x)));
-    if s.len() < nb || !(min > 0.0) {
+    if s.len() < nb || min.is_nan() || min <= 0.0 {
         f64::INFINITY
     } else {
         max / min

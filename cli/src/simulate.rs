@@ -153,7 +153,7 @@ pub struct SimulateArgs {
     /// Fourier: objective evaluations allowed to the optimiser (each one evaluates
     /// the regressor at 20·harmonics instants over one period, however many --steps
     /// are recorded). Default: 3000 up to 12 joints, then 3000·(12/n)², so that it
-    /// takes about as long on any robot: about a second for a 6-joint arm in a
+    /// takes about as long on any robot: under 2 s for a 6-joint arm in a
     /// release build, with a progress bar. Too few for one Nelder–Mead run (0, say; a
     /// run needs more than one evaluation per variable, 1 + 2·harmonics per joint)
     /// keep the random feasible start. At most 10000000.

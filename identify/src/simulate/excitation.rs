@@ -221,7 +221,7 @@ impl ExcitationDesign {
     /// The default number of objective evaluations for `n` joints: 3000 up to 12
     /// joints, then `3000 (12/n)²`, since one evaluation stacks `n` rows of `10 n`
     /// columns per sample and so costs about `n²`: the default takes about the same
-    /// time whatever the robot (about a second for a 6-joint arm in a release build).
+    /// time whatever the robot (under 2 s for a 6-joint arm in a release build).
     pub fn default_evaluations(n: usize) -> usize {
         if n <= 12 {
             3000

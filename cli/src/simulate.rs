@@ -5,8 +5,8 @@ use crate::error::CliError;
 use crate::ranges::per_joint;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
 use dyngen_identify::simulate::{
-    add_joint_terms, add_stribeck_terms, record, record_trajectory, Criterion, ExcitationDesign, Experiment, Logger,
-    Motion, NoiseModel,
+    add_joint_terms, add_stribeck_terms, record, record_trajectory, regressor_condition, Criterion, ExcitationDesign,
+    Experiment, Logger, Motion, NoiseModel,
 };
 use dyngen_identify::stribeck::Stribeck;
 use dyngen_model::joint_params::Coulomb;
@@ -30,8 +30,8 @@ pub enum ExperimentKind {
     /// within its limits (default 2 s in 100 steps).
     Paper,
     /// A finite Fourier series per joint (Swevers et al. 1997), coefficients
-    /// optimised (--criterion) within the joint position and velocity limits
-    /// (default one 10 s period in 100 steps).
+    /// optimised (--criterion) within the joint position, velocity and acceleration
+    /// limits (default one 10 s period in 100 steps).
     Fourier,
 }
 
@@ -151,12 +151,12 @@ pub struct SimulateArgs {
     pub base_frequency: f64,
 
     /// Fourier: objective evaluations allowed to the optimiser (each one evaluates
-    /// the regressor at every sample). Default: 3000 up to 12 joints, then 3000·(12/n)²,
-    /// so that it takes about as long on any robot: seconds for a 6-joint arm in a
-    /// release build, about 30 s (450 evaluations) for a 31-joint tree, with a
-    /// progress bar. Too few for one Nelder–Mead run (0, say; a run needs more than
-    /// one evaluation per variable, 1 + 2·harmonics per joint) keep the random feasible
-    /// start. At most 10000000.
+    /// the regressor at 20·harmonics instants over one period, however many --steps
+    /// are recorded). Default: 3000 up to 12 joints, then 3000·(12/n)², so that it
+    /// takes about as long on any robot: under 2 s for a 6-joint arm in a
+    /// release build, with a progress bar. Too few for one Nelder–Mead run (0, say; a
+    /// run needs more than one evaluation per variable, 1 + 2·harmonics per joint)
+    /// keep the random feasible start. At most 10000000.
     #[arg(long, value_parser = crate::ranges::EVALUATIONS)]
     pub evaluations: Option<usize>,
 
@@ -165,6 +165,12 @@ pub struct SimulateArgs {
     /// reproducible bound); 0 < s ≤ 1e6.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = crate::ranges::TIME_BUDGET)]
     pub time_budget: Option<f64>,
+
+    /// Fourier: joint acceleration limits (rad/s² or m/s², positive), one for all
+    /// joints or one per joint. Default: 5/s times each joint's velocity limit
+    /// (full speed from rest in 0.2 s), since URDF and MJCF give none.
+    #[arg(long, value_name = "A1,A2,…", allow_hyphen_values = true)]
+    pub max_acceleration: Option<String>,
 
     #[command(flatten)]
     pub gravity: ModelArgs,
@@ -213,22 +219,37 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             design.harmonics = args.harmonics;
             design.base_frequency = args.base_frequency;
             design.duration = args.duration.unwrap_or(1.0 / args.base_frequency);
-            design.samples = args.steps;
+            // A fixed design grid over one period, whatever --steps records (see
+            // ExcitationDesign::default_samples).
+            design.samples = ExcitationDesign::default_samples(args.harmonics);
+            if let Some(text) = &args.max_acceleration {
+                let limits = per_joint("--max-acceleration", text, model.dof())?;
+                if let Some(bad) = limits.iter().find(|&&a| a <= 0.0) {
+                    return Err(CliError::usage(format!(
+                        "--max-acceleration: {bad} is not a positive acceleration"
+                    )));
+                }
+                for (l, a) in design.limits.iter_mut().zip(limits) {
+                    l.acceleration = a;
+                }
+            }
             if let Some(n) = args.evaluations {
                 design.max_evaluations = n;
             }
             design.time_budget = args.time_budget.map(std::time::Duration::from_secs_f64);
             design.seed = args.seed;
             // A bar with the evaluations spent and the time left: one evaluation stacks
-            // the regressor at every sample, tens of milliseconds on a 30-joint tree.
+            // the regressor at every design sample, milliseconds on a 30-joint tree.
             let bar = progress.bar(design.max_evaluations as u64, "optimising the Fourier excitation");
             let found = design.optimise_with_progress(&robot, &mut |done| bar.set_position(done as u64));
             bar.finish_and_clear();
+            let found = found.map_err(CliError::failed)?;
             match found.criterion {
                 Criterion::JointTorques => eprintln!(
-                    "excitation: condition number of the base regressor {:.4e} (start {:.4e}, {} evaluations, {} base \
-                     columns)",
+                    "excitation: condition number of the base regressor {:.4e} on {} design samples (start {:.4e}, {} \
+                     evaluations, {} base columns)",
                     found.value,
+                    design.samples,
                     found.initial_value,
                     found.evaluations,
                     found.base_columns.len()
@@ -298,6 +319,16 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         Some(l) => record_trajectory(&robot, &params, &experiment.motion, &l.times(experiment.duration)),
         None => record(&robot, &params, &experiment),
     });
+    if let (Motion::Fourier(e), CriterionArg::Torques) = (&experiment.motion, args.criterion) {
+        // The design's samples stand for the recording: say how the recording itself
+        // is conditioned.
+        let times: Vec<f64> = clean.samples.iter().map(|s| s.t).collect();
+        eprintln!(
+            "excitation: condition number of the base regressor {:.4e} over the {} recorded samples",
+            regressor_condition(&robot, e, &times),
+            times.len()
+        );
+    }
     if joint_params.iter().any(|&x| x != 0.0) {
         add_joint_terms(&mut clean, &joint_params, Coulomb::Sign);
     }

@@ -213,6 +213,57 @@ fn paper_experiment_has_default_length() {
     assert_eq!(traj.t()[100], 2.0);
 }
 
+/// `--experiment fourier` designs on 20·harmonics samples of one period whatever
+/// `--steps` records, prints the condition number there and over the recording, and
+/// keeps the recorded accelerations within `--max-acceleration`; a limit that is not
+/// positive, or one per joint for the wrong number of joints, is a usage error.
+#[test]
+fn fourier_design_has_fixed_samples_and_limited_accelerations() {
+    let dir = temp_dir("dyngen-cli", "fourier");
+    let csv = dir.join("f.csv");
+    let o = run!(
+        "simulate",
+        ur5(),
+        "-o",
+        csv,
+        "--experiment",
+        "fourier",
+        "--steps",
+        "2000",
+        "--evaluations",
+        "100",
+        "--max-acceleration",
+        "2"
+    );
+    assert_ok(&o);
+    let err = stderr(&o);
+    assert!(err.contains("on 100 design samples"), "{err}");
+    assert!(err.contains("over the 2001 recorded samples"), "{err}");
+    let traj = dyngen_identify::data::read_csv(&csv, Some(6)).unwrap();
+    let a = traj.accelerations().unwrap();
+    let fastest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(fastest <= 2.0 && fastest > 0.2, "{fastest}");
+
+    for (value, needle) in [
+        ("0", "--max-acceleration: 0 is not a positive acceleration"),
+        ("1,2", "--max-acceleration: 2 values for 6 joints"),
+        ("nan", "--max-acceleration: `nan` is not a list of numbers"),
+    ] {
+        let o = run!(
+            "simulate",
+            ur5(),
+            "-o",
+            dir.join("g.csv"),
+            "--experiment",
+            "fourier",
+            "--max-acceleration",
+            value
+        );
+        assert_error(&o, needle);
+        assert_eq!(o.status.code(), Some(2));
+    }
+}
+
 #[test]
 fn bad_inputs_name_the_file_and_line() {
     let dir = temp_dir("dyngen-cli", "bad");

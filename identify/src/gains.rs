@@ -197,8 +197,7 @@ pub fn identify_gains(
     let start: Vec<f64> = w.iter().map(|w| w.abs().ln()).collect();
     let signs: Vec<f64> = w.iter().map(|w| w.signum()).collect();
     let to_w = |u: &[f64]| -> Vec<f64> { u.iter().zip(&signs).map(|(u, s)| s * u.exp()).collect() };
-    let mut evaluations = 0;
-    let best = crate::simulate::minimise(
+    let best = crate::minimise::minimise(
         &mut |u: &[f64]| {
             let w = to_w(u);
             match solve(&w) {
@@ -209,7 +208,7 @@ pub fn identify_gains(
         &start,
         &vec![1e-3; n],
         4000,
-        &mut evaluations,
+        None,
     );
     let last_change = best
         .x
@@ -218,7 +217,7 @@ pub fn identify_gains(
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     w = to_w(&best.x);
-    iterations += evaluations;
+    iterations += best.evaluations;
     let x = solve(&w)?;
     Ok(GainEstimate {
         initial,

@@ -46,6 +46,7 @@ mod error;
 mod estimate;
 mod least_squares;
 mod log_cholesky;
+mod minimise;
 mod principal;
 mod rls;
 mod standard;

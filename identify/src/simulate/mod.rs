@@ -32,12 +32,12 @@ mod experiment;
 mod integrate;
 mod logger;
 mod motion;
-mod nelder_mead;
-pub(crate) use nelder_mead::minimise;
 mod noise;
 
 pub use cardano::{cardano_angles, cardano_matrix, cardano_rate_matrix, cardano_rates};
-pub use excitation::{moment_sigma, Criterion, ExcitationDesign, JointLimits, OptimisedExcitation};
+pub use excitation::{
+    moment_sigma, regressor_condition, Criterion, ExcitationDesign, JointLimits, OptimisedExcitation,
+};
 pub use experiment::{record, record_trajectory, BodyMeasurement, Experiment, Motion, Recording, Sample};
 pub use integrate::{simulate_rk4, Simulation};
 pub use logger::{add_joint_terms, add_stribeck_terms, Logger};

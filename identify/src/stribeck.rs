@@ -514,7 +514,7 @@ fn linear_joint(v: &[f64], a: &[f64], target: &[f64], coulomb: Coulomb, c: Joint
     Some([x[0], x[1], x[2], x[3]])
 }
 
-/// The time blocks of [`held_out`]: each is scored with the models fitted on the others.
+/// The time blocks of `held_out`: each is scored with the models fitted on the others.
 pub const BLOCKS: usize = 4;
 
 /// A Stribeck term is kept only if it lowers the joint's held-out sum of squares by

@@ -4,28 +4,36 @@
 use super::experiment::{Recording, Sample};
 use dyngen_reference::SplitMix64;
 use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 
-/// Seeded standard normal draws: `rand_distr`'s ziggurat sampler over a ChaCha8
-/// stream seeded by [`SeedableRng::seed_from_u64`]. ChaCha8's stream for a seed is
-/// specified and portable, so a seed gives the same draws on every platform.
+/// Standard normal draws by the Box–Muller transform over [`SplitMix64`]: from two
+/// uniforms `u1 = 1 − U ∈ (0, 1]`, `u2 = U ∈ [0, 1)` (in that order),
+/// `z1 = √(−2 ln u1) cos 2πu2`, then `z2 = √(−2 ln u1) sin 2πu2` on the next call.
+/// The stream for a seed is fixed forever, like [`SplitMix64`]'s.
 #[derive(Clone, Debug)]
 pub struct Gaussian {
-    rng: ChaCha8Rng,
+    rng: SplitMix64,
+    spare: Option<f64>,
 }
 
 impl Gaussian {
     pub fn new(seed: u64) -> Gaussian {
         Gaussian {
-            rng: ChaCha8Rng::seed_from_u64(seed),
+            rng: SplitMix64::new(seed),
+            spare: None,
         }
     }
 
     /// One draw from `N(0, 1)`.
     pub fn standard(&mut self) -> f64 {
-        self.rng.sample(StandardNormal)
+        if let Some(z) = self.spare.take() {
+            return z;
+        }
+        let u1 = 1.0 - self.rng.next_f64();
+        let u2 = self.rng.next_f64();
+        let radius = (-2.0 * u1.ln()).sqrt();
+        let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
+        self.spare = Some(radius * s);
+        radius * c
     }
 
     /// One draw from `N(0, σ²)`.

@@ -423,8 +423,6 @@ enum Shape {
 /// to [`ALGORITHMS`] (and its method to its capability trait in `dyngen`).
 struct Algorithm {
     name: &'static str,
-    /// The capability trait it belongs to.
-    capability: Capability,
     /// Arguments in signature order.
     args: &'static [In],
     /// The name of the trait method's output slice.
@@ -445,6 +443,12 @@ struct Algorithm {
 const REGRESSOR_MAX_STATEMENTS: usize = 1200;
 
 impl Algorithm {
+    /// The capability trait it belongs to: the one whose functions name it.
+    fn capability(&self) -> Capability {
+        // ok: every ALGORITHMS name is a trait function (test `every_algorithm_has_a_capability`).
+        Capability::from_name(self.name).expect("an ALGORITHMS entry named after a trait function")
+    }
+
     fn max_statements(&self, options: &Options) -> usize {
         if self.name.ends_with("regressor") || self.name.ends_with("regressors") {
             options.max_statements.min(REGRESSOR_MAX_STATEMENTS)
@@ -461,7 +465,6 @@ const QVAP: &[In] = &[In::Q, In::V, In::A, In::Params];
 const ALGORITHMS: &[Algorithm] = &[
     Algorithm {
         name: "rnea",
-        capability: Capability::InverseDynamics,
         args: QVAP,
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -477,7 +480,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "nonlinear_effects",
-        capability: Capability::InverseDynamics,
         args: &[In::Q, In::V, In::Params],
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -497,7 +499,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "generalized_gravity",
-        capability: Capability::InverseDynamics,
         args: &[In::Q, In::Params],
         out: "tau",
         shape: Shape::Vector(Len::V),
@@ -512,7 +513,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "forward_kinematics",
-        capability: Capability::Kinematics,
         args: &[In::Q],
         out: "poses",
         shape: Shape::PerBody(Record::Pose),
@@ -531,7 +531,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_wrenches",
-        capability: Capability::InverseDynamics,
         args: QVAP,
         out: "wrenches",
         shape: Shape::PerBody(Record::Wrench),
@@ -545,7 +544,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "crba",
-        capability: Capability::MassMatrix,
         args: &[In::Q, In::Params],
         out: "m",
         shape: Shape::Matrix {
@@ -563,7 +561,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "aba",
-        capability: Capability::ForwardDynamics,
         args: &[In::Q, In::V, In::Tau, In::Params],
         out: "a",
         shape: Shape::Vector(Len::V),
@@ -583,7 +580,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_torque_regressor",
-        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -602,7 +598,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_regressor",
-        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -624,7 +619,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_regressor",
-        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -643,7 +637,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_base_regressor",
-        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -665,7 +658,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "joint_wrench_regressor",
-        capability: Capability::Regressors,
         args: QVA,
         out: "y",
         shape: Shape::Matrix {
@@ -684,7 +676,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "body_regressors",
-        capability: Capability::Regressors,
         args: QVA,
         out: "out",
         shape: Shape::PerBody(Record::BodyRegressor),
@@ -703,7 +694,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "body_resultants",
-        capability: Capability::Regressors,
         args: QVAP,
         out: "out",
         shape: Shape::PerBody(Record::Wrench),
@@ -718,7 +708,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_params",
-        capability: Capability::Regressors,
         args: &[In::Params],
         out: "beta",
         shape: Shape::Vector(Len::Base),
@@ -733,7 +722,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "principal_base_params",
-        capability: Capability::Regressors,
         args: &[In::Theta],
         out: "beta",
         shape: Shape::Vector(Len::PrincipalBase),
@@ -748,7 +736,6 @@ const ALGORITHMS: &[Algorithm] = &[
     },
     Algorithm {
         name: "base_params_joints",
-        capability: Capability::JointDynamics,
         args: &[In::Params, In::JointParams],
         out: "beta",
         shape: Shape::Vector(Len::BaseJoints),
@@ -954,8 +941,8 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     let mut bodies = Vec::new();
     // The capability traits' methods, by trait.
     let mut methods: Vec<(Capability, TokenStream)> = Vec::new();
-    for algorithm in ALGORITHMS.iter().filter(|a| selected.contains(a.capability)) {
-        methods.push((algorithm.capability, algorithm.trait_method(&ty, &sizes)));
+    for algorithm in ALGORITHMS.iter().filter(|a| selected.contains(a.capability())) {
+        methods.push((algorithm.capability(), algorithm.trait_method(&ty, &sizes)));
         if let Some(item) = composed(algorithm, model, &sizes, options.compose_above_nv) {
             items.push((algorithm.name.to_string(), item));
             continue;
@@ -1673,6 +1660,13 @@ fn robot_type(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_algorithm_has_a_capability() {
+        for algorithm in ALGORITHMS {
+            assert!(Capability::from_name(algorithm.name).is_some(), "{}", algorithm.name);
+        }
+    }
 
     /// A selection generates its groups (with what they are built from) and their
     /// traits only: `joint_dynamics` brings `rnea`, `crba` and the regressors it calls.

@@ -584,6 +584,27 @@ pub(crate) fn cores() -> usize {
     *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |t| t.get()))
 }
 
+/// `f(i)` for `i` in `0..n`, spread over the machine's cores (round robin), returned
+/// in index order; on one core (or for one item) without spawning a thread.
+pub(crate) fn in_parallel<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = cores().clamp(1, n.max(1));
+    if threads <= 1 {
+        return (0..n).map(f).collect();
+    }
+    let mut out: Vec<(usize, T)> = std::thread::scope(|s| {
+        let f = &f;
+        let handles: Vec<_> = (0..threads)
+            .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, f(j))).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    out.sort_by_key(|(j, _)| *j);
+    out.into_iter().map(|(_, x)| x).collect()
+}
+
 /// Folds the pending rows of every block, spreading the blocks over the machine's
 /// cores; each block's result does not depend on which thread folds it.
 fn fold_all(mut blocks: Vec<&mut Block>, accumulation: Accumulation, parallel: bool) {

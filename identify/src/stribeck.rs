@@ -778,7 +778,7 @@ pub fn refine<E>(
     // Which joints earn the term, on at most ROUND_SAMPLES samples spread over the
     // recording (in parallel).
     let stride = traj.len().div_ceil(ROUND_SAMPLES).max(1);
-    let mut choices = in_parallel(n, |j| {
+    let mut choices = crate::accumulate::in_parallel(n, |j| {
         let pick = |x: &[f64]| -> Vec<f64> { x.iter().step_by(stride).copied().collect() };
         let target: Vec<f64> = (0..traj.len())
             .step_by(stride)
@@ -911,23 +911,6 @@ fn choose(
         held_out: Some(rms),
         reason: "it lowers the held-out error".into(),
     }
-}
-
-/// `f(j)` for every joint, in parallel, in joint order.
-fn in_parallel<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let threads = crate::accumulate::cores().clamp(1, n.max(1));
-    let mut out: Vec<(usize, T)> = std::thread::scope(|s| {
-        let f = &f;
-        let handles: Vec<_> = (0..threads)
-            .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, f(j))).collect::<Vec<_>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    out.sort_by_key(|(j, _)| *j);
-    out.into_iter().map(|(_, x)| x).collect()
 }
 
 /// Per joint a Stribeck term without effect (`Fs = Fc` of `x`), `vs` inside its range.
@@ -1150,7 +1133,7 @@ fn rounds<E>(
         let before = state.cost;
         // (1) Every joint with the term on its own (in parallel), the rigid-body
         // torques held; the others as they are, without it.
-        let fits = in_parallel(n, |j| {
+        let fits = crate::accumulate::in_parallel(n, |j| {
             let target: Vec<f64> = (0..len).map(|k| columns.tau[j][k] - state.rigid[k * n + j]).collect();
             let linear = joint_linear(&state.estimate.solution, n, j);
             match (setup.allowed[j], setup.ranges[j]) {

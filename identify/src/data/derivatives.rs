@@ -384,23 +384,7 @@ fn per_column(
     dof: usize,
     f: impl Fn(usize) -> Result<Vec<f64>, DataError> + Sync,
 ) -> Result<Vec<f64>, DataError> {
-    let threads = crate::accumulate::cores().clamp(1, dof.max(1));
-    let columns: Vec<Result<Vec<f64>, DataError>> = if threads <= 1 {
-        (0..dof).map(&f).collect()
-    } else {
-        let f = &f;
-        let mut done: Vec<(usize, Result<Vec<f64>, DataError>)> = std::thread::scope(|s| {
-            let handles: Vec<_> = (0..threads)
-                .map(|t| s.spawn(move || (t..dof).step_by(threads).map(|j| (j, f(j))).collect::<Vec<_>>()))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .collect()
-        });
-        done.sort_by_key(|(j, _)| *j);
-        done.into_iter().map(|(_, c)| c).collect()
-    };
+    let columns = crate::accumulate::in_parallel(dof, f);
     let mut out = vec![0.0; len * dof];
     for (j, c) in columns.into_iter().enumerate() {
         set_column(&mut out, dof, j, &c?);

@@ -108,7 +108,7 @@
 //! # Ok::<(), ConfigurationError>(())
 //! ```
 
-use crate::{JointType, RobotModel, Scalar};
+use crate::{JointType, OrderedScalar, RobotModel};
 use core::fmt;
 use nalgebra::Matrix3;
 
@@ -182,7 +182,12 @@ impl std::error::Error for ConfigurationError {}
 /// [`ConfigurationError::Length`] when `q` or `out` does not have `nq` entries or `v`
 /// does not have `nv`; [`ConfigurationError::NonFinite`] for the first joint whose
 /// result is not finite (the content of `out` is then unspecified).
-pub fn integrate<S: Scalar>(model: &RobotModel, q: &[S], v: &[S], out: &mut [S]) -> Result<(), ConfigurationError> {
+pub fn integrate<S: OrderedScalar>(
+    model: &RobotModel,
+    q: &[S],
+    v: &[S],
+    out: &mut [S],
+) -> Result<(), ConfigurationError> {
     let (nq, nv) = dimensions(model);
     check_length("q", q.len(), nq)?;
     check_length("v", v.len(), nv)?;
@@ -257,7 +262,12 @@ pub fn integrate<S: Scalar>(model: &RobotModel, q: &[S], v: &[S], out: &mut [S])
 /// [`ConfigurationError::Length`] when `q0` or `q1` does not have `nq` entries or
 /// `out` does not have `nv`; [`ConfigurationError::NonFinite`] for the first joint
 /// whose result is not finite (the content of `out` is then unspecified).
-pub fn difference<S: Scalar>(model: &RobotModel, q0: &[S], q1: &[S], out: &mut [S]) -> Result<(), ConfigurationError> {
+pub fn difference<S: OrderedScalar>(
+    model: &RobotModel,
+    q0: &[S],
+    q1: &[S],
+    out: &mut [S],
+) -> Result<(), ConfigurationError> {
     let (nq, nv) = dimensions(model);
     check_length("q0", q0.len(), nq)?;
     check_length("q1", q1.len(), nq)?;
@@ -311,7 +321,7 @@ pub fn difference<S: Scalar>(model: &RobotModel, q0: &[S], q1: &[S], out: &mut [
 /// # Errors
 ///
 /// [`ConfigurationError::Length`] when `out` does not have `nq` entries.
-pub fn neutral<S: Scalar>(model: &RobotModel, out: &mut [S]) -> Result<(), ConfigurationError> {
+pub fn neutral<S: OrderedScalar>(model: &RobotModel, out: &mut [S]) -> Result<(), ConfigurationError> {
     let (nq, _) = dimensions(model);
     check_length("out", out.len(), nq)?;
     let mut iq = 0;
@@ -338,7 +348,7 @@ pub fn neutral<S: Scalar>(model: &RobotModel, out: &mut [S]) -> Result<(), Confi
 /// [`ConfigurationError::NonFinite`] for the first joint with a zero quaternion or a
 /// non-finite coordinate. Its quaternion is left as it was, as are the joints after
 /// it; the joints before it are normalised.
-pub fn normalize<S: Scalar>(model: &RobotModel, q: &mut [S]) -> Result<(), ConfigurationError> {
+pub fn normalize<S: OrderedScalar>(model: &RobotModel, q: &mut [S]) -> Result<(), ConfigurationError> {
     let (nq, _) = dimensions(model);
     check_length("q", q.len(), nq)?;
     let mut iq = 0;
@@ -371,7 +381,7 @@ pub fn normalize<S: Scalar>(model: &RobotModel, q: &mut [S]) -> Result<(), Confi
 /// `R` rotates vectors of the child frame into the parent frame
 /// (`x_parent = R x_child`). For a unit quaternion it is a rotation; the quaternion is
 /// not normalised here (as Eigen).
-pub fn quaternion_to_matrix<S: Scalar>(q: [S; 4]) -> Matrix3<S> {
+pub fn quaternion_to_matrix<S: OrderedScalar>(q: [S; 4]) -> Matrix3<S> {
     let [x, y, z, w] = q;
     let two = S::from_f64(2.0);
     let (tx, ty, tz) = (two * x, two * y, two * z);
@@ -401,7 +411,7 @@ pub fn quaternion_to_matrix<S: Scalar>(q: [S; 4]) -> Matrix3<S> {
 /// `z = (R₁₀ − R₀₁)/(4w)`. Accurate at every angle; the inverse of
 /// [`quaternion_to_matrix`] for a rotation `r` (for another matrix the result is
 /// meaningless, possibly NaN, but nothing panics).
-pub fn matrix_to_quaternion<S: Scalar>(r: &Matrix3<S>) -> [S; 4] {
+pub fn matrix_to_quaternion<S: OrderedScalar>(r: &Matrix3<S>) -> [S; 4] {
     let (one, quarter) = (S::ONE, S::from_f64(0.25));
     let two = S::from_f64(2.0);
     let (r00, r11, r22) = (r[(0, 0)], r[(1, 1)], r[(2, 2)]);
@@ -467,8 +477,8 @@ fn check_length(argument: &'static str, found: usize, expected: usize) -> Result
 }
 
 /// Joint `j` (0-based index into `model.joints`) is finite, or its error.
-fn check_finite<S: Scalar>(x: &[S], j: usize, model: &RobotModel) -> Result<(), ConfigurationError> {
-    if x.iter().all(|x| x.to_f64().is_finite()) {
+fn check_finite<S: OrderedScalar>(x: &[S], j: usize, model: &RobotModel) -> Result<(), ConfigurationError> {
+    if x.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
         Err(ConfigurationError::NonFinite {
@@ -478,7 +488,7 @@ fn check_finite<S: Scalar>(x: &[S], j: usize, model: &RobotModel) -> Result<(), 
     }
 }
 
-fn cross<S: Scalar>(a: [S; 3], b: [S; 3]) -> [S; 3] {
+fn cross<S: OrderedScalar>(a: [S; 3], b: [S; 3]) -> [S; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -486,16 +496,16 @@ fn cross<S: Scalar>(a: [S; 3], b: [S; 3]) -> [S; 3] {
     ]
 }
 
-fn dot4<S: Scalar>(a: [S; 4], b: [S; 4]) -> S {
+fn dot4<S: OrderedScalar>(a: [S; 4], b: [S; 4]) -> S {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
 }
 
-fn conjugate<S: Scalar>(q: [S; 4]) -> [S; 4] {
+fn conjugate<S: OrderedScalar>(q: [S; 4]) -> [S; 4] {
     [-q[0], -q[1], -q[2], q[3]]
 }
 
 /// The Hamilton product `a ⊗ b` (rotation `R(a) R(b)`), in Eigen's operation order.
-fn quat_mul<S: Scalar>(a: [S; 4], b: [S; 4]) -> [S; 4] {
+fn quat_mul<S: OrderedScalar>(a: [S; 4], b: [S; 4]) -> [S; 4] {
     let ([ax, ay, az, aw], [bx, by, bz, bw]) = (a, b);
     [
         aw * bx + ax * bw + ay * bz - az * by,
@@ -506,7 +516,7 @@ fn quat_mul<S: Scalar>(a: [S; 4], b: [S; 4]) -> [S; 4] {
 }
 
 /// `R(q) v` for a unit quaternion, as Eigen: `t = 2 q_xyz × v`, `v + w t + q_xyz × t`.
-fn rotate<S: Scalar>(q: [S; 4], v: [S; 3]) -> [S; 3] {
+fn rotate<S: OrderedScalar>(q: [S; 4], v: [S; 3]) -> [S; 3] {
     let u = [q[0], q[1], q[2]];
     let t = cross(u, v).map(|x| x + x);
     let ut = cross(u, t);
@@ -516,9 +526,9 @@ fn rotate<S: Scalar>(q: [S; 4], v: [S; 3]) -> [S; 3] {
 /// `q / |q|`; NaN for a zero or non-finite quaternion. The norm is taken directly when
 /// `|q|²` is a normal number, else after scaling by the largest component (no
 /// overflow or underflow for any finite non-zero `q`).
-fn normalized<S: Scalar>(q: [S; 4]) -> [S; 4] {
+fn normalized<S: OrderedScalar>(q: [S; 4]) -> [S; 4] {
     let n2 = dot4(q, q);
-    if n2 >= S::from_f64(1e-30) && n2.to_f64().is_finite() {
+    if n2 >= S::from_f64(1e-30) && n2.is_finite() {
         let n = n2.sqrt();
         return q.map(|x| x / n);
     }
@@ -533,7 +543,7 @@ fn normalized<S: Scalar>(q: [S; 4]) -> [S; 4] {
 /// The coefficients `(a, b) = (sin ω / ω, (1 − cos ω)/ω)` of the planar joint's
 /// `V(ω) = [[a, −b], [b, a]]`, from the half angle, by Taylor series below
 /// `|ω| = 10⁻²` (exact to rounding there).
-fn planar_v<S: Scalar>(w: S) -> (S, S) {
+fn planar_v<S: OrderedScalar>(w: S) -> (S, S) {
     let c = S::from_f64;
     let w2 = w * w;
     if w < c(1e-2) && w > c(-1e-2) {
@@ -550,7 +560,7 @@ fn planar_v<S: Scalar>(w: S) -> (S, S) {
 
 /// `α = (ω/2) cot(ω/2)`, the diagonal of the planar joint's `V(ω)⁻¹`, by Taylor series
 /// below `|ω| = 10⁻²`.
-fn planar_v_inverse<S: Scalar>(w: S) -> S {
+fn planar_v_inverse<S: OrderedScalar>(w: S) -> S {
     let c = S::from_f64;
     let w2 = w * w;
     if w < c(1e-2) && w > c(-1e-2) {
@@ -564,7 +574,7 @@ fn planar_v_inverse<S: Scalar>(w: S) -> S {
 /// `exp(ω)` as a unit quaternion `[sin(θ/2) ω/θ, cos(θ/2)]`, and the coefficients
 /// `a = (1 − cos θ)/θ²`, `b = (θ − sin θ)/θ³` of `V(ω)`, all by Taylor series below
 /// `θ = 10⁻²` (exact to rounding there).
-fn exp_so3<S: Scalar>(w: [S; 3]) -> ([S; 4], S, S) {
+fn exp_so3<S: OrderedScalar>(w: [S; 3]) -> ([S; 4], S, S) {
     let t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
     let t = t2.sqrt();
     let (sh, ch) = (S::from_f64(0.5) * t).sin_cos();
@@ -586,7 +596,7 @@ fn exp_so3<S: Scalar>(w: [S; 3]) -> ([S; 4], S, S) {
 /// `log(r)` of a unit quaternion on its `w ≥ 0` side, `|ω| = θ ∈ [0, π]`, and the
 /// coefficient `β = (1 − (θ/2) cot(θ/2))/θ²` of `[ω]×²` in `V(ω)⁻¹` (Taylor series
 /// below `θ = 10⁻²`).
-fn log_so3<S: Scalar>(r: [S; 4]) -> ([S; 3], S) {
+fn log_so3<S: OrderedScalar>(r: [S; 4]) -> ([S; 3], S) {
     let c = S::from_f64;
     let (v, w) = ([r[0], r[1], r[2]], r[3]);
     let (v, w) = if w < S::ZERO { (v.map(|x| -x), -w) } else { (v, w) };

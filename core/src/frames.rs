@@ -3,7 +3,7 @@
 //! everything `LOCAL_WORLD_ALIGNED` (at the frame origin, world axes); the other two
 //! reference frames follow from the frame's placement in a few products.
 
-use crate::{Pose, Scalar};
+use crate::{OrderedScalar, Pose, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// In which frame a velocity, an acceleration or a Jacobian is expressed, as
@@ -270,7 +270,7 @@ impl<S: Scalar> FrameMotion<S> {
 /// (Pinocchio's `log3`), accurate to rounding at every angle: the angle from `atan2`
 /// (an `acos` of the trace loses half the digits near 0), and near π, where the skew
 /// part vanishes, the axis from the symmetric part.
-pub fn log3<S: Scalar>(r: &Matrix3<S>) -> Vector3<S> {
+pub fn log3<S: OrderedScalar>(r: &Matrix3<S>) -> Vector3<S> {
     let half = S::from_f64(0.5);
     // Rodrigues: r = c E + s [a]× + (1 − c) a aᵀ, so the skew part is 2 s a.
     let skew = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
@@ -313,7 +313,9 @@ impl<S: Scalar> Pose<S> {
             translation: Vector3::from_element(z),
         }
     }
+}
 
+impl<S: OrderedScalar> Pose<S> {
     /// The error from `self` to `target` as a world-aligned twist,
     /// `[p_target − p; log3(R_target Rᵀ)]`: what carries `self` onto `target` in unit
     /// time to first order, so that `J_lwa Δq = error` is the Newton step of inverse

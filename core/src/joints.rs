@@ -19,7 +19,7 @@
 //! assert_eq!(row, [2.0, 0.5, 1.0, 1.0]);
 //! ```
 
-use crate::Scalar;
+use crate::{OrderedScalar, Scalar};
 
 /// Joint parameters per joint: `[Ia, Fv, Fc, F0]`.
 pub const JOINT_PARAMS_PER_JOINT: usize = 4;
@@ -50,45 +50,39 @@ impl core::fmt::Display for InvalidEpsilon {
     }
 }
 
-impl<S: Scalar> Coulomb<S> {
+impl<S: OrderedScalar> Coulomb<S> {
     /// `Coulomb::Smooth { epsilon }`, or an error naming `epsilon` when it is not
     /// positive and finite.
     pub fn smooth(epsilon: S) -> Result<Coulomb<S>, InvalidEpsilon> {
-        let e = epsilon.to_f64();
-        if e.is_finite() && e > 0.0 {
+        if epsilon.is_finite() && epsilon > S::ZERO {
             Ok(Coulomb::Smooth { epsilon })
         } else {
-            Err(InvalidEpsilon(e))
+            Err(InvalidEpsilon(epsilon.to_f64()))
         }
     }
+}
 
+impl<S: Scalar> Coulomb<S> {
     /// `c'(q̇)`, the slope of the model: 0 for `sign` (away from `q̇ = 0`),
-    /// `(1 − tanh²(q̇/ε)) / ε` for the smooth model.
+    /// `(1 − tanh²(q̇/ε)) / ε` for the smooth model (0 where `ε` is not positive).
     #[inline]
     pub fn slope(self, v: S) -> S {
         match self {
-            Coulomb::Smooth { epsilon } if epsilon > S::ZERO => {
+            Coulomb::Smooth { epsilon } => {
                 let t = (v / epsilon).tanh();
-                (S::ONE - t * t) / epsilon
+                epsilon.select_positive((S::ONE - t * t) / epsilon, S::ZERO)
             }
-            _ => S::ZERO,
+            Coulomb::Sign => S::ZERO,
         }
     }
 
-    /// `c(q̇)`: `sign(q̇)` or `tanh(q̇/ε)`.
+    /// `c(q̇)`: `sign(q̇)` (NaN for NaN) or `tanh(q̇/ε)` (`sign` where `ε` is not
+    /// positive).
     #[inline]
     pub fn eval(self, v: S) -> S {
         match self {
-            Coulomb::Smooth { epsilon } if epsilon > S::ZERO => (v / epsilon).tanh(),
-            _ => {
-                if v > S::ZERO {
-                    S::ONE
-                } else if v < S::ZERO {
-                    -S::ONE
-                } else {
-                    S::ZERO
-                }
-            }
+            Coulomb::Smooth { epsilon } => epsilon.select_positive((v / epsilon).tanh(), v.sign()),
+            Coulomb::Sign => v.sign(),
         }
     }
 }

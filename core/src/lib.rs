@@ -26,10 +26,14 @@ extern crate std;
 #[cfg(not(any(feature = "std", feature = "libm")))]
 compile_error!("dyngen needs the `std` feature or the `libm` feature for sin, cos, sqrt and tanh");
 
+#[cfg(feature = "batch")]
+pub mod batch;
 pub mod configuration;
 mod derivatives;
 mod frames;
 mod joints;
+#[cfg(feature = "batch")]
+pub mod lanes;
 mod robot;
 mod robot_model;
 mod scalar;
@@ -45,7 +49,7 @@ pub use robot::{
     MassMatrix, OpCount, Pose, Regressors, Robot, RobotDescription, Wrench,
 };
 pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
-pub use scalar::Scalar;
+pub use scalar::{OrderedScalar, Scalar};
 
 /// The traits a generated robot implements, to bring their methods into scope at
 /// once: `use dyngen::prelude::*;`.

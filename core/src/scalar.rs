@@ -1,6 +1,13 @@
 //! The scalar type generated code computes in. Generated functions are generic over
-//! [`Scalar`]; `f64` is the reference, `f32` suits microcontrollers and SIMD-friendly
-//! control loops.
+//! [`Scalar`]; `f64` is the reference, `f32` suits microcontrollers, and a lane type
+//! (feature `batch`: [`crate::batch`]) computes several states in one call.
+//!
+//! [`Scalar`] has no order: a lane type holds several numbers, and code that branched
+//! on a value would take one branch for all of them. Generated code never branches on a
+//! value; what must (the friction sign, a guard) uses the lane-wise [`Scalar::sign`] and
+//! [`Scalar::select_positive`]. Code that needs the order of one number (the maps of
+//! [`crate::configuration`], [`crate::log3`], [`crate::Coulomb::smooth`]) asks for
+//! [`OrderedScalar`], which `f64` and `f32` are.
 
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -9,7 +16,6 @@ use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 pub trait Scalar:
     Copy
     + PartialEq
-    + PartialOrd
     + Debug
     + Default
     + Send
@@ -27,9 +33,9 @@ pub trait Scalar:
 {
     const ZERO: Self;
     const ONE: Self;
-    /// Converts a constant of the generated code (rounding for narrower types).
+    /// Converts a constant of the generated code (rounding for narrower types; the
+    /// same in every lane of a lane type).
     fn from_f64(x: f64) -> Self;
-    fn to_f64(self) -> f64;
     fn sin(self) -> Self;
     fn cos(self) -> Self;
     /// Both at once: one call where the platform computes them together.
@@ -51,6 +57,22 @@ pub trait Scalar:
     fn mul_add(self, a: Self, b: Self) -> Self {
         self * a + b
     }
+    /// `|self|`.
+    fn abs(self) -> Self;
+    /// `−1`, `0` or `1` by the sign of `self` (`+0` for `±0`, NaN for NaN), lane by lane.
+    fn sign(self) -> Self;
+    /// `a` where `self > 0` and `b` elsewhere (NaN included), lane by lane. Both
+    /// `a` and `b` are computed.
+    fn select_positive(self, a: Self, b: Self) -> Self;
+    /// Whether the value is finite (every lane of a lane type).
+    fn is_finite(self) -> bool;
+}
+
+/// A [`Scalar`] holding one number: ordered, and convertible to `f64`. `f64` and
+/// `f32` are; lane types are not. What branches on a value asks for it.
+pub trait OrderedScalar: Scalar + PartialOrd {
+    /// The value as an `f64` (exact for `f32`).
+    fn to_f64(self) -> f64;
 }
 
 macro_rules! impl_scalar {
@@ -61,10 +83,6 @@ macro_rules! impl_scalar {
             #[inline(always)]
             fn from_f64(x: f64) -> Self {
                 x as $t
-            }
-            #[inline(always)]
-            fn to_f64(self) -> f64 {
-                self as f64
             }
             #[inline(always)]
             fn sin(self) -> Self {
@@ -100,6 +118,41 @@ macro_rules! impl_scalar {
                 {
                     self * a + b
                 }
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                num_traits::Float::abs(self)
+            }
+            #[inline(always)]
+            fn sign(self) -> Self {
+                if self > 0.0 {
+                    1.0
+                } else if self < 0.0 {
+                    -1.0
+                } else if self == 0.0 {
+                    0.0
+                } else {
+                    self
+                }
+            }
+            #[inline(always)]
+            fn select_positive(self, a: Self, b: Self) -> Self {
+                if self > 0.0 {
+                    a
+                } else {
+                    b
+                }
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                num_traits::Float::is_finite(self)
+            }
+        }
+
+        impl OrderedScalar for $t {
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
             }
         }
     };

@@ -490,20 +490,34 @@ impl<'a, E: Copy> View<'a, E> {
     }
 
     /// Value `i` of the states `k..k + count` into `lanes[i]`, the last state
-    /// repeated to fill the lanes.
-    fn gather<L: Lanes<Elem = E>>(&self, k: usize, count: usize, scratch: &mut [E], lanes: &mut [L]) {
-        for (i, lane) in lanes.iter_mut().enumerate() {
-            match self {
-                View::Columns(rows) if count == L::LANES => *lane = L::from_lanes(&rows[i][k..k + count]),
-                _ => {
-                    for (j, s) in scratch.iter_mut().enumerate() {
-                        let state = k + j.min(count - 1);
-                        *s = match self {
-                            View::Rows(data, width) => data[state * width + i],
-                            View::Columns(rows) => rows[i][state],
-                        };
+    /// repeated to fill the lanes. `tile`: `width × LANES` values of room.
+    fn gather<L: Lanes<Elem = E>>(&self, k: usize, count: usize, tile: &mut [E], lanes: &mut [L]) {
+        let n = L::LANES;
+        match self {
+            View::Columns(rows) if count == n => {
+                for (lane, row) in lanes.iter_mut().zip(rows) {
+                    *lane = L::from_lanes(&row[k..k + n]);
+                }
+            }
+            View::Columns(rows) => {
+                for (lane, row) in lanes.iter_mut().zip(rows) {
+                    let tile = &mut tile[..n];
+                    for (j, t) in tile.iter_mut().enumerate() {
+                        *t = row[k + j.min(count - 1)];
                     }
-                    *lane = L::from_lanes(scratch);
+                    *lane = L::from_lanes(tile);
+                }
+            }
+            View::Rows(data, width) => {
+                // The states' rows, read in order, into a tile of one lane group per value.
+                for j in 0..n {
+                    let state = k + j.min(count - 1);
+                    for (i, &x) in data[state * width..(state + 1) * width].iter().enumerate() {
+                        tile[i * n + j] = x;
+                    }
+                }
+                for (lane, tile) in lanes.iter_mut().zip(tile.chunks_exact(n)) {
+                    *lane = L::from_lanes(tile);
                 }
             }
         }
@@ -571,37 +585,61 @@ impl<'a, E: OrderedScalar> ViewMut<'a, E> {
 
     /// `lanes` (value `i` in `lanes[i]`) into the states `k..k + count`; the first
     /// state with a non-finite value is an error (`offset`: the thread's first state).
+    /// `tile`: `width × LANES` values of room.
     fn scatter<L: Lanes<Elem = E>>(
         &mut self,
         k: usize,
         count: usize,
         offset: usize,
-        scratch: &mut [E],
+        tile: &mut [E],
         lanes: &[L],
     ) -> Result<(), BatchError> {
-        let mut bad = None::<usize>;
-        let name = match self {
-            ViewMut::Rows { name, .. } | ViewMut::Columns { name, .. } => *name,
-        };
-        for (i, lane) in lanes.iter().enumerate() {
-            lane.write_lanes(scratch);
-            for (j, &x) in scratch[..count].iter().enumerate() {
-                if !x.is_finite() {
-                    bad = Some(bad.map_or(j, |b| b.min(j)));
+        let n = L::LANES;
+        match self {
+            ViewMut::Columns { rows, .. } if count == n => {
+                for (lane, row) in lanes.iter().zip(rows.iter_mut()) {
+                    lane.write_lanes(&mut row[k..k + n]);
                 }
-                match self {
-                    ViewMut::Rows { data, width, .. } => data[(k + j) * *width + i] = x,
-                    ViewMut::Columns { rows, .. } => rows[i][k + j] = x,
+            }
+            ViewMut::Columns { rows, .. } => {
+                for (lane, row) in lanes.iter().zip(rows.iter_mut()) {
+                    lane.write_lanes(&mut tile[..n]);
+                    row[k..k + count].copy_from_slice(&tile[..count]);
+                }
+            }
+            ViewMut::Rows { data, width, .. } => {
+                for (lane, tile) in lanes.iter().zip(tile.chunks_exact_mut(n)) {
+                    lane.write_lanes(tile);
+                }
+                for j in 0..count {
+                    let state = k + j;
+                    for (i, x) in data[state * *width..(state + 1) * *width].iter_mut().enumerate() {
+                        *x = tile[i * n + j];
+                    }
                 }
             }
         }
-        match bad {
-            None => Ok(()),
-            Some(j) => Err(BatchError::NonFinite {
-                output: name,
-                state: offset + k + j,
-            }),
+        // The padding lanes repeat the last state, so every lane is finite exactly
+        // when every state is; only then is each state looked at.
+        if lanes.iter().all(|x| x.is_finite()) {
+            return Ok(());
         }
+        let mut scratch = vec![E::ZERO; n];
+        let first = (0..count)
+            .find(|&j| {
+                lanes.iter().any(|lane| {
+                    lane.write_lanes(&mut scratch[..n]);
+                    !scratch[j].is_finite()
+                })
+            })
+            .unwrap_or(0);
+        let output = match self {
+            ViewMut::Rows { name, .. } | ViewMut::Columns { name, .. } => *name,
+        };
+        Err(BatchError::NonFinite {
+            output,
+            state: offset + k + first,
+        })
     }
 }
 
@@ -618,19 +656,20 @@ where
     F: Fn(&mut T, &[Vec<L>], &mut [Vec<L>]),
 {
     let mut state = init();
-    let mut scratch = vec![L::Elem::ZERO; L::LANES];
     let mut x: Vec<Vec<L>> = inputs.iter().map(|v| vec![L::ZERO; v.width()]).collect();
     let mut y: Vec<Vec<L>> = outputs.iter().map(|v| vec![L::ZERO; v.width()]).collect();
+    let widest = inputs.iter().map(View::width).chain(outputs.iter().map(ViewMut::width)).max();
+    let mut tile = vec![L::Elem::ZERO; widest.unwrap_or(0) * L::LANES];
     let n = end - start;
     let mut k = 0;
     while k < n {
         let count = L::LANES.min(n - k);
         for (view, lanes) in inputs.iter().zip(&mut x) {
-            view.gather(k, count, &mut scratch, lanes);
+            view.gather(k, count, &mut tile, lanes);
         }
         kernel(&mut state, &x, &mut y);
         for (view, lanes) in outputs.iter_mut().zip(&y) {
-            view.scatter(k, count, start, &mut scratch, lanes)?;
+            view.scatter(k, count, start, &mut tile, lanes)?;
         }
         k += count;
     }

@@ -183,12 +183,12 @@ macro_rules! lanes {
             }
             #[inline(always)]
             fn select_positive(self, a: Self, b: Self) -> Self {
-                let (s, a, b) = (self.to_array(), a.to_array(), b.to_array());
-                Self::new(core::array::from_fn(|i| s[i].select_positive(a[i], b[i])))
+                // NaN > 0 is false in every lane, as in the scalar.
+                $name(self.0.simd_gt(wide::$wide::ZERO).select(a.0, b.0))
             }
             #[inline(always)]
             fn is_finite(self) -> bool {
-                self.to_array().iter().all(|x| x.is_finite())
+                self.0.is_finite().all()
             }
         }
 

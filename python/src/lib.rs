@@ -430,9 +430,14 @@ impl PyModel {
         };
         let max_threads = self.max_threads;
         let result = py.detach(|| {
-            // The core count is read once per call.
-            let cores = max_threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-            let threads = cores.min(rows / MIN_ROWS_PER_THREAD).max(1);
+            // The core count is read once per call, and only for a batch that can be
+            // split (`available_parallelism` reads the cgroup's quota: microseconds).
+            let threads = if rows < 2 * MIN_ROWS_PER_THREAD || max_threads == Some(1) {
+                1
+            } else {
+                let cores = max_threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+                cores.min(rows / MIN_ROWS_PER_THREAD).max(1)
+            };
             if threads == 1 {
                 let mut ws = self.take_workspace();
                 let out = run_chunk(&mut ws, 0, rows, &inputs, slices, widths, &kernel);

@@ -12,8 +12,11 @@ large. Conventions are Pinocchio's: spatial vectors ``[linear; angular]``, stand
 parameters per body ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``, a free
 flyer's quaternion ``[x, y, z, w]``; but a continuous joint has one coordinate, its
 angle, where Pinocchio has ``(cos, sin)``.
+
+:func:`identify` runs the identification of ``dyngen identify`` on a recording and
+returns its estimate as a dict of numpy arrays.
 """
 
-from ._dyngen import LoadError, Model, __version__, load
+from ._dyngen import LoadError, Model, __version__, identify, load
 
-__all__ = ["LoadError", "Model", "__version__", "load"]
+__all__ = ["LoadError", "Model", "__version__", "identify", "load"]

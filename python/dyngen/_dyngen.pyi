@@ -1,7 +1,7 @@
 """Type stubs of the native module ``dyngen._dyngen``."""
 
 import os
-from typing import List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -22,6 +22,28 @@ def load(path: Union[str, "os.PathLike[str]"], free_flyer: bool = False, strict:
     ``free_flyer`` puts the root link on a free flyer (7 more positions
     ``[x, y, z, qx, qy, qz, qw]``, 6 more velocities); ``strict`` refuses what is
     otherwise loaded with a warning. Raises :class:`LoadError`."""
+
+def identify(
+    robot_path: Union[str, "os.PathLike[str]"],
+    data_path: Union[str, "os.PathLike[str]"],
+    *,
+    mode: str = "standard",
+    method: str = "ols",
+    friction: str = "none",
+    epsilon: float = 0.01,
+    ridge_lambda: float = 1e-6,
+    cutoff: float = 10.0,
+    raw_states: bool = False,
+    recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Dict[str, Any]:
+    """Identifies the robot's inertial parameters from a recording, as ``dyngen
+    identify`` does: ``mode`` ``"standard"``, ``"principal"`` or ``"mim"``; ``method``
+    ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
+    ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
+    ``"stribeck-smooth"``. Returns ``names``, ``values``, ``sigma``,
+    ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,
+    ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
+    ``warnings``. Raises :class:`LoadError` or ``ValueError``."""
 
 class Model:
     """A robot loaded by :func:`load` and the rigid-body algorithms on it.

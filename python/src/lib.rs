@@ -8,7 +8,9 @@
 //! evaluation runs with the GIL released, a large batch split across threads
 //! (`std::thread::scope`), each thread with its own [`Workspace`], so that no state
 //! allocates. Bad input raises a Python exception naming the argument and, for a
-//! batch, the row.
+//! batch, the row. `identify` runs the identification pipeline of `dyngen identify`.
+
+mod identify;
 
 use dyngen_algo::{Multibody, ReferenceFrame, Se3, Workspace, PARAMS_PER_BODY};
 use dyngen_model::{LoadOptions, Model};
@@ -1093,6 +1095,7 @@ impl PyModel {
 #[pymodule]
 fn _dyngen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
     m.add_class::<PyModel>()?;
     m.add("LoadError", m.py().get_type::<LoadError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

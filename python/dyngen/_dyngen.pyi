@@ -1,0 +1,120 @@
+"""Type stubs of the native module ``dyngen._dyngen``."""
+
+import os
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+Array = npt.NDArray[np.float64]
+Reference = str  # "local_world_aligned" | "local" | "world"
+
+class LoadError(ValueError):
+    """A robot description that does not load; the message is dyngen-model's, every
+    error as ``file:line: message``."""
+
+def load(path: Union[str, "os.PathLike[str]"], free_flyer: bool = False, strict: bool = False) -> Model:
+    """Loads a URDF, or MJCF for a file ending in ``.xml`` or ``.mjcf``.
+
+    ``free_flyer`` puts the root link on a free flyer (7 more positions
+    ``[x, y, z, qx, qy, qz, qw]``, 6 more velocities); ``strict`` refuses what is
+    otherwise loaded with a warning. Raises :class:`LoadError`."""
+
+def identify(
+    robot_path: Union[str, "os.PathLike[str]"],
+    data_path: Union[str, "os.PathLike[str]"],
+    *,
+    mode: str = "standard",
+    method: str = "ols",
+    friction: str = "none",
+    epsilon: float = 0.01,
+    ridge_lambda: float = 1e-6,
+    cutoff: float = 10.0,
+    raw_states: bool = False,
+    recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Dict[str, Any]:
+    """Identifies the robot's inertial parameters from a recording, as ``dyngen
+    identify`` does: ``mode`` ``"standard"``, ``"principal"`` or ``"mim"``; ``method``
+    ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
+    ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
+    ``"stribeck-smooth"``. Returns ``names``, ``values``, ``sigma``,
+    ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,
+    ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
+    ``warnings``. Raises :class:`LoadError` or ``ValueError``."""
+
+class Model:
+    """A robot loaded by :func:`load` and the rigid-body algorithms on it.
+
+    Every algorithm takes one state (1-D arrays: ``q`` of length ``nq``; ``v``, ``a``,
+    ``tau`` of length ``nv``) or a batch (2-D arrays ``(N, nq)``, ``(N, nv)``) and
+    returns the per-state shape, with a leading ``N`` for a batch. Raises
+    ``ValueError`` for a wrong shape, a non-finite input or result, an unknown frame
+    or reference."""
+
+    @property
+    def name(self) -> str:
+        """The robot's name."""
+    @property
+    def nq(self) -> int:
+        """Number of position coordinates."""
+    @property
+    def nv(self) -> int:
+        """Number of velocity coordinates."""
+    @property
+    def nbodies(self) -> int:
+        """Number of moving bodies (= joints)."""
+    @property
+    def joint_names(self) -> List[str]:
+        """The joints' names, in the order of ``q`` and ``v``."""
+    @property
+    def body_names(self) -> List[str]:
+        """The moving bodies' names, body 1 first."""
+    @property
+    def frame_names(self) -> List[str]:
+        """Every named frame, the base first."""
+    @property
+    def gravity(self) -> Array:
+        """Gravity in the base frame, shape (3,)."""
+    @property
+    def warnings(self) -> List[str]:
+        """The loader's warnings."""
+    @property
+    def params(self) -> Array:
+        """Standard parameters, shape (10 * nbodies,), per body
+        ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``; settable."""
+    @params.setter
+    def params(self, value: ArrayLike) -> None: ...
+    @property
+    def max_threads(self) -> Optional[int]:
+        """The most threads a batch is split across (``None``: every core)."""
+    @max_threads.setter
+    def max_threads(self, value: Optional[int]) -> None: ...
+    def neutral(self) -> Array:
+        """The neutral configuration, shape (nq,)."""
+    def rnea(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """Inverse dynamics ``tau = M(q) a + C(q, v) v + g(q)``: (nv,) or (N, nv)."""
+    def nonlinear_effects(self, q: ArrayLike, v: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """``C(q, v) v + g(q)``: (nv,) or (N, nv)."""
+    def generalized_gravity(self, q: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """``g(q)``: (nv,) or (N, nv)."""
+    def crba(self, q: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """The mass matrix ``M(q)``: (nv, nv) or (N, nv, nv)."""
+    def aba(self, q: ArrayLike, v: ArrayLike, tau: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """Forward dynamics ``M(q)⁻¹ (tau − C(q, v) v − g(q))``: (nv,) or (N, nv)."""
+    def forward_kinematics(self, q: ArrayLike) -> Tuple[Array, Array]:
+        """Every body's placement ``(R, t)`` in the base frame: (nbodies, 3, 3) and
+        (nbodies, 3), or with a leading N."""
+    def frame_placement(self, q: ArrayLike, frame: str) -> Tuple[Array, Array]:
+        """A frame's placement ``(R, t)``: (3, 3) and (3,), or with a leading N."""
+    def frame_jacobian(self, q: ArrayLike, frame: str, reference: Reference = "local_world_aligned") -> Array:
+        """A frame's Jacobian in ``"local_world_aligned"``, ``"local"`` or ``"world"``:
+        (6, nv) or (N, 6, nv)."""
+    def joint_wrenches(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """Each joint's wrench on its body, in the body frame: (nbodies, 6) or (N, nbodies, 6)."""
+    def joint_torque_regressor(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Array:
+        """``Y`` with ``tau = Y @ params``: (nv, 10 nbodies) or (N, nv, 10 nbodies)."""
+    def joint_wrench_regressor(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Array:
+        """``W`` with ``W @ params`` the joint wrenches: (6 nbodies, 10 nbodies) or with a leading N."""

@@ -1,0 +1,72 @@
+"""`dyngen.identify` on a recording simulated with other parameters than the URDF's:
+exact torques, so the identifiable parameters come back exactly."""
+
+import re
+
+import numpy as np
+import pytest
+
+import dyngen
+from conftest import ROBOTS
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """A UR5 moving along sums of sines (100 Hz, 20 s) with every body's parameters
+    scaled by its own factor; positions, velocities, accelerations and the torques of
+    the scaled parameters, in dyngen's CSV schema."""
+    robot = dyngen.load(ROBOTS[0][1])
+    rng = np.random.default_rng(1)
+    truth = robot.params * np.repeat(rng.uniform(0.7, 1.4, robot.nbodies), 10)
+    t = np.arange(2000) * 0.01
+    n = robot.nv
+    amplitude = rng.uniform(0.3, 0.8, (n, 3))
+    frequency = rng.uniform(0.1, 0.6, (n, 3)) * 2 * np.pi
+    phase = rng.uniform(0, 2 * np.pi, (n, 3))
+    arg = frequency[None] * t[:, None, None] + phase[None]
+    q = np.sum(amplitude[None] * np.sin(arg), axis=2)
+    v = np.sum(amplitude[None] * frequency[None] * np.cos(arg), axis=2)
+    a = -np.sum(amplitude[None] * frequency[None] ** 2 * np.sin(arg), axis=2)
+    tau = robot.rnea(q, v, a, params=truth)
+    path = tmp_path_factory.mktemp("identify") / "ur5.csv"
+    header = ["t"] + [f"{x}{j + 1}" for x in ("q", "v", "a", "tau") for j in range(n)]
+    np.savetxt(path, np.column_stack([t, q, v, a, tau]), delimiter=",", header=",".join(header), comments="",
+               fmt="%.17g")
+    return robot, truth, path
+
+
+def test_identifies_what_the_data_determines(recording):
+    robot, truth, path = recording
+    result = dyngen.identify(ROBOTS[0][1], path, raw_states=True)
+    names, values, status = result["names"], result["values"], result["status"]
+    assert len(names) == len(values) == len(status) == robot.nbodies * 10
+    determined = sum(s in ("identified", "not_significant") for s in status)
+    assert result["rank"] == determined + len(result["combinations"]) < len(names)
+    assert np.max(result["residual_rms"]) < 1e-9 * np.max(np.abs(robot.rnea(*np.zeros((3, robot.nv)), params=truth)))
+    identified = [k for k, s in enumerate(status) if s == "identified"]
+    assert identified, status
+    np.testing.assert_allclose(values[identified], truth[identified], rtol=1e-7, atol=1e-9)
+    # The combinations (base parameters) are those of the simulated parameters, not
+    # of the URDF's.
+    k = result["combination_matrix"]
+    assert k.shape == (len(result["combinations"]), len(names))
+    np.testing.assert_allclose(result["combination_values"], k @ truth, rtol=1e-8, atol=1e-10)
+    assert np.max(np.abs(result["combination_values"] - k @ robot.params)) > 1e-2
+
+
+def test_unknown_option(recording):
+    _, _, path = recording
+    with pytest.raises(ValueError, match=re.escape("identify: unknown method `lsq`; it must be one of: ols, wls")):
+        dyngen.identify(ROBOTS[0][1], path, method="lsq")
+
+
+def test_missing_recording(tmp_path):
+    with pytest.raises(ValueError, match=re.escape(str(tmp_path / "missing.csv"))):
+        dyngen.identify(ROBOTS[0][1], tmp_path / "missing.csv")
+
+
+def test_recording_of_another_robot(recording):
+    _, _, path = recording
+    with pytest.raises(ValueError, match="identify: ") as info:
+        dyngen.identify(ROBOTS[1][1], path)  # the Panda has 7 joints, the recording 6
+    assert "7" in str(info.value)

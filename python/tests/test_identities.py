@@ -1,0 +1,96 @@
+"""Identities between the algorithms, and the model's attributes."""
+
+import numpy as np
+
+import dyngen
+from conftest import ROBOTS, random_states
+
+
+def close(x, y, tolerance=1e-11):
+    scale = max(1.0, np.max(np.abs(y)))
+    assert np.max(np.abs(np.asarray(x) - y)) <= tolerance * scale
+
+
+def test_mass_matrix_symmetric_positive_definite(robot):
+    q, _, _ = random_states(robot, 20, np.random.default_rng(1))
+    for m in robot.crba(q):
+        assert np.array_equal(m, m.T)
+        assert np.min(np.linalg.eigvalsh(m)) > 0.0
+
+
+def test_aba_inverts_rnea(robot):
+    q, v, a = random_states(robot, 20, np.random.default_rng(1))
+    tau = robot.rnea(q, v, a)
+    close(robot.aba(q, v, tau), a, 1e-9)
+
+
+def test_rnea_is_mass_matrix_times_a_plus_bias(robot):
+    q, v, a = random_states(robot, 20, np.random.default_rng(1))
+    m = robot.crba(q)
+    close(robot.rnea(q, v, a), np.einsum("nij,nj->ni", m, a) + robot.nonlinear_effects(q, v))
+    close(robot.generalized_gravity(q), robot.rnea(q, np.zeros_like(v), np.zeros_like(a)))
+
+
+def test_regressors_are_linear_in_params(robot):
+    q, v, a = random_states(robot, 5, np.random.default_rng(1))
+    params = robot.params * np.repeat(np.random.default_rng(2).uniform(0.5, 2.0, robot.nbodies), 10)
+    y = robot.joint_torque_regressor(q, v, a)
+    close(y @ params, robot.rnea(q, v, a, params=params))
+    w = robot.joint_wrench_regressor(q, v, a)
+    close((w @ params).reshape(5, robot.nbodies, 6), robot.joint_wrenches(q, v, a, params=params))
+
+
+def test_jacobian_matches_placements(robot):
+    """The LOCAL_WORLD_ALIGNED Jacobian's linear rows are the derivative of the frame's
+    position along a joint coordinate (central differences, on a revolute joint)."""
+    q, _, _ = random_states(robot, 1, np.random.default_rng(1))
+    q = q[0]
+    frame = robot.frame_names[-1]
+    j = robot.frame_jacobian(q, frame)
+    # The last joint's coordinate (a 1-coordinate joint on every shipped robot).
+    h = 1e-6
+    dq = np.zeros(robot.nq)
+    dq[-1] = h
+    _, t_plus = robot.frame_placement(q + dq, frame)
+    _, t_minus = robot.frame_placement(q - dq, frame)
+    close((t_plus - t_minus) / (2 * h), j[:3, -1], 1e-7)
+
+
+def test_params_setter(ur5):
+    q, v, a = random_states(ur5, 3, np.random.default_rng(1))
+    nominal = ur5.params
+    doubled = 2.0 * nominal
+    try:
+        ur5.params = doubled
+        assert np.array_equal(ur5.params, doubled)
+        assert np.array_equal(ur5.rnea(q, v, a), ur5.rnea(q, v, a, params=doubled))
+        close(ur5.rnea(q, v, a), 2.0 * ur5.rnea(q, v, a, params=nominal))
+    finally:
+        ur5.params = nominal
+    assert np.array_equal(ur5.params, nominal)
+
+
+def test_attributes():
+    ur5 = dyngen.load(ROBOTS[0][1])
+    assert (ur5.name, ur5.nq, ur5.nv, ur5.nbodies) == ("ur5", 6, 6, 6)
+    assert ur5.joint_names[0] == "shoulder_pan_joint" and len(ur5.joint_names) == 6
+    assert ur5.body_names[-1] == "wrist_3_link"
+    assert "tool0" in ur5.frame_names
+    assert np.array_equal(ur5.gravity, [0.0, 0.0, -9.81])
+    assert ur5.params.shape == (60,)
+    assert ur5.warnings == []
+    assert repr(ur5) == 'Model(name="ur5", nq=6, nv=6, nbodies=6)'
+    humanoid = dyngen.load(ROBOTS[2][1], free_flyer=True)
+    assert humanoid.joint_names[0] == "root_joint"
+    assert (humanoid.nq, humanoid.nv) == (38, 37)  # 7 + 6 for the free flyer, one continuous joint
+    neutral = humanoid.neutral()
+    assert np.array_equal(neutral[:7], [0, 0, 0, 0, 0, 0, 1])
+    assert dyngen.__version__
+
+
+def test_docstrings():
+    assert dyngen.load.__doc__ and dyngen.Model.__doc__
+    for name in ["rnea", "crba", "aba", "forward_kinematics", "frame_placement", "frame_jacobian",
+                 "joint_torque_regressor", "joint_wrench_regressor", "joint_wrenches",
+                 "nonlinear_effects", "generalized_gravity", "neutral"]:
+        assert getattr(dyngen.Model, name).__doc__, name

@@ -1,0 +1,227 @@
+"""Every algorithm against Pinocchio's Python bindings (`pip install pin`) on the
+shipped UR5, Panda, and 31-joint humanoid on a free flyer, 20 random states each."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from conftest import ROBOTS, load, random_states, record
+
+TOLERANCE = 1e-12
+STATES = 20
+
+
+def error(x, y):
+    """Largest difference, relative to the magnitude of the reference where it
+    exceeds 1."""
+    x, y = np.asarray(x), np.asarray(y)
+    assert x.shape == y.shape, (x.shape, y.shape)
+    return np.max(np.abs(x - y), initial=0.0) / max(1.0, np.max(np.abs(y), initial=0.0))
+
+
+class Pair:
+    """A robot loaded by dyngen and by Pinocchio, with the maps between their
+    coordinates: Pinocchio numbers the joints as dyngen does (checked by name), but
+    gives a continuous joint two positions (cos θ, sin θ) where dyngen has θ."""
+
+    def __init__(self, name, path, free_flyer):
+        self.name = name
+        self.robot = load(path, free_flyer)
+        if free_flyer:
+            self.model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        else:
+            self.model = pin.buildModelFromUrdf(str(path))
+        self.data = self.model.createData()
+        pin_names = list(self.model.names)[1:]
+        assert sorted(pin_names) == sorted(self.robot.joint_names)
+        # Pinocchio joint (1-based) of each dyngen joint, in dyngen's order.
+        self.joints = [self.model.getJointId(n) for n in self.robot.joint_names]
+        self.v_perm = []  # dyngen velocity k is Pinocchio's v_perm[k]
+        self.param_perm = []  # dyngen parameter k is Pinocchio's param_perm[k]
+        self.q_layout = []  # (dyngen offset, Pinocchio offset, nq dyngen, continuous)
+        q_off = 0
+        for j in self.joints:
+            joint = self.model.joints[j]
+            continuous = joint.nq == 2 and joint.nv == 1
+            nq = 1 if continuous else joint.nq
+            self.q_layout.append((q_off, joint.idx_q, nq, continuous))
+            q_off += nq
+            self.v_perm.extend(range(joint.idx_v, joint.idx_v + joint.nv))
+            self.param_perm.extend(range(10 * (j - 1), 10 * j))
+        assert q_off == self.robot.nq and len(self.v_perm) == self.robot.nv
+        self.v_perm = np.array(self.v_perm)
+        self.param_perm = np.array(self.param_perm)
+        self.same_order = pin_names == self.robot.joint_names
+
+    def q(self, q):
+        """dyngen's configuration as Pinocchio's."""
+        out = np.zeros(self.model.nq)
+        for (dq, pq, nq, continuous) in self.q_layout:
+            if continuous:
+                out[pq : pq + 2] = [np.cos(q[dq]), np.sin(q[dq])]
+            else:
+                out[pq : pq + nq] = q[dq : dq + nq]
+        return out
+
+    def v(self, v):
+        """A dyngen velocity-space vector in Pinocchio's order."""
+        out = np.empty(self.model.nv)
+        out[self.v_perm] = v
+        return out
+
+    def from_v(self, x):
+        """A Pinocchio velocity-space vector (or the rows of a matrix) in dyngen's order."""
+        return np.asarray(x)[self.v_perm]
+
+    def params(self):
+        """Pinocchio's standard parameters, in dyngen's order."""
+        pi = np.concatenate([self.model.inertias[j].toDynamicParameters() for j in range(1, self.model.njoints)])
+        return pi[self.param_perm]
+
+    def set_params(self, params):
+        """Gives Pinocchio the standard parameters `params` (dyngen's order)."""
+        pi = np.empty_like(params)
+        pi[self.param_perm] = params
+        for j in range(1, self.model.njoints):
+            self.model.inertias[j] = pin.Inertia.FromDynamicParameters(pi[10 * (j - 1) : 10 * j])
+
+
+@pytest.fixture(scope="module", params=[r[0] for r in ROBOTS])
+def pair(request):
+    name, path, free_flyer = next(r for r in ROBOTS if r[0] == request.param)
+    return Pair(name, path, free_flyer)
+
+
+@pytest.fixture(scope="module")
+def states(pair):
+    return random_states(pair.robot, STATES, np.random.default_rng(1))
+
+
+def check(pair, algorithm, ours, theirs):
+    e = error(ours, theirs)
+    record(pair.name, algorithm, e)
+    assert e <= TOLERANCE, f"{pair.name} {algorithm}: error {e:.3e}"
+
+
+def test_joint_order_and_parameters(pair):
+    # The shipped robots are numbered as Pinocchio numbers them; the maps above
+    # would cover a different order.
+    assert pair.same_order
+    assert pair.robot.nv == pair.model.nv
+    check(pair, "params", pair.robot.params, pair.params())
+    np.testing.assert_array_equal(pair.robot.gravity, pair.model.gravity.linear)
+
+
+def test_rnea(pair, states):
+    for q, v, a in zip(*states):
+        ours = pair.robot.rnea(q, v, a)
+        theirs = pin.rnea(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(a))
+        check(pair, "rnea", ours, pair.from_v(theirs))
+
+
+def test_nonlinear_effects_and_gravity(pair, states):
+    for q, v, _ in zip(*states):
+        ours = pair.robot.nonlinear_effects(q, v)
+        theirs = pin.nonLinearEffects(pair.model, pair.data, pair.q(q), pair.v(v))
+        check(pair, "nonlinear_effects", ours, pair.from_v(theirs))
+        ours = pair.robot.generalized_gravity(q)
+        theirs = pin.computeGeneralizedGravity(pair.model, pair.data, pair.q(q))
+        check(pair, "generalized_gravity", ours, pair.from_v(theirs))
+
+
+def test_crba(pair, states):
+    for q in states[0]:
+        theirs = pin.crba(pair.model, pair.data, pair.q(q))
+        theirs = np.triu(theirs) + np.triu(theirs, 1).T  # Pinocchio fills the upper triangle
+        theirs = theirs[np.ix_(pair.v_perm, pair.v_perm)]
+        check(pair, "crba", pair.robot.crba(q), theirs)
+
+
+def test_aba(pair, states):
+    rng = np.random.default_rng(1)
+    for q, v, _ in zip(*states):
+        tau = rng.uniform(-10.0, 10.0, pair.robot.nv)
+        ours = pair.robot.aba(q, v, tau)
+        theirs = pin.aba(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(tau))
+        check(pair, "aba", ours, pair.from_v(theirs))
+
+
+def test_forward_kinematics(pair, states):
+    for q in states[0]:
+        rotations, translations = pair.robot.forward_kinematics(q)
+        pin.forwardKinematics(pair.model, pair.data, pair.q(q))
+        for i, j in enumerate(pair.joints):
+            check(pair, "forward_kinematics", rotations[i], pair.data.oMi[j].rotation)
+            check(pair, "forward_kinematics", translations[i], pair.data.oMi[j].translation)
+
+
+def frame_ids(pair):
+    """Every dyngen frame with Pinocchio's id of the body frame of that name (the
+    world of a free flyer is Pinocchio's `universe`)."""
+    ids = []
+    for name in pair.robot.frame_names:
+        assert pair.model.existFrame(name), name
+        fid = pair.model.getFrameId(name)
+        ids.append((name, fid))
+    assert len(ids) == len(pair.robot.frame_names)
+    return ids
+
+
+def test_frame_placement(pair, states):
+    ids = frame_ids(pair)
+    for q in states[0]:
+        pin.framesForwardKinematics(pair.model, pair.data, pair.q(q))
+        for name, fid in ids:
+            rotation, translation = pair.robot.frame_placement(q, name)
+            check(pair, "frame_placement", rotation, pair.data.oMf[fid].rotation)
+            check(pair, "frame_placement", translation, pair.data.oMf[fid].translation)
+
+
+@pytest.mark.parametrize(
+    "reference, pin_reference",
+    [("local_world_aligned", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL), ("world", pin.WORLD)],
+)
+def test_frame_jacobian(pair, states, reference, pin_reference):
+    ids = frame_ids(pair)
+    for q in states[0]:
+        for name, fid in ids:
+            ours = pair.robot.frame_jacobian(q, name, reference=reference)
+            theirs = pin.computeFrameJacobian(pair.model, pair.data, pair.q(q), fid, pin_reference)
+            check(pair, f"frame_jacobian {reference}", ours, theirs[:, pair.v_perm])
+
+
+def test_joint_torque_regressor(pair, states):
+    for q, v, a in zip(*states):
+        ours = pair.robot.joint_torque_regressor(q, v, a)
+        theirs = pin.computeJointTorqueRegressor(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(a))
+        check(pair, "joint_torque_regressor", ours, theirs[np.ix_(pair.v_perm, pair.param_perm)])
+
+
+def test_joint_wrenches(pair, states):
+    for q, v, a in zip(*states):
+        ours = pair.robot.joint_wrenches(q, v, a)
+        pin.rnea(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(a))
+        theirs = np.array([pair.data.f[j].vector for j in pair.joints])
+        check(pair, "joint_wrenches", ours, theirs)
+
+
+def test_other_params(pair, states):
+    """`params=` reaches every algorithm: each body's parameters scaled by its own
+    factor (still physical), on both sides."""
+    rng = np.random.default_rng(1)
+    params = pair.robot.params * np.repeat(rng.uniform(0.5, 2.0, pair.robot.nbodies), 10)
+    nominal = pair.params()
+    try:
+        pair.set_params(params)
+        for q, v, a in zip(*states):
+            pq, pv, pa = pair.q(q), pair.v(v), pair.v(a)
+            check(pair, "rnea params=", pair.robot.rnea(q, v, a, params=params),
+                  pair.from_v(pin.rnea(pair.model, pair.data, pq, pv, pa)))
+            m = pin.crba(pair.model, pair.data, pq)
+            m = (np.triu(m) + np.triu(m, 1).T)[np.ix_(pair.v_perm, pair.v_perm)]
+            check(pair, "crba params=", pair.robot.crba(q, params=params), m)
+            tau = pair.robot.rnea(q, v, a, params=params)
+            check(pair, "aba params=", pair.robot.aba(q, v, tau, params=params),
+                  pair.from_v(pin.aba(pair.model, pair.data, pq, pv, pair.v(tau))))
+    finally:
+        pair.set_params(nominal)

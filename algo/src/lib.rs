@@ -59,7 +59,7 @@ pub use jacobian::{compute_frame_jacobian, frame_jacobian, ReferenceFrame};
 pub use joint::{quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
 pub use kinematics::{body_motions, forward_kinematics};
 pub use multibody::{JointSpec, Multibody, TreeError, Workspace, PARAMS_PER_BODY};
-pub use real::Real;
+pub use real::{polynomial_sin_cos, Precision, Real};
 pub use regressor::{force_regressor, joint_torque_regressor, joint_wrench_regressor};
 pub use rnea::rnea;
 pub use spatial::{Force, Inertia, Motion, Rotate, Se3};

@@ -608,13 +608,11 @@ impl<'a, E: OrderedScalar> ViewMut<'a, E> {
                 }
             }
             ViewMut::Rows { data, width, .. } => {
-                for (lane, tile) in lanes.iter().zip(tile.chunks_exact_mut(n)) {
-                    lane.write_lanes(tile);
-                }
+                // Each state's row in order, lane j of every value (read in place).
                 for j in 0..count {
                     let state = k + j;
-                    for (i, x) in data[state * *width..(state + 1) * *width].iter_mut().enumerate() {
-                        *x = tile[i * n + j];
+                    for (x, lane) in data[state * *width..(state + 1) * *width].iter_mut().zip(lanes) {
+                        *x = lane.lane(j);
                     }
                 }
             }
@@ -658,7 +656,11 @@ where
     let mut state = init();
     let mut x: Vec<Vec<L>> = inputs.iter().map(|v| vec![L::ZERO; v.width()]).collect();
     let mut y: Vec<Vec<L>> = outputs.iter().map(|v| vec![L::ZERO; v.width()]).collect();
-    let widest = inputs.iter().map(View::width).chain(outputs.iter().map(ViewMut::width)).max();
+    let widest = inputs
+        .iter()
+        .map(View::width)
+        .chain(outputs.iter().map(ViewMut::width))
+        .max();
     let mut tile = vec![L::Elem::ZERO; widest.unwrap_or(0) * L::LANES];
     let n = end - start;
     let mut k = 0;

@@ -28,7 +28,7 @@
 //! * [`neutral`]: zeros, identity quaternions.
 //! * [`normalize`]: each quaternion scaled to unit norm.
 //!
-//! All are generic over [`Scalar`], allocate nothing and never panic: a slice of the
+//! All are generic over [`OrderedScalar`], allocate nothing and never panic: a slice of the
 //! wrong length or a non-finite result (a NaN or infinite input, a zero quaternion) is a
 //! [`ConfigurationError`].
 //!

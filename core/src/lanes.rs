@@ -6,9 +6,10 @@
 //!
 //! Every lane computes exactly what the scalar type computes for its state: `+ − × ÷`
 //! and `√` are correctly rounded in both, `mul_add` is fused in both or in neither (as
-//! [`Scalar::mul_add`] says), and `sin`, `cos`, `tanh`, `atan2` are the standard
-//! library's, lane by lane. So a batch gives bit for bit the results of one call per
-//! state.
+//! [`Scalar::mul_add`] says), `sin` and `cos` are [`dyngen_algo::polynomial_sin_cos`]
+//! in both (additions and multiplications only, so on the registers too), and `tanh`
+//! and `atan2` are the standard library's, lane by lane. So a batch gives bit for bit
+//! the results of one call per state.
 //!
 //! ```
 //! use dyngen::lanes::F64x4;
@@ -37,7 +38,7 @@ pub trait Lanes: Scalar {
 }
 
 macro_rules! lanes {
-    ($(#[$doc:meta])* $name:ident, $wide:ident, $elem:ident, $n:literal) => {
+    ($(#[$doc:meta])* $name:ident, $wide:ident, $elem:ident, $n:literal, $precision:expr) => {
         $(#[$doc])*
         #[derive(Clone, Copy, Debug, Default, PartialEq)]
         #[repr(transparent)]
@@ -133,14 +134,24 @@ macro_rules! lanes {
             }
             #[inline(always)]
             fn sin(self) -> Self {
-                self.map(|x| Scalar::sin(x))
+                Scalar::sin_cos(self).0
             }
             #[inline(always)]
             fn cos(self) -> Self {
-                self.map(|x| Scalar::cos(x))
+                Scalar::sin_cos(self).1
             }
+            /// [`dyngen_algo::polynomial_sin_cos`] on the registers, as the number
+            /// type computes it; a lane beyond its limit (or not finite) takes the
+            /// number type's own.
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
+                let (sin, cos) = dyngen_algo::polynomial_sin_cos((), self, $precision);
+                let limit = wide::$wide::splat($precision.limit() as $elem);
+                if self.0.abs().simd_le(limit).all() {
+                    return (sin, cos);
+                }
+                // The number type takes the polynomial where it applies, its own
+                // beyond: lane by lane, what one call per state gives.
                 let x = self.to_array();
                 let (mut s, mut c) = ([0.0; $n], [0.0; $n]);
                 for i in 0..$n {
@@ -228,19 +239,19 @@ macro_rules! lanes {
 
 lanes!(
     /// Four `f64` lanes: one AVX register, two SSE2 registers.
-    F64x4, f64x4, f64, 4
+    F64x4, f64x4, f64, 4, dyngen_algo::Precision::Double
 );
 lanes!(
     /// Eight `f64` lanes: one AVX-512 register, two AVX or four SSE2 registers.
-    F64x8, f64x8, f64, 8
+    F64x8, f64x8, f64, 8, dyngen_algo::Precision::Double
 );
 lanes!(
     /// Eight `f32` lanes: one AVX register, two SSE2 registers.
-    F32x8, f32x8, f32, 8
+    F32x8, f32x8, f32, 8, dyngen_algo::Precision::Single
 );
 lanes!(
     /// Sixteen `f32` lanes: one AVX-512 register, two AVX or four SSE2 registers.
-    F32x16, f32x16, f32, 16
+    F32x16, f32x16, f32, 16, dyngen_algo::Precision::Single
 );
 
 #[cfg(test)]
@@ -270,8 +281,23 @@ mod tests {
         check(-x, &|a, _| -a);
         check(x.mul_add(y, x), &|a, b| Scalar::mul_add(a, b, a));
         check(x.abs().sqrt(), &|a, _| a.abs().sqrt());
-        check(x.sin(), &|a, _| a.sin());
-        check(x.sin_cos().1, &|a, _| a.cos());
+        check(x.sin(), &|a, _| Scalar::sin(a));
+        check(x.sin_cos().1, &|a, _| Scalar::cos(a));
+        // Beyond the polynomial's limit, and not finite: the number type's own.
+        let big = F64x4::new([1.0e6, -3.0, f64::INFINITY, f64::NAN]);
+        for (i, (s, c)) in big.sin().to_array().into_iter().zip(big.cos().to_array()).enumerate() {
+            let x = big.to_array()[i];
+            let (ws, wc) = Scalar::sin_cos(x);
+            assert!(
+                s.to_bits() == ws.to_bits() || (s.is_nan() && ws.is_nan()),
+                "sin lane {i}"
+            );
+            assert!(
+                c.to_bits() == wc.to_bits() || (c.is_nan() && wc.is_nan()),
+                "cos lane {i}"
+            );
+        }
+        assert_eq!(Scalar::sin(1.0e6), 1.0e6f64.sin());
         check(x.tanh(), &|a, _| a.tanh());
         check(x.atan2(y), &|a, b| a.atan2(b));
         check(x.sign(), &|a, _| a.sign());

@@ -86,15 +86,18 @@ macro_rules! impl_scalar {
             }
             #[inline(always)]
             fn sin(self) -> Self {
-                num_traits::Float::sin(self)
+                Scalar::sin_cos(self).0
             }
             #[inline(always)]
             fn cos(self) -> Self {
-                num_traits::Float::cos(self)
+                Scalar::sin_cos(self).1
             }
+            /// `dyngen_algo`'s ([`dyngen_algo::polynomial_sin_cos`] where it applies):
+            /// the run-time algorithms, generated code and the lane types compute the
+            /// same numbers.
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
-                num_traits::Float::sin_cos(self)
+                dyngen_algo::Real::sin_cos(self)
             }
             #[inline(always)]
             fn sqrt(self) -> Self {

@@ -532,8 +532,7 @@ fn normalized<S: OrderedScalar>(q: [S; 4]) -> [S; 4] {
         let n = n2.sqrt();
         return q.map(|x| x / n);
     }
-    let abs = |x: S| if x < S::ZERO { -x } else { x };
-    let m = q.iter().fold(S::ZERO, |m, &x| if abs(x) > m { abs(x) } else { m });
+    let m = q.iter().fold(S::ZERO, |m, &x| if x.abs() > m { x.abs() } else { m });
     // m = 0: 0/0 = NaN; m = ∞: ∞/∞ or 0/∞ then 0/0 = NaN; a NaN component stays NaN.
     let s = q.map(|x| x / m);
     let n = dot4(s, s).sqrt();

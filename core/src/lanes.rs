@@ -132,14 +132,6 @@ macro_rules! lanes {
             fn from_f64(x: f64) -> Self {
                 Self::splat(x as $elem)
             }
-            #[inline(always)]
-            fn sin(self) -> Self {
-                Scalar::sin_cos(self).0
-            }
-            #[inline(always)]
-            fn cos(self) -> Self {
-                Scalar::sin_cos(self).1
-            }
             /// [`dyngen_algo::polynomial_sin_cos`] on the registers, as the number
             /// type computes it; a lane beyond its limit (or not finite) takes the
             /// number type's own.

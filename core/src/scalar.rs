@@ -36,8 +36,16 @@ pub trait Scalar:
     /// Converts a constant of the generated code (rounding for narrower types; the
     /// same in every lane of a lane type).
     fn from_f64(x: f64) -> Self;
-    fn sin(self) -> Self;
-    fn cos(self) -> Self;
+    /// `sin_cos(self).0`.
+    #[inline(always)]
+    fn sin(self) -> Self {
+        Scalar::sin_cos(self).0
+    }
+    /// `sin_cos(self).1`.
+    #[inline(always)]
+    fn cos(self) -> Self {
+        Scalar::sin_cos(self).1
+    }
     /// Both at once: one call where the platform computes them together.
     fn sin_cos(self) -> (Self, Self);
     fn sqrt(self) -> Self;
@@ -83,14 +91,6 @@ macro_rules! impl_scalar {
             #[inline(always)]
             fn from_f64(x: f64) -> Self {
                 x as $t
-            }
-            #[inline(always)]
-            fn sin(self) -> Self {
-                Scalar::sin_cos(self).0
-            }
-            #[inline(always)]
-            fn cos(self) -> Self {
-                Scalar::sin_cos(self).1
             }
             /// `dyngen_algo`'s ([`dyngen_algo::polynomial_sin_cos`] where it applies):
             /// the run-time algorithms, generated code and the lane types compute the

@@ -18,7 +18,7 @@ use numpy::{IxDyn, PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyU
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 pyo3::create_exception!(
     dyngen,
@@ -107,6 +107,18 @@ struct Arg<'a, 'py> {
     name: &'static str,
     value: &'a Bound<'py, PyAny>,
     width: usize,
+}
+
+/// The cores, read once: `available_parallelism` reads the cgroup's quota (microseconds)
+/// on every call.
+fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// The input `name`, `width` values per state.
+fn arg<'a, 'py>(name: &'static str, value: &'a Bound<'py, PyAny>, width: usize) -> Arg<'a, 'py> {
+    Arg { name, value, width }
 }
 
 /// An input read as C-contiguous `float64`, checked against its width.
@@ -432,12 +444,11 @@ impl PyModel {
         };
         let max_threads = self.max_threads;
         let result = py.detach(|| {
-            // The core count is read once per call, and only for a batch that can be
-            // split (`available_parallelism` reads the cgroup's quota: microseconds).
+            // The core count is read only for a batch that can be split.
             let threads = if rows < 2 * MIN_ROWS_PER_THREAD || max_threads == Some(1) {
                 1
             } else {
-                let cores = max_threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+                let cores = max_threads.unwrap_or_else(cores);
                 cores.min(rows / MIN_ROWS_PER_THREAD).max(1)
             };
             if threads == 1 {
@@ -644,23 +655,7 @@ impl PyModel {
         let [tau] = self.evaluate(
             py,
             "rnea",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-                Arg {
-                    name: "a",
-                    value: a,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv]],
             |ws, [q, v, a], [tau]| dyngen_algo::rnea(body, ws, q, v, a, p, tau),
         )?;
@@ -695,18 +690,7 @@ impl PyModel {
         let [h] = self.evaluate(
             py,
             "nonlinear_effects",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv)],
             [&[nv]],
             |ws, [q, v], [h]| dyngen_algo::rnea(body, ws, q, v, &zero, p, h),
         )?;
@@ -736,17 +720,9 @@ impl PyModel {
             .unwrap_or(&self.body.params);
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let zero = vec![0.0; nv];
-        let [g] = self.evaluate(
-            py,
-            "generalized_gravity",
-            [Arg {
-                name: "q",
-                value: q,
-                width: nq,
-            }],
-            [&[nv]],
-            |ws, [q], [g]| dyngen_algo::rnea(body, ws, q, &zero, &zero, p, g),
-        )?;
+        let [g] = self.evaluate(py, "generalized_gravity", [arg("q", q, nq)], [&[nv]], |ws, [q], [g]| {
+            dyngen_algo::rnea(body, ws, q, &zero, &zero, p, g)
+        })?;
         Ok(g)
     }
 
@@ -773,17 +749,9 @@ impl PyModel {
             .transpose()?
             .unwrap_or(&self.body.params);
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [m] = self.evaluate(
-            py,
-            "crba",
-            [Arg {
-                name: "q",
-                value: q,
-                width: nq,
-            }],
-            [&[nv, nv]],
-            |ws, [q], [m]| dyngen_algo::crba(body, ws, q, p, m),
-        )?;
+        let [m] = self.evaluate(py, "crba", [arg("q", q, nq)], [&[nv, nv]], |ws, [q], [m]| {
+            dyngen_algo::crba(body, ws, q, p, m)
+        })?;
         Ok(m)
     }
 
@@ -820,23 +788,7 @@ impl PyModel {
         let [qdd] = self.evaluate(
             py,
             "aba",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-                Arg {
-                    name: "tau",
-                    value: tau,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
             [&[nv]],
             |ws, [q, v, tau], [qdd]| dyngen_algo::aba(body, ws, q, v, tau, p, &[], qdd),
         )?;
@@ -857,11 +809,7 @@ impl PyModel {
         let [r, t] = self.evaluate(
             py,
             "forward_kinematics",
-            [Arg {
-                name: "q",
-                value: q,
-                width: nq,
-            }],
+            [arg("q", q, nq)],
             [&[nb, 3, 3], &[nb, 3]],
             |ws, [q], [r, t]| {
                 dyngen_algo::forward_kinematics(body, ws, q);
@@ -887,11 +835,7 @@ impl PyModel {
         let [r, t] = self.evaluate(
             py,
             "frame_placement",
-            [Arg {
-                name: "q",
-                value: q,
-                width: nq,
-            }],
+            [arg("q", q, nq)],
             [&[3, 3], &[3]],
             |ws, [q], [r, t]| {
                 dyngen_algo::forward_kinematics(body, ws, q);
@@ -929,17 +873,9 @@ impl PyModel {
             )));
         };
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [j] = self.evaluate(
-            py,
-            "frame_jacobian",
-            [Arg {
-                name: "q",
-                value: q,
-                width: nq,
-            }],
-            [&[6, nv]],
-            |ws, [q], [j]| dyngen_algo::compute_frame_jacobian(body, ws, q, index, &offset, reference, j),
-        )?;
+        let [j] = self.evaluate(py, "frame_jacobian", [arg("q", q, nq)], [&[6, nv]], |ws, [q], [j]| {
+            dyngen_algo::compute_frame_jacobian(body, ws, q, index, &offset, reference, j)
+        })?;
         Ok(j)
     }
 
@@ -973,23 +909,7 @@ impl PyModel {
         let [f] = self.evaluate(
             py,
             "joint_wrenches",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-                Arg {
-                    name: "a",
-                    value: a,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nb, 6]],
             |ws, [q, v, a], [f]| {
                 // The torques go to the result's first nv entries (nv ≤ 6 nbodies: no
@@ -1023,23 +943,7 @@ impl PyModel {
         let [y] = self.evaluate(
             py,
             "joint_torque_regressor",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-                Arg {
-                    name: "a",
-                    value: a,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv, np]],
             |ws, [q, v, a], [y]| dyngen_algo::joint_torque_regressor(body, ws, q, v, a, y),
         )?;
@@ -1066,23 +970,7 @@ impl PyModel {
         let [w] = self.evaluate(
             py,
             "joint_wrench_regressor",
-            [
-                Arg {
-                    name: "q",
-                    value: q,
-                    width: nq,
-                },
-                Arg {
-                    name: "v",
-                    value: v,
-                    width: nv,
-                },
-                Arg {
-                    name: "a",
-                    value: a,
-                    width: nv,
-                },
-            ],
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[6 * self.body.bodies(), np]],
             |ws, [q, v, a], [w]| dyngen_algo::joint_wrench_regressor(body, ws, q, v, a, w),
         )?;

@@ -429,6 +429,38 @@ impl Joint {
             }
         }
     }
+
+    /// `d/dε (q ⊕ ε dv)` at `ε = 0` into `dq` (its `nq` entries): how the joint's
+    /// coordinates `q` move along the tangent `dv` (its `nv` entries), `⊕` being
+    /// Pinocchio's `integrate` (motion in the child frame). A quaternion
+    /// `r = [u; w]` moves by `½ r ⊗ [dω; 0] = ½ [w dω + u × dω; −u·dω]`, a free
+    /// flyer's position by `R dv`, a planar joint's by its in-plane velocity turned by
+    /// `θ`; one-coordinate joints by `dv` itself.
+    #[inline(always)]
+    pub fn integrate_tangent<S: Real>(&self, c: S::Context, q: &[S], dv: &[S], dq: &mut [S]) {
+        let half = S::constant(c, 0.5);
+        let quaternion = |r: &[S], w: [S; 3], out: &mut [S]| {
+            let (u, s) = ([r[0], r[1], r[2]], r[3]);
+            let x = crate::spatial::add(crate::spatial::scale(s, w), crate::spatial::cross(u, w));
+            out[..3].copy_from_slice(&x.map(|x| half * x));
+            out[3] = -(half * crate::spatial::dot(u, w));
+        };
+        match self.kind {
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic => dq[0] = dv[0],
+            JointType::Spherical => quaternion(q, [dv[0], dv[1], dv[2]], dq),
+            JointType::FreeFlyer => {
+                let r = quaternion_rotation(c, [q[3], q[4], q[5], q[6]]);
+                dq[..3].copy_from_slice(&crate::spatial::mat_vec(&r, [dv[0], dv[1], dv[2]]));
+                quaternion(&q[3..], [dv[3], dv[4], dv[5]], &mut dq[3..]);
+            }
+            JointType::Planar => {
+                let (s, co) = q[2].sin_cos();
+                dq[0] = co * dv[0] - s * dv[1];
+                dq[1] = s * dv[0] + co * dv[1];
+                dq[2] = dv[2];
+            }
+        }
+    }
 }
 
 /// A rotation with its structure kept: about a coordinate axis it is four entries.

@@ -17,8 +17,17 @@
 //! - [`aba`] (`aba.rs`): forward dynamics, with rotor inertia;
 //! - [`joint_torque_regressor`] (`regressor.rs`): `τ = Y π`, linear in the standard
 //!   parameters, and [`joint_wrench_regressor`], `6 n` rows of joint wrenches;
-//! - [`frame_jacobian`], [`compute_frame_jacobian`] (`jacobian.rs`): a frame's Jacobian
-//!   in any [`ReferenceFrame`].
+//! - [`frame_jacobian`], [`compute_frame_jacobian`], [`frame_velocity`],
+//!   [`frame_classical_acceleration`], [`frame_jacobian_time_variation`]
+//!   (`jacobian.rs`): a frame's Jacobian, velocity, classical acceleration (the drift
+//!   `J̇ v` at `a = 0`) and `J̇` in any [`ReferenceFrame`];
+//! - [`center_of_mass`], [`com_jacobian`], [`centroidal_map`],
+//!   [`centroidal_map_time_variation`] (`centroidal.rs`): the centre of mass, its
+//!   Jacobian, the centroidal momentum matrix `A_g` and `Ȧ_g`;
+//! - [`rnea_derivatives`], [`aba_derivatives`] (`derivatives.rs`): the derivatives of
+//!   inverse and forward dynamics, and `M⁻¹`;
+//! - [`Dual`] (`dual.rs`): forward-mode differentiation, on which the time variations
+//!   and the derivatives run the algorithms above.
 //!
 //! ```
 //! use dyngen_algo::{rnea, JointSpec, JointType, Multibody, Se3, Workspace};
@@ -43,7 +52,10 @@
 extern crate alloc;
 
 mod aba;
+mod centroidal;
 mod crba;
+mod derivatives;
+mod dual;
 mod jacobian;
 mod joint;
 mod kinematics;
@@ -54,8 +66,14 @@ mod rnea;
 pub mod spatial;
 
 pub use aba::aba;
+pub use centroidal::{center_of_mass, centroidal_map, centroidal_map_time_variation, com_jacobian};
 pub use crba::crba;
-pub use jacobian::{compute_frame_jacobian, frame_jacobian, ReferenceFrame};
+pub use derivatives::{aba_derivatives, rnea_derivatives};
+pub use dual::{Dual, DualWorkspace};
+pub use jacobian::{
+    compute_frame_jacobian, frame_classical_acceleration, frame_jacobian, frame_jacobian_time_variation,
+    frame_velocity, ReferenceFrame,
+};
 pub use joint::{quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
 pub use kinematics::{body_motions, forward_kinematics};
 pub use multibody::{JointSpec, Multibody, TreeError, Workspace, PARAMS_PER_BODY};

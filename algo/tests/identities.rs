@@ -3,11 +3,14 @@
 //! aba inverts rnea (with and without rotor inertia), crba's columns are rnea's
 //! differences, the regressor times the parameters is rnea, and the Jacobian maps
 //! velocities to the frame velocity rnea's forward pass would give (checked by a
-//! finite difference of the placement).
+//! finite difference of the placement); the derivatives and time variations against
+//! central differences.
 
 use dyngen_algo::{
-    aba, body_motions, compute_frame_jacobian, crba, forward_kinematics, frame_jacobian, joint_torque_regressor,
-    joint_wrench_regressor, rnea, JointType, Multibody, ReferenceFrame, Se3, Workspace,
+    aba, aba_derivatives, body_motions, centroidal_map, centroidal_map_time_variation, compute_frame_jacobian, crba,
+    forward_kinematics, frame_classical_acceleration, frame_jacobian, frame_jacobian_time_variation, frame_velocity,
+    joint_torque_regressor, joint_wrench_regressor, rnea, rnea_derivatives, DualWorkspace, JointType, Multibody,
+    ReferenceFrame, Se3, Workspace,
 };
 use dyngen_model::{load_robot, load_urdf_options, LoadOptions};
 use rand::{Rng, SeedableRng};
@@ -168,41 +171,196 @@ fn the_algorithms_agree_with_each_other() {
 }
 
 /// `q ⊕ v t` to first order in `t`, enough for a central difference: `q + q̇ t` with
-/// `q̇` from each joint's rule (quaternions `½ q ⊗ (ω, 0)`, a free flyer's position
-/// `R v`, a planar joint's position `R(θ) [vx, vy]`).
+/// `q̇` from each joint's rule ([`dyngen_algo::Joint::integrate_tangent`]).
 fn integrate(body: &Multibody, q: &[f64], v: &[f64], t: f64) -> Vec<f64> {
     let mut out = q.to_vec();
+    let mut dq = [0.0; 7];
     for j in &body.joints {
-        let (qo, vo) = (j.q_offset, j.v_offset);
-        let quaternion = |out: &mut Vec<f64>, at: usize, w: &[f64]| {
-            let (x, y, z, s) = (q[at], q[at + 1], q[at + 2], q[at + 3]);
-            let d = [
-                0.5 * (s * w[0] + y * w[2] - z * w[1]),
-                0.5 * (s * w[1] + z * w[0] - x * w[2]),
-                0.5 * (s * w[2] + x * w[1] - y * w[0]),
-                -0.5 * (x * w[0] + y * w[1] + z * w[2]),
-            ];
-            for k in 0..4 {
-                out[at + k] += d[k] * t;
-            }
-        };
-        match j.kind {
-            JointType::Revolute | JointType::Continuous | JointType::Prismatic => out[qo] += v[vo] * t,
-            JointType::Spherical => quaternion(&mut out, qo, &v[vo..vo + 3]),
-            JointType::FreeFlyer => {
-                let r = dyngen_algo::quaternion_rotation((), [q[qo + 3], q[qo + 4], q[qo + 5], q[qo + 6]]);
-                for k in 0..3 {
-                    out[qo + k] += (0..3).map(|c| r[k][c] * v[vo + c]).sum::<f64>() * t;
-                }
-                quaternion(&mut out, qo + 3, &v[vo + 3..vo + 6]);
-            }
-            JointType::Planar => {
-                let (s, c) = q[qo + 2].sin_cos();
-                out[qo] += (c * v[vo] - s * v[vo + 1]) * t;
-                out[qo + 1] += (s * v[vo] + c * v[vo + 1]) * t;
-                out[qo + 2] += v[vo + 2] * t;
-            }
+        let (qs, vs) = (j.q_offset..j.q_offset + j.nq(), j.v_offset..j.v_offset + j.nv());
+        j.integrate_tangent((), &q[qs.clone()], &v[vs], &mut dq[..j.nq()]);
+        for (k, i) in qs.enumerate() {
+            out[i] += dq[k] * t;
         }
     }
     out
+}
+
+/// The central difference `(f(+h) − f(−h)) / 2h` of a vector function.
+fn difference(f: &mut dyn FnMut(f64) -> Vec<f64>, h: f64) -> Vec<f64> {
+    let (p, m) = (f(h), f(-h));
+    p.iter().zip(&m).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+}
+
+/// Column `c` of an `rows × cols` row-major matrix.
+fn column(m: &[f64], cols: usize, c: usize) -> Vec<f64> {
+    m.iter().skip(c).step_by(cols).copied().collect()
+}
+
+/// The derivatives, time variations and classical accelerations that run the
+/// algorithms on dual numbers, against central differences of the algorithms on
+/// `f64` along each joint's own motion (ball joints, free flyers, planar and
+/// prismatic joints included), and `M⁻¹ (M + diag Ia) = E` with rotor inertia.
+#[test]
+fn derivatives_are_the_differences_of_the_algorithms() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+    let h = 1e-6;
+    for (name, body) in models() {
+        let (nv, nb) = (body.nv(), body.bodies());
+        let params = body.params.clone();
+        let mut ws = Workspace::new(&body, ());
+        let mut dual8 = DualWorkspace::<f64, 8>::new(&body, ());
+        let mut dual1 = DualWorkspace::<f64, 1>::new(&body, ());
+        let q = random_q(&body, &mut rng);
+        let v: Vec<f64> = (0..nv).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let a: Vec<f64> = (0..nv).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let armature: Vec<f64> = (0..nv).map(|_| rng.gen_range(0.0..0.1)).collect();
+        let unit = |d: usize| -> Vec<f64> { (0..nv).map(|k| f64::from(u8::from(k == d))).collect() };
+        let shifted = |x: &[f64], d: usize, t: f64| -> Vec<f64> {
+            let mut y = x.to_vec();
+            y[d] += t;
+            y
+        };
+        let mut worst = 0.0f64;
+        let mut check = |what: &str, ours: &[f64], fd: &[f64]| {
+            let e = max_diff(ours, fd);
+            assert!(e < 1e-6, "{name}: {what}: {e:e}");
+            worst = worst.max(e);
+        };
+
+        let [mut dq, mut dv, mut m] = [(); 3].map(|_| vec![0.0; nv * nv]);
+        rnea_derivatives(
+            &body, &mut dual8, &mut ws, &q, &v, &a, &params, &mut dq, &mut dv, &mut m,
+        );
+        let mut tau = vec![0.0; nv];
+        for d in 0..nv {
+            let mut along_q = |t: f64| {
+                rnea(
+                    &body,
+                    &mut ws,
+                    &integrate(&body, &q, &unit(d), t),
+                    &v,
+                    &a,
+                    &params,
+                    &mut tau,
+                );
+                tau.clone()
+            };
+            check("∂τ/∂q", &column(&dq, nv, d), &difference(&mut along_q, h));
+            let mut along_v = |t: f64| {
+                rnea(&body, &mut ws, &q, &shifted(&v, d, t), &a, &params, &mut tau);
+                tau.clone()
+            };
+            check("∂τ/∂v", &column(&dv, nv, d), &difference(&mut along_v, h));
+        }
+        let mut crba_m = vec![0.0; nv * nv];
+        crba(&body, &mut ws, &q, &params, &mut crba_m);
+        assert_eq!(m, crba_m, "{name}: ∂τ/∂a is crba's M");
+
+        rnea(&body, &mut ws, &q, &v, &a, &params, &mut tau);
+        let (mut ddq, mut minv) = (vec![0.0; nv], vec![0.0; nv * nv]);
+        aba_derivatives(
+            &body, &mut dual8, &q, &v, &tau, &params, &armature, &mut ddq, &mut dq, &mut dv, &mut minv,
+        );
+        let mut plain = vec![0.0; nv];
+        aba(&body, &mut ws, &q, &v, &tau, &params, &armature, &mut plain);
+        assert_eq!(ddq, plain, "{name}: the derivatives' q̈ is aba's");
+        for d in 0..nv {
+            let mut along_q = |t: f64| {
+                aba(
+                    &body,
+                    &mut ws,
+                    &integrate(&body, &q, &unit(d), t),
+                    &v,
+                    &tau,
+                    &params,
+                    &armature,
+                    &mut plain,
+                );
+                plain.clone()
+            };
+            check("∂q̈/∂q", &column(&dq, nv, d), &difference(&mut along_q, h));
+            let mut along_v = |t: f64| {
+                aba(
+                    &body,
+                    &mut ws,
+                    &q,
+                    &shifted(&v, d, t),
+                    &tau,
+                    &params,
+                    &armature,
+                    &mut plain,
+                );
+                plain.clone()
+            };
+            check("∂q̈/∂v", &column(&dv, nv, d), &difference(&mut along_v, h));
+        }
+        // M⁻¹ (M + diag Ia) = E.
+        let product: Vec<f64> = (0..nv * nv)
+            .map(|rc| {
+                let (r, c) = (rc / nv, rc % nv);
+                (0..nv)
+                    .map(|k| minv[r * nv + k] * (crba_m[k * nv + c] + if k == c { armature[c] } else { 0.0 }))
+                    .sum()
+            })
+            .collect();
+        let identity: Vec<f64> = (0..nv * nv).map(|rc| f64::from(u8::from(rc / nv == rc % nv))).collect();
+        assert!(max_diff(&product, &identity) < 1e-9, "{name}: M⁻¹ (M + Ia)");
+
+        // J̇ and Ȧ_g along q̇ = v; the classical acceleration is d/dt of the frame's
+        // LOCAL_WORLD_ALIGNED velocity J(q(t)) (v + t a).
+        let frame = Se3 {
+            rotation: [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            translation: [0.05, -0.02, 0.1],
+        };
+        for reference in [
+            ReferenceFrame::World,
+            ReferenceFrame::Local,
+            ReferenceFrame::LocalWorldAligned,
+        ] {
+            let (mut jac, mut jac_dot) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+            frame_jacobian_time_variation(&body, &mut dual1, &q, &v, nb, &frame, reference, &mut jac, &mut jac_dot);
+            let mut along = |t: f64| {
+                let mut j = vec![0.0; 6 * nv];
+                compute_frame_jacobian(
+                    &body,
+                    &mut ws,
+                    &integrate(&body, &q, &v, t),
+                    nb,
+                    &frame,
+                    reference,
+                    &mut j,
+                );
+                j
+            };
+            check("J̇", &jac_dot, &difference(&mut along, h));
+        }
+        let mut along = |t: f64| {
+            let vt: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + a * t).collect();
+            body_motions(&body, &mut ws, &integrate(&body, &q, &v, t), &vt, &a);
+            frame_velocity(&body, &ws, nb, &frame, ReferenceFrame::LocalWorldAligned)
+                .to_array()
+                .to_vec()
+        };
+        let fd = difference(&mut along, h);
+        let acc = frame_classical_acceleration(
+            &body,
+            &mut dual1,
+            &q,
+            &v,
+            &a,
+            nb,
+            &frame,
+            ReferenceFrame::LocalWorldAligned,
+        );
+        check("classical acceleration", &acc.to_array(), &fd);
+        let (mut ag, mut ag_dot) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+        centroidal_map_time_variation(&body, &mut dual1, &q, &v, &params, &mut ag, &mut ag_dot);
+        let mut along = |t: f64| {
+            let mut x = vec![0.0; 6 * nv];
+            centroidal_map(&body, &mut ws, &integrate(&body, &q, &v, t), &params, &mut x);
+            x
+        };
+        check("Ȧ_g", &ag_dot, &difference(&mut along, h));
+        println!("{name}: worst relative difference {worst:.1e}");
+    }
 }

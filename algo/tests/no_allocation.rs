@@ -3,7 +3,9 @@
 //! under a free flyer: ball-free, but 6-coordinate root) and the planar mobile arm.
 
 use dyngen_algo::{
-    aba, compute_frame_jacobian, crba, forward_kinematics, frame_jacobian, joint_torque_regressor, rnea,
+    aba, aba_derivatives, body_motions, centroidal_map, centroidal_map_time_variation, com_jacobian,
+    compute_frame_jacobian, crba, forward_kinematics, frame_classical_acceleration, frame_jacobian,
+    frame_jacobian_time_variation, frame_velocity, joint_torque_regressor, rnea, rnea_derivatives, DualWorkspace,
     ReferenceFrame, Se3, Workspace,
 };
 use dyngen_model::{load_urdf_options, LoadOptions};
@@ -51,6 +53,17 @@ fn no_algorithm_allocates_per_call() {
         let params = body.params.clone();
         let armature = vec![0.01; nv];
         let frame = Se3::identity(0.0, 1.0);
+        let (mut dual8, mut dual1) = (
+            DualWorkspace::<f64, 8>::new(&body, ()),
+            DualWorkspace::<f64, 1>::new(&body, ()),
+        );
+        let [mut d1, mut d2, mut d3] = [(); 3].map(|_| vec![0.0; nv * nv]);
+        let (mut jac_dot, mut jcom, mut ag, mut ag_dot) = (
+            vec![0.0; 6 * nv],
+            vec![0.0; 3 * nv],
+            vec![0.0; 6 * nv],
+            vec![0.0; 6 * nv],
+        );
         assert_eq!(q.len(), nq);
         let before = ALLOCATIONS.load(Ordering::SeqCst);
         for _ in 0..3 {
@@ -69,6 +82,30 @@ fn no_algorithm_allocates_per_call() {
                 &mut jac,
             );
             joint_torque_regressor(&body, &mut ws, &q, &v, &a, &mut y);
+            rnea_derivatives(
+                &body, &mut dual8, &mut ws, &q, &v, &a, &params, &mut d1, &mut d2, &mut d3,
+            );
+            aba_derivatives(
+                &body, &mut dual8, &q, &v, &tau, &params, &armature, &mut qdd, &mut d1, &mut d2, &mut d3,
+            );
+            body_motions(&body, &mut ws, &q, &v, &a);
+            frame_velocity(&body, &ws, body.bodies(), &frame, ReferenceFrame::Local);
+            frame_classical_acceleration(&body, &mut dual1, &q, &v, &a, 1, &frame, ReferenceFrame::World);
+            let last = body.bodies();
+            frame_jacobian_time_variation(
+                &body,
+                &mut dual1,
+                &q,
+                &v,
+                last,
+                &frame,
+                ReferenceFrame::LocalWorldAligned,
+                &mut jac,
+                &mut jac_dot,
+            );
+            com_jacobian(&body, &mut ws, &q, &params, &mut jcom);
+            centroidal_map(&body, &mut ws, &q, &params, &mut ag);
+            centroidal_map_time_variation(&body, &mut dual1, &q, &v, &params, &mut ag, &mut ag_dot);
         }
         let after = ALLOCATIONS.load(Ordering::SeqCst);
         assert_eq!(

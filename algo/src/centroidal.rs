@@ -1,6 +1,6 @@
 //! The centre of mass, its Jacobian and the centroidal momentum matrix (Orin, Goswami
 //! and Lee, "Centroidal dynamics of a humanoid robot", 2013; Pinocchio's
-//! `centerOfMass`, `jacobianCenterOfMass`, `ccrba` and `dccrba`), from the bodies'
+//! `centerOfMass`, `jacobianCenterOfMass` and `ccrba`), from the bodies'
 //! inertias in the base frame summed over subtrees.
 
 use crate::dual::DualWorkspace;
@@ -106,7 +106,9 @@ pub fn centroidal_map<S: Real>(
 }
 
 /// `A_g(q)` and its time variation `Ȧ_g(q, v) = d/dt A_g(q(t))` along `q̇ = v` (each
-/// 6 × nv row-major), so that `ḣ_g = A_g a + Ȧ_g v`: Pinocchio's `dccrba`.
+/// 6 × nv row-major), so that `ḣ_g = A_g a + Ȧ_g v`. Pinocchio's `dccrba` gives
+/// another matrix with the same product with `v` (its angular rows leave out
+/// `ċ × A_lin`, whose product with `v` is `ċ × m ċ = 0`).
 /// [`centroidal_map`] run on [`crate::Dual`] numbers, one direction.
 ///
 /// # Panics

@@ -112,6 +112,36 @@ class Model:
     def frame_jacobian(self, q: ArrayLike, frame: str, reference: Reference = "local_world_aligned") -> Array:
         """A frame's Jacobian in ``"local_world_aligned"``, ``"local"`` or ``"world"``:
         (6, nv) or (N, 6, nv)."""
+    def frame_jacobian_time_variation(
+        self, q: ArrayLike, v: ArrayLike, frame: str, reference: Reference = "local_world_aligned"
+    ) -> Tuple[Array, Array]:
+        """A frame's Jacobian and its time variation d/dt J(q(t)) along dq/dt = v:
+        (6, nv) each, or (N, 6, nv)."""
+    def frame_velocity(self, q: ArrayLike, v: ArrayLike, frame: str, reference: Reference = "local_world_aligned") -> Array:
+        """A frame's spatial velocity [v; ω] in ``reference``: (6,) or (N, 6)."""
+    def frame_classical_acceleration(
+        self, q: ArrayLike, v: ArrayLike, a: ArrayLike, frame: str, reference: Reference = "local_world_aligned"
+    ) -> Array:
+        """A frame's classical acceleration (Pinocchio's getFrameClassicalAcceleration);
+        with a = 0 the drift J̇v: (6,) or (N, 6)."""
+    def rnea_derivatives(
+        self, q: ArrayLike, v: ArrayLike, a: ArrayLike, params: Optional[ArrayLike] = None
+    ) -> Tuple[Array, Array, Array]:
+        """(∂tau/∂q, ∂tau/∂v, M), each (nv, nv) or (N, nv, nv); ∂/∂q in the tangent space."""
+    def aba_derivatives(
+        self, q: ArrayLike, v: ArrayLike, tau: ArrayLike, params: Optional[ArrayLike] = None
+    ) -> Tuple[Array, Array, Array, Array]:
+        """(ddq, ∂ddq/∂q, ∂ddq/∂v, M⁻¹): (nv,) then (nv, nv) each, with a leading N for a batch."""
+    def center_of_mass(self, q: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """The centre of mass in the base frame: (3,) or (N, 3)."""
+    def com_jacobian(self, q: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """The centre of mass's Jacobian, base axes: (3, nv) or (N, 3, nv)."""
+    def centroidal_map(self, q: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
+        """The centroidal momentum matrix A_g (Pinocchio's ccrba): (6, nv) or (N, 6, nv)."""
+    def centroidal_map_time_variation(
+        self, q: ArrayLike, v: ArrayLike, params: Optional[ArrayLike] = None
+    ) -> Tuple[Array, Array]:
+        """A_g and d/dt A_g(q(t)) along dq/dt = v: (6, nv) each, or (N, 6, nv)."""
     def joint_wrenches(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
         """Each joint's wrench on its body, in the body frame: (nbodies, 6) or (N, nbodies, 6)."""
     def joint_torque_regressor(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Array:

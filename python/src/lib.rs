@@ -1,24 +1,27 @@
 //! The native module `dyngen._dyngen` of the Python package `dyngen`: a robot loaded
 //! at run time by `dyngen-model` (URDF or MJCF), its dynamics evaluated by
-//! `dyngen-algo` on `f64`, on numpy arrays.
+//! `dyngen-algo` on numpy arrays.
 //!
 //! Every algorithm takes one state (1-D arrays) or a batch (2-D arrays, one state per
 //! row). Inputs that are C-contiguous `float64` arrays are read in place, others are
 //! converted once; results are written into freshly allocated numpy arrays. The
-//! evaluation runs with the GIL released, a large batch split across threads
-//! (`std::thread::scope`), each thread with its own [`Workspace`], so that no state
-//! allocates. Bad input raises a Python exception naming the argument and, for a
+//! evaluation runs with the GIL released: one state on `f64`, a batch on SIMD lanes
+//! of eight states ([`dyngen::batch::Batch`]), split across threads for a large one,
+//! bit for bit the states one at a time. Every kernel is written once for both
+//! (the `evaluate!` macro). Bad input raises a Python exception naming the argument and, for a
 //! batch, the row. `identify` runs the identification pipeline of `dyngen identify`.
 
 mod identify;
 
-use dyngen_algo::{Multibody, ReferenceFrame, Se3, Workspace, PARAMS_PER_BODY};
+use dyngen::batch::{Batch, BatchError, Input, Layout, Output, Threads};
+use dyngen::lanes::F64x8;
+use dyngen_algo::{DualWorkspace, Multibody, Real, ReferenceFrame, Se3, Workspace, PARAMS_PER_BODY};
 use dyngen_model::{LoadOptions, Model};
 use numpy::{IxDyn, PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::{Mutex, OnceLock};
+use std::sync::Mutex;
 
 pyo3::create_exception!(
     dyngen,
@@ -28,9 +31,8 @@ pyo3::create_exception!(
      error as `file:line: message`."
 );
 
-/// A batch is split across threads only when every thread gets at least this many
-/// rows: below, starting a thread costs more than it saves.
-const MIN_ROWS_PER_THREAD: usize = 256;
+/// The lanes a batch is evaluated on: eight states per call.
+type Lane = F64x8;
 
 /// The valid names of the `reference` argument of the frame Jacobian.
 const REFERENCES: [(&str, ReferenceFrame); 3] = [
@@ -97,8 +99,9 @@ struct PyModel {
     /// Per frame of the model: its body and its placement in that body.
     frames: Vec<(usize, Se3<f64>)>,
     warnings: Vec<String>,
-    /// Workspaces made for `body`, reused across calls: one per thread in use.
-    pool: Mutex<Vec<Workspace<f64>>>,
+    /// States for one-state calls, made for `body` and reused across calls: one per
+    /// thread in use.
+    pool: Mutex<Vec<State<f64>>>,
     max_threads: Option<usize>,
 }
 
@@ -107,13 +110,6 @@ struct Arg<'a, 'py> {
     name: &'static str,
     value: &'a Bound<'py, PyAny>,
     width: usize,
-}
-
-/// The cores, read once: `available_parallelism` reads the cgroup's quota (microseconds)
-/// on every call.
-fn cores() -> usize {
-    static CORES: OnceLock<usize> = OnceLock::new();
-    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// The input `name`, `width` values per state.
@@ -139,7 +135,7 @@ struct Rows<'a> {
 }
 
 /// Why a row failed.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum RowFailure {
     /// Entry `index` of input `arg` in row `row` is not finite.
     Input {
@@ -149,17 +145,13 @@ enum RowFailure {
     },
     /// The result of row `row` is not finite.
     Output { row: usize },
+    /// The batch could not run (a thread the system refused).
+    Batch(String),
 }
 
 impl RowFailure {
-    fn row(&self) -> usize {
-        match *self {
-            RowFailure::Input { row, .. } | RowFailure::Output { row } => row,
-        }
-    }
-
-    fn message(&self, algorithm: &str, batch: bool) -> String {
-        match (*self, batch) {
+    fn error(&self, algorithm: &str, batch: bool) -> PyErr {
+        let message = match (self, batch) {
             (RowFailure::Input { arg, index, .. }, false) => {
                 format!("{algorithm}: `{arg}` has a non-finite entry at index {index}")
             }
@@ -172,7 +164,11 @@ impl RowFailure {
             (RowFailure::Output { row }, true) => format!(
                 "{algorithm}: the result of row {row} is not finite (a singular mass matrix, or inputs too large)"
             ),
-        }
+            (RowFailure::Batch(error), _) => {
+                return pyo3::exceptions::PyRuntimeError::new_err(format!("{algorithm}: {error}"))
+            }
+        };
+        PyValueError::new_err(message)
     }
 }
 
@@ -265,49 +261,79 @@ fn read_all<'py>(algorithm: &str, args: &[Arg<'_, 'py>]) -> PyResult<(Vec<Read<'
     Ok((read, rows))
 }
 
-/// Evaluates `kernel` on rows `start..start + count`, the outputs being those rows'
-/// slices of every output; stops at the first row with a non-finite input or result.
-fn run_chunk<const I: usize, const O: usize, F>(
-    workspace: &mut Workspace<f64>,
-    start: usize,
-    count: usize,
-    inputs: &[Rows<'_>; I],
-    mut outputs: [&mut [f64]; O],
-    widths: [usize; O],
-    kernel: &F,
-) -> Result<(), RowFailure>
-where
-    F: Fn(&mut Workspace<f64>, [&[f64]; I], [&mut [f64]; O]),
-{
-    for r in 0..count {
-        let row = start + r;
-        let ins: [&[f64]; I] = core::array::from_fn(|k| {
-            let w = inputs[k].width;
-            &inputs[k].data[row * w..(row + 1) * w]
-        });
-        for (k, x) in ins.iter().enumerate() {
-            if let Some(index) = x.iter().position(|v| !v.is_finite()) {
-                return Err(RowFailure::Input {
-                    row,
-                    arg: inputs[k].name,
-                    index,
-                });
-            }
-        }
-        let mut k = 0;
-        let outs = outputs.each_mut().map(|o| {
-            let w = widths[k];
-            k += 1;
-            &mut o[r * w..(r + 1) * w]
-        });
-        kernel(workspace, ins, outs);
-        for (o, w) in outputs.iter().zip(widths) {
-            if o[r * w..(r + 1) * w].iter().any(|v| !v.is_finite()) {
-                return Err(RowFailure::Output { row });
-            }
+/// What one thread keeps while it evaluates, in the scalar it evaluates on (`f64` for
+/// one state, [`Lane`] for a batch): the workspaces of the algorithms, the
+/// parameters, and `nv` zeros.
+struct State<S: Real> {
+    plain: Workspace<S>,
+    params: Vec<S>,
+    zero: Vec<S>,
+    /// Made on first use: the derivatives (8 directions per pass) and the time
+    /// variations (1 direction).
+    dual8: Option<DualWorkspace<S, 8>>,
+    dual1: Option<DualWorkspace<S, 1>>,
+}
+
+impl<S: Real<Context = ()>> State<S> {
+    fn new(body: &Multibody, params: &[f64]) -> Self {
+        State {
+            plain: Workspace::new(body, ()),
+            params: params.iter().map(|&x| S::constant((), x)).collect(),
+            zero: vec![S::constant((), 0.0); body.nv()],
+            dual8: None,
+            dual1: None,
         }
     }
-    Ok(())
+}
+
+/// The workspace of `slot`, made for `body` on first use.
+fn dual<'a, S: Real<Context = ()>, const N: usize>(
+    slot: &'a mut Option<DualWorkspace<S, N>>,
+    body: &Multibody,
+) -> &'a mut DualWorkspace<S, N> {
+    slot.get_or_insert_with(|| DualWorkspace::new(body, ()))
+}
+
+/// `x` in the numbers `S`.
+fn lift<S: Real<Context = ()>>(x: &Se3<f64>) -> Se3<S> {
+    Se3 {
+        rotation: x.rotation.map(|row| row.map(|e| S::constant((), e))),
+        translation: x.translation.map(|e| S::constant((), e)),
+    }
+}
+
+/// The first row (then argument, then entry) of the inputs that is not finite.
+fn first_non_finite(inputs: &[Rows<'_>], rows: usize) -> Option<RowFailure> {
+    (0..rows).find_map(|row| {
+        inputs.iter().find_map(|x| {
+            let values = &x.data[row * x.width..(row + 1) * x.width];
+            values
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|index| RowFailure::Input {
+                    row,
+                    arg: x.name,
+                    index,
+                })
+        })
+    })
+}
+
+/// [`PyModel::evaluate`] with its kernel written once for both scalars: `f64` for one
+/// state, [`Lane`] for a batch.
+macro_rules! evaluate {
+    ($model:expr, $py:expr, $algorithm:expr, $params:expr, [$($arg:expr),* $(,)?], [$($out:expr),* $(,)?],
+     |$state:ident, [$($i:ident),*], [$($o:ident),*]| $body:expr) => {
+        $model.evaluate(
+            $py,
+            $algorithm,
+            $params,
+            [$($arg),*],
+            [$($out),*],
+            |$state, [$($i),*], [$($o),*]| $body,
+            |$state, [$($i),*], [$($o),*]| $body,
+        )
+    };
 }
 
 impl PyModel {
@@ -342,14 +368,14 @@ impl PyModel {
         PARAMS_PER_BODY * self.body.bodies()
     }
 
-    fn take_workspace(&self) -> Workspace<f64> {
-        // A poisoned pool only lost workspaces; take it over as it is.
+    fn take_state(&self) -> State<f64> {
+        // A poisoned pool only lost states; take it over as it is.
         let taken = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
-        taken.unwrap_or_else(|| Workspace::new(&self.body, ()))
+        taken.unwrap_or_else(|| State::new(&self.body, &self.body.params))
     }
 
-    fn give_back(&self, workspaces: impl IntoIterator<Item = Workspace<f64>>) {
-        self.pool.lock().unwrap_or_else(|e| e.into_inner()).extend(workspaces);
+    fn give_back(&self, state: State<f64>) {
+        self.pool.lock().unwrap_or_else(|e| e.into_inner()).push(state);
     }
 
     /// The frame named `frame`: its body and its placement there.
@@ -395,20 +421,29 @@ impl PyModel {
         Ok(Some(array))
     }
 
-    /// Runs `kernel` on every state of the inputs `args` (one state or a batch), with
-    /// the GIL released and a large batch split across threads, into new arrays of
-    /// the per-state shapes `outputs` (with a leading `N` for a batch).
-    fn evaluate<'py, const I: usize, const O: usize, F>(
+    /// Runs a kernel on every state of the inputs `args` (one state or a batch) with
+    /// the parameters `params` (the model's for `None`), with the GIL released, into
+    /// new arrays of the per-state shapes `outputs` (with a leading `N` for a batch).
+    /// One state runs `one` on `f64` (in a pooled [`State`]); a batch runs `lanes` on
+    /// [`Lane`]s, eight states per call, split across threads by
+    /// [`dyngen::batch::Batch`]: bit for bit the per-state results. Non-finite inputs
+    /// and results are refused, naming the first such row.
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate<'py, const I: usize, const O: usize, F, L>(
         &self,
         py: Python<'py>,
         algorithm: &str,
+        params: Option<&[f64]>,
         args: [Arg<'_, 'py>; I],
         outputs: [&[usize]; O],
-        kernel: F,
+        one: F,
+        lanes: L,
     ) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; O]>
     where
-        F: Fn(&mut Workspace<f64>, [&[f64]; I], [&mut [f64]; O]) + Sync,
+        F: Fn(&mut State<f64>, [&[f64]; I], [&mut [f64]; O]) + Sync,
+        L: Fn(&mut State<Lane>, [&[Lane]; I], [&mut [Lane]; O]) + Sync,
     {
+        let params = params.unwrap_or(&self.body.params);
         let (read, batch) = read_all(algorithm, &args)?;
         let rows = batch.unwrap_or(1);
         let mut data: Vec<Rows<'_>> = Vec::with_capacity(I);
@@ -419,7 +454,6 @@ impl PyModel {
                 width: r.width,
             });
         }
-        let inputs: [Rows<'_>; I] = core::array::from_fn(|k| data[k]);
         let arrays = outputs.map(|dims| {
             let shape: Vec<usize> = batch.into_iter().chain(dims.iter().copied()).collect();
             PyArrayDyn::<f64>::zeros(py, IxDyn(&shape), false)
@@ -439,71 +473,96 @@ impl PyModel {
                     .map_err(|e| PyValueError::new_err(format!("{algorithm}: result not writable: {e}")))?,
             );
         }
-        let Ok(slices) = <[&mut [f64]; O]>::try_from(slices) else {
+        let Ok(mut slices) = <[&mut [f64]; O]>::try_from(slices) else {
             unreachable!("one slice per output")
         };
-        let max_threads = self.max_threads;
+        // At most `max_threads`, each with a full share of states.
+        let most = (rows / Batch::<Lane>::STATES_PER_THREAD).max(1);
+        let threads = self.max_threads.map_or(Threads::Auto, |t| Threads::Count(t.min(most)));
+        let body = &self.body;
         let result = py.detach(|| {
-            // The core count is read only for a batch that can be split.
-            let threads = if rows < 2 * MIN_ROWS_PER_THREAD || max_threads == Some(1) {
-                1
-            } else {
-                let cores = max_threads.unwrap_or_else(cores);
-                cores.min(rows / MIN_ROWS_PER_THREAD).max(1)
-            };
-            if threads == 1 {
-                let mut ws = self.take_workspace();
-                let out = run_chunk(&mut ws, 0, rows, &inputs, slices, widths, &kernel);
-                self.give_back([ws]);
-                return out;
+            if let Some(failure) = first_non_finite(&data, rows) {
+                return Err(failure);
             }
-            let chunk = rows.div_ceil(threads);
-            let mut rest = slices;
-            std::thread::scope(|s| {
-                let mut handles = Vec::with_capacity(threads);
-                let mut start = 0;
-                while start < rows {
-                    let count = chunk.min(rows - start);
-                    let mut k = 0;
-                    let mine = rest.each_mut().map(|r| {
-                        let (head, tail) = std::mem::take(r).split_at_mut(count * widths[k]);
-                        *r = tail;
-                        k += 1;
-                        head
-                    });
-                    let mut ws = self.take_workspace();
-                    let (inputs, kernel) = (&inputs, &kernel);
-                    handles.push(s.spawn(move || {
-                        let out = run_chunk(&mut ws, start, count, inputs, mine, widths, kernel);
-                        (ws, out)
-                    }));
-                    start += count;
+            let inputs: [&[f64]; I] = core::array::from_fn(|k| data[k].data);
+            if batch.is_none() {
+                let mut state = self.take_state();
+                state.params.copy_from_slice(params);
+                one(&mut state, inputs, slices.each_mut().map(|s| &mut **s));
+                self.give_back(state);
+                return match slices.iter().all(|s| s.iter().all(|x| x.is_finite())) {
+                    true => Ok(()),
+                    false => Err(RowFailure::Output { row: 0 }),
+                };
+            }
+            let ins: [Input<'_, f64>; I] = core::array::from_fn(|k| Input {
+                name: data[k].name,
+                data: data[k].data,
+                width: data[k].width,
+            });
+            let mut k = 0;
+            let mut outs = slices.map(|data| {
+                k += 1;
+                Output {
+                    name: "result",
+                    data,
+                    width: widths[k - 1],
                 }
-                // Each thread stops at its first failure; report the earliest row.
-                let mut first: Option<RowFailure> = None;
-                for h in handles {
-                    let (ws, out) = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-                    self.give_back([ws]);
-                    if let Err(f) = out {
-                        if first.is_none_or(|g| f.row() < g.row()) {
-                            first = Some(f);
-                        }
-                    }
-                }
-                first.map_or(Ok(()), Err)
-            })
+            });
+            Batch::<Lane>::new(rows, Layout::Rows)
+                .threads(threads)
+                .apply_with(
+                    &ins,
+                    &mut outs,
+                    || State::<Lane>::new(body, params),
+                    |state, x, y| {
+                        let x: [&[Lane]; I] = core::array::from_fn(|k| x[k].as_slice());
+                        let Ok(y) = <&mut [Vec<Lane>; O]>::try_from(y) else {
+                            unreachable!("one output per array")
+                        };
+                        lanes(state, x, y.each_mut().map(|y| y.as_mut_slice()));
+                    },
+                )
+                .map_err(|e| match e {
+                    BatchError::NonFinite { state, .. } => RowFailure::Output { row: state },
+                    other => RowFailure::Batch(other.to_string()),
+                })
         });
         drop(guards);
-        result.map_err(|f| PyValueError::new_err(f.message(algorithm, batch.is_some())))?;
+        result.map_err(|f| f.error(algorithm, batch.is_some()))?;
         Ok(arrays)
     }
 }
 
 /// Rotations and translations, as numpy arrays.
 type Placements<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+/// Two and three matrices (or batches of them), as numpy arrays.
+type Matrices2<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+type Matrices3<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+);
+type Arrays4<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+);
+
+/// The reference frame named `name`.
+fn reference_frame(algorithm: &str, name: &str) -> PyResult<ReferenceFrame> {
+    match REFERENCES.iter().find(|(n, _)| *n == name) {
+        Some(&(_, reference)) => Ok(reference),
+        None => Err(PyValueError::new_err(format!(
+            "{algorithm}: unknown reference `{name}`; it must be one of: {}",
+            REFERENCES.map(|(n, _)| n).join(", ")
+        ))),
+    }
+}
 
 /// Copies the `Se3` `x` into a row-major rotation (9 entries) and a translation (3).
-fn write_se3(x: &Se3<f64>, rotation: &mut [f64], translation: &mut [f64]) {
+fn write_se3<S: Copy>(x: &Se3<S>, rotation: &mut [S], translation: &mut [S]) {
     for r in 0..3 {
         rotation[3 * r..3 * r + 3].copy_from_slice(&x.rotation[r]);
     }
@@ -596,7 +655,7 @@ impl PyModel {
 
     /// The most threads a batch is split across; `None` (the default) uses every
     /// core `std::thread::available_parallelism` reports. A batch is split only when
-    /// every thread gets at least 256 states; results do not depend on the split.
+    /// every thread gets at least 512 states; results do not depend on the split.
     #[getter]
     fn max_threads(&self) -> Option<usize> {
         self.max_threads
@@ -646,18 +705,16 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("rnea", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [tau] = self.evaluate(
+        let [tau] = evaluate!(
+            self,
             py,
             "rnea",
+            p,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv]],
-            |ws, [q, v, a], [tau]| dyngen_algo::rnea(body, ws, q, v, a, p, tau),
+            |st, [q, v, a], [tau]| dyngen_algo::rnea(body, &mut st.plain, q, v, a, &st.params, tau)
         )?;
         Ok(tau)
     }
@@ -680,19 +737,16 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("nonlinear_effects", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let zero = vec![0.0; nv];
-        let [h] = self.evaluate(
+        let [h] = evaluate!(
+            self,
             py,
             "nonlinear_effects",
+            p,
             [arg("q", q, nq), arg("v", v, nv)],
             [&[nv]],
-            |ws, [q, v], [h]| dyngen_algo::rnea(body, ws, q, v, &zero, p, h),
+            |st, [q, v], [h]| dyngen_algo::rnea(body, &mut st.plain, q, v, &st.zero, &st.params, h)
         )?;
         Ok(h)
     }
@@ -713,16 +767,17 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("generalized_gravity", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let zero = vec![0.0; nv];
-        let [g] = self.evaluate(py, "generalized_gravity", [arg("q", q, nq)], [&[nv]], |ws, [q], [g]| {
-            dyngen_algo::rnea(body, ws, q, &zero, &zero, p, g)
-        })?;
+        let [g] = evaluate!(
+            self,
+            py,
+            "generalized_gravity",
+            p,
+            [arg("q", q, nq)],
+            [&[nv]],
+            |st, [q], [g]| dyngen_algo::rnea(body, &mut st.plain, q, &st.zero, &st.zero, &st.params, g)
+        )?;
         Ok(g)
     }
 
@@ -743,14 +798,10 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("crba", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [m] = self.evaluate(py, "crba", [arg("q", q, nq)], [&[nv, nv]], |ws, [q], [m]| {
-            dyngen_algo::crba(body, ws, q, p, m)
+        let [m] = evaluate!(self, py, "crba", p, [arg("q", q, nq)], [&[nv, nv]], |st, [q], [m]| {
+            dyngen_algo::crba(body, &mut st.plain, q, &st.params, m)
         })?;
         Ok(m)
     }
@@ -779,20 +830,102 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("aba", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [qdd] = self.evaluate(
+        let [qdd] = evaluate!(
+            self,
             py,
             "aba",
+            p,
             [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
             [&[nv]],
-            |ws, [q, v, tau], [qdd]| dyngen_algo::aba(body, ws, q, v, tau, p, &[], qdd),
+            |st, [q, v, tau], [qdd]| dyngen_algo::aba(body, &mut st.plain, q, v, tau, &st.params, &[], qdd)
         )?;
         Ok(qdd)
+    }
+
+    /// The derivatives of inverse dynamics at `(q, v, a)` (Pinocchio's
+    /// `computeRNEADerivatives`): `∂tau/∂q` (in the tangent space: a free flyer's or
+    /// a ball joint's columns along its own angular velocity, as `v`), `∂tau/∂v` and
+    /// `∂tau/∂a = M(q)`. Exact to rounding: rnea itself run on dual numbers.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v, a: shape (nv,) or (N, nv).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     (dtau_dq, dtau_dv, M), each shape (nv, nv) or (N, nv, nv), row `i` the
+    ///     derivatives of `tau[i]`.
+    #[pyo3(signature = (q, v, a, params = None))]
+    fn rnea_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Matrices3<'py>> {
+        let p = self.read_params("rnea_derivatives", params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [dq, dv, m] = evaluate!(
+            self,
+            py,
+            "rnea_derivatives",
+            p,
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
+            [&[nv, nv], &[nv, nv], &[nv, nv]],
+            |st, [q, v, a], [dq, dv, m]| {
+                let State {
+                    plain, params, dual8, ..
+                } = st;
+                dyngen_algo::rnea_derivatives(body, dual(dual8, body), plain, q, v, a, params, dq, dv, m)
+            }
+        )?;
+        Ok((dq, dv, m))
+    }
+
+    /// Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):
+    /// `ddq = aba(q, v, tau)`, `∂ddq/∂q` (in the tangent space), `∂ddq/∂v` and
+    /// `∂ddq/∂tau = M(q)⁻¹`. Exact to rounding: aba itself run on dual numbers.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v, tau: shape (nv,) or (N, nv).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     (ddq, ddq_dq, ddq_dv, Minv): shape (nv,) then three (nv, nv), with a
+    ///     leading N for a batch.
+    ///
+    /// Raises:
+    ///     ValueError: also where `M(q)` is singular (the result is not finite).
+    #[pyo3(signature = (q, v, tau, params = None))]
+    fn aba_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Arrays4<'py>> {
+        let p = self.read_params("aba_derivatives", params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [ddq, dq, dv, minv] = evaluate!(
+            self,
+            py,
+            "aba_derivatives",
+            p,
+            [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
+            [&[nv], &[nv, nv], &[nv, nv], &[nv, nv]],
+            |st, [q, v, tau], [ddq, dq, dv, minv]| {
+                let State { params, dual8, .. } = st;
+                dyngen_algo::aba_derivatives(body, dual(dual8, body), q, v, tau, params, &[], ddq, dq, dv, minv)
+            }
+        )?;
+        Ok((ddq, dq, dv, minv))
     }
 
     /// Every moving body's placement in the base frame, body 1 first (the order of
@@ -806,17 +939,23 @@ impl PyModel {
     ///     (nbodies, 3), or (N, nbodies, 3, 3) and (N, nbodies, 3).
     fn forward_kinematics<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Placements<'py>> {
         let (body, nq, nb) = (&self.body, self.body.nq(), self.body.bodies());
-        let [r, t] = self.evaluate(
+        let [r, t] = evaluate!(
+            self,
             py,
             "forward_kinematics",
+            None,
             [arg("q", q, nq)],
             [&[nb, 3, 3], &[nb, 3]],
-            |ws, [q], [r, t]| {
-                dyngen_algo::forward_kinematics(body, ws, q);
+            |st, [q], [r, t]| {
+                dyngen_algo::forward_kinematics(body, &mut st.plain, q);
                 for i in 0..nb {
-                    write_se3(&ws.world[i + 1], &mut r[9 * i..9 * i + 9], &mut t[3 * i..3 * i + 3]);
+                    write_se3(
+                        &st.plain.world[i + 1],
+                        &mut r[9 * i..9 * i + 9],
+                        &mut t[3 * i..3 * i + 3],
+                    );
                 }
-            },
+            }
         )?;
         Ok((r, t))
     }
@@ -832,15 +971,17 @@ impl PyModel {
     fn frame_placement<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, frame: &str) -> PyResult<Placements<'py>> {
         let (index, offset) = self.frame("frame_placement", frame)?;
         let (body, nq) = (&self.body, self.body.nq());
-        let [r, t] = self.evaluate(
+        let [r, t] = evaluate!(
+            self,
             py,
             "frame_placement",
+            None,
             [arg("q", q, nq)],
             [&[3, 3], &[3]],
-            |ws, [q], [r, t]| {
-                dyngen_algo::forward_kinematics(body, ws, q);
-                write_se3(&ws.world[index].compose(&offset), r, t);
-            },
+            |st, [q], [r, t]| {
+                dyngen_algo::forward_kinematics(body, &mut st.plain, q);
+                write_se3(&st.plain.world[index].compose(&lift(&offset)), r, t);
+            }
         )?;
         Ok((r, t))
     }
@@ -866,17 +1007,278 @@ impl PyModel {
         reference: &str,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (index, offset) = self.frame("frame_jacobian", frame)?;
-        let Some(&(_, reference)) = REFERENCES.iter().find(|(name, _)| *name == reference) else {
-            return Err(PyValueError::new_err(format!(
-                "frame_jacobian: unknown reference `{reference}`; it must be one of: {}",
-                REFERENCES.map(|(name, _)| name).join(", ")
-            )));
-        };
+        let reference = reference_frame("frame_jacobian", reference)?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [j] = self.evaluate(py, "frame_jacobian", [arg("q", q, nq)], [&[6, nv]], |ws, [q], [j]| {
-            dyngen_algo::compute_frame_jacobian(body, ws, q, index, &offset, reference, j)
-        })?;
+        let [j] = evaluate!(
+            self,
+            py,
+            "frame_jacobian",
+            None,
+            [arg("q", q, nq)],
+            [&[6, nv]],
+            |st, [q], [j]| dyngen_algo::compute_frame_jacobian(body, &mut st.plain, q, index, &offset, reference, j)
+        )?;
         Ok(j)
+    }
+
+    /// A frame's Jacobian and its time variation `dJ = d/dt J(q(t))` along `dq/dt = v`
+    /// (Pinocchio's `getFrameJacobianTimeVariation`), in `reference`.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v: shape (nv,) or (N, nv).
+    ///     frame: a name of `frame_names`.
+    ///     reference: as `frame_jacobian`.
+    ///
+    /// Returns:
+    ///     (J, dJ), each shape (6, nv) or (N, 6, nv).
+    #[pyo3(signature = (q, v, frame, reference = "local_world_aligned"))]
+    fn frame_jacobian_time_variation<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+    ) -> PyResult<Matrices2<'py>> {
+        let name = "frame_jacobian_time_variation";
+        let (index, offset) = self.frame(name, frame)?;
+        let reference = reference_frame(name, reference)?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [j, dj] = evaluate!(
+            self,
+            py,
+            name,
+            None,
+            [arg("q", q, nq), arg("v", v, nv)],
+            [&[6, nv], &[6, nv]],
+            |st, [q, v], [j, dj]| {
+                let d = dual(&mut st.dual1, body);
+                dyngen_algo::frame_jacobian_time_variation(body, d, q, v, index, &offset, reference, j, dj)
+            }
+        )?;
+        Ok((j, dj))
+    }
+
+    /// A frame's spatial velocity `[v; ω]` in `reference` (Pinocchio's
+    /// `getFrameVelocity`): in `"local_world_aligned"` the velocity of its origin and
+    /// its angular velocity, in the base's axes.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v: shape (nv,) or (N, nv).
+    ///     frame: a name of `frame_names`.
+    ///     reference: as `frame_jacobian`.
+    ///
+    /// Returns:
+    ///     shape (6,) or (N, 6).
+    #[pyo3(signature = (q, v, frame, reference = "local_world_aligned"))]
+    fn frame_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (index, offset) = self.frame("frame_velocity", frame)?;
+        let reference = reference_frame("frame_velocity", reference)?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [out] = evaluate!(
+            self,
+            py,
+            "frame_velocity",
+            None,
+            [arg("q", q, nq), arg("v", v, nv)],
+            [&[6]],
+            |st, [q, v], [out]| {
+                let State { plain, zero, .. } = st;
+                dyngen_algo::body_motions(body, plain, q, v, zero);
+                out.copy_from_slice(&dyngen_algo::frame_velocity(body, plain, index, &offset, reference).to_array());
+            }
+        )?;
+        Ok(out)
+    }
+
+    /// A frame's classical acceleration (Pinocchio's `getFrameClassicalAcceleration`):
+    /// in `"local_world_aligned"` the second derivative of its origin and the
+    /// derivative of its angular velocity, in the base's axes; in `"local"` the same
+    /// in its own axes; in `"world"` those of the body-fixed point at the base's
+    /// origin. With `a = 0` it is the drift `dJ v` of `"local_world_aligned"`.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v, a: shape (nv,) or (N, nv).
+    ///     frame: a name of `frame_names`.
+    ///     reference: as `frame_jacobian`.
+    ///
+    /// Returns:
+    ///     shape (6,) or (N, 6), `[linear; angular]`.
+    #[pyo3(signature = (q, v, a, frame, reference = "local_world_aligned"))]
+    #[allow(clippy::too_many_arguments)]
+    fn frame_classical_acceleration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let name = "frame_classical_acceleration";
+        let (index, offset) = self.frame(name, frame)?;
+        let reference = reference_frame(name, reference)?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [out] = evaluate!(
+            self,
+            py,
+            name,
+            None,
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
+            [&[6]],
+            |st, [q, v, a], [out]| {
+                let d = dual(&mut st.dual1, body);
+                let acc = dyngen_algo::frame_classical_acceleration(body, d, q, v, a, index, &offset, reference);
+                out.copy_from_slice(&acc.to_array());
+            }
+        )?;
+        Ok(out)
+    }
+
+    /// The centre of mass of the moving bodies in the base frame (Pinocchio's
+    /// `centerOfMass`).
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     shape (3,) or (N, 3).
+    #[pyo3(signature = (q, params = None))]
+    fn center_of_mass<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let p = self.read_params("center_of_mass", params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq) = (&self.body, self.body.nq());
+        let [c] = evaluate!(
+            self,
+            py,
+            "center_of_mass",
+            p,
+            [arg("q", q, nq)],
+            [&[3]],
+            |st, [q], [c]| c.copy_from_slice(&dyngen_algo::center_of_mass(body, &mut st.plain, q, &st.params))
+        )?;
+        Ok(c)
+    }
+
+    /// The Jacobian of the centre of mass (Pinocchio's `jacobianCenterOfMass`): its
+    /// velocity is `J v`, in the base's axes.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     shape (3, nv) or (N, 3, nv).
+    #[pyo3(signature = (q, params = None))]
+    fn com_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let p = self.read_params("com_jacobian", params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [j] = evaluate!(
+            self,
+            py,
+            "com_jacobian",
+            p,
+            [arg("q", q, nq)],
+            [&[3, nv]],
+            |st, [q], [j]| {
+                dyngen_algo::com_jacobian(body, &mut st.plain, q, &st.params, j);
+            }
+        )?;
+        Ok(j)
+    }
+
+    /// The centroidal momentum matrix `A_g` (Pinocchio's `ccrba`): the centroidal
+    /// momentum `[linear; angular]` (the angular part about the centre of mass, the
+    /// base's axes) is `A_g v`.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     shape (6, nv) or (N, 6, nv).
+    #[pyo3(signature = (q, params = None))]
+    fn centroidal_map<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let p = self.read_params("centroidal_map", params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [ag] = evaluate!(
+            self,
+            py,
+            "centroidal_map",
+            p,
+            [arg("q", q, nq)],
+            [&[6, nv]],
+            |st, [q], [ag]| {
+                dyngen_algo::centroidal_map(body, &mut st.plain, q, &st.params, ag);
+            }
+        )?;
+        Ok(ag)
+    }
+
+    /// `A_g` and its time variation `dA_g = d/dt A_g(q(t))` along `dq/dt = v`: the
+    /// rate of the centroidal momentum is `A_g a + dA_g v`. (Pinocchio's `dccrba`
+    /// gives another matrix with the same product with `v`.)
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v: shape (nv,) or (N, nv).
+    ///     params: standard parameters, shape (10 * nbodies,); the model's by default.
+    ///
+    /// Returns:
+    ///     (A_g, dA_g), each shape (6, nv) or (N, 6, nv).
+    #[pyo3(signature = (q, v, params = None))]
+    fn centroidal_map_time_variation<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Matrices2<'py>> {
+        let name = "centroidal_map_time_variation";
+        let p = self.read_params(name, params)?;
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
+        let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
+        let [ag, ag_dot] = evaluate!(
+            self,
+            py,
+            name,
+            p,
+            [arg("q", q, nq), arg("v", v, nv)],
+            [&[6, nv], &[6, nv]],
+            |st, [q, v], [ag, ag_dot]| {
+                let State { params, dual1, .. } = st;
+                dyngen_algo::centroidal_map_time_variation(body, dual(dual1, body), q, v, params, ag, ag_dot)
+            }
+        )?;
+        Ok((ag, ag_dot))
     }
 
     /// The wrench each joint applies to the body it carries, in that body's frame
@@ -900,25 +1302,23 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let p = self.read_params("joint_wrenches", params)?;
-        let p = p
-            .as_ref()
-            .map(|p| slice(p, "params"))
-            .transpose()?
-            .unwrap_or(&self.body.params);
+        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv, nb) = (&self.body, self.body.nq(), self.body.nv(), self.body.bodies());
-        let [f] = self.evaluate(
+        let [f] = evaluate!(
+            self,
             py,
             "joint_wrenches",
+            p,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nb, 6]],
-            |ws, [q, v, a], [f]| {
+            |st, [q, v, a], [f]| {
                 // The torques go to the result's first nv entries (nv ≤ 6 nbodies: no
                 // joint has more than 6 velocities), then the wrenches over them.
-                dyngen_algo::rnea(body, ws, q, v, a, p, &mut f[..nv]);
+                dyngen_algo::rnea(body, &mut st.plain, q, v, a, &st.params, &mut f[..nv]);
                 for i in 0..nb {
-                    f[6 * i..6 * i + 6].copy_from_slice(&ws.force[i + 1].to_array());
+                    f[6 * i..6 * i + 6].copy_from_slice(&st.plain.force[i + 1].to_array());
                 }
-            },
+            }
         )?;
         Ok(f)
     }
@@ -940,12 +1340,14 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (body, nq, nv, np) = (&self.body, self.body.nq(), self.body.nv(), self.nparams());
-        let [y] = self.evaluate(
+        let [y] = evaluate!(
+            self,
             py,
             "joint_torque_regressor",
+            None,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv, np]],
-            |ws, [q, v, a], [y]| dyngen_algo::joint_torque_regressor(body, ws, q, v, a, y),
+            |st, [q, v, a], [y]| dyngen_algo::joint_torque_regressor(body, &mut st.plain, q, v, a, y)
         )?;
         Ok(y)
     }
@@ -967,12 +1369,14 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (body, nq, nv, np) = (&self.body, self.body.nq(), self.body.nv(), self.nparams());
-        let [w] = self.evaluate(
+        let [w] = evaluate!(
+            self,
             py,
             "joint_wrench_regressor",
+            None,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[6 * self.body.bodies(), np]],
-            |ws, [q, v, a], [w]| dyngen_algo::joint_wrench_regressor(body, ws, q, v, a, w),
+            |st, [q, v, a], [w]| dyngen_algo::joint_wrench_regressor(body, &mut st.plain, q, v, a, w)
         )?;
         Ok(w)
     }

@@ -6,8 +6,11 @@ import pytest
 
 from conftest import random_states
 
-# A batch large enough to be split: at least 256 states per thread.
+# A batch large enough to be split: at least 512 states per thread.
 ROWS = 1200
+# The derivatives (dual numbers, many times the work of one evaluation): more than
+# one group of lanes and a partial last one, on one thread.
+HEAVY_ROWS = 43
 
 
 def one_by_one(f, *batches):
@@ -47,6 +50,15 @@ def algorithms(robot):
         "joint_wrenches": (robot.joint_wrenches, 3),
         "joint_torque_regressor": (robot.joint_torque_regressor, 3),
         "joint_wrench_regressor": (robot.joint_wrench_regressor, 3),
+        "rnea_derivatives": (robot.rnea_derivatives, 3),
+        "aba_derivatives": (robot.aba_derivatives, 3),
+        "frame_velocity": (lambda q, v: robot.frame_velocity(q, v, frame, "local"), 2),
+        "frame_classical_acceleration": (lambda q, v, a: robot.frame_classical_acceleration(q, v, a, frame, "world"), 3),
+        "frame_jacobian_time_variation": (lambda q, v: robot.frame_jacobian_time_variation(q, v, frame), 2),
+        "center_of_mass": (robot.center_of_mass, 1),
+        "com_jacobian": (robot.com_jacobian, 1),
+        "centroidal_map": (robot.centroidal_map, 1),
+        "centroidal_map_time_variation": (robot.centroidal_map_time_variation, 2),
     }
 
 
@@ -65,14 +77,28 @@ ALGORITHMS = [
     "joint_wrenches",
     "joint_torque_regressor",
     "joint_wrench_regressor",
+    "rnea_derivatives",
+    "aba_derivatives",
+    "frame_velocity",
+    "frame_classical_acceleration",
+    "frame_jacobian_time_variation",
+    "center_of_mass",
+    "com_jacobian",
+    "centroidal_map",
+    "centroidal_map_time_variation",
 ]
 
 
-@pytest.mark.parametrize("algorithm", ALGORITHMS)
-@pytest.mark.parametrize("threads", [1, 2, 4])
+@pytest.mark.parametrize(
+    "algorithm, threads",
+    [(a, t) for a in ALGORITHMS for t in (1, 2, 4) if t == 1 or "derivatives" not in a],
+)
 def test_batch_equals_loop(robot, algorithm, threads):
     f, arity = algorithms(robot)[algorithm]
-    rows = ROWS if robot.nv < 20 or "regressor" not in algorithm else 600
+    if "derivatives" in algorithm:
+        rows = HEAVY_ROWS
+    else:
+        rows = ROWS if robot.nv < 20 or "regressor" not in algorithm else 600
     states = random_states(robot, rows, np.random.default_rng(1))[:arity]
     robot.max_threads = threads
     try:
@@ -128,3 +154,12 @@ def test_shapes(robot):
     assert r.shape == (3, 3) and t.shape == (3,)
     assert robot.frame_jacobian(q, robot.frame_names[-1]).shape == (3, 6, nv)
     assert robot.neutral().shape == (nq,)
+    assert [x.shape for x in robot.rnea_derivatives(q, v, a)] == [(3, nv, nv)] * 3
+    assert [x.shape for x in robot.aba_derivatives(q[0], v[0], a[0])] == [(nv,)] + [(nv, nv)] * 3
+    assert robot.frame_velocity(q[0], v[0], robot.frame_names[-1]).shape == (6,)
+    assert robot.frame_classical_acceleration(q, v, a, robot.frame_names[-1]).shape == (3, 6)
+    assert [x.shape for x in robot.frame_jacobian_time_variation(q, v, robot.frame_names[-1])] == [(3, 6, nv)] * 2
+    assert robot.center_of_mass(q).shape == (3, 3)
+    assert robot.com_jacobian(q[0]).shape == (3, nv)
+    assert robot.centroidal_map(q).shape == (3, 6, nv)
+    assert [x.shape for x in robot.centroidal_map_time_variation(q[0], v[0])] == [(6, nv)] * 2

@@ -83,6 +83,22 @@ def test_unknown_reference(ur5, state):
         ur5.frame_jacobian(state[0][0], "tool0", reference="base")
 
 
+def test_unknown_reference_of_the_frame_motions(ur5, state):
+    q, v, a = state
+    for call in (lambda: ur5.frame_velocity(q[0], v[0], "tool0", "base"),
+                 lambda: ur5.frame_classical_acceleration(q[0], v[0], a[0], "tool0", "base"),
+                 lambda: ur5.frame_jacobian_time_variation(q[0], v[0], "tool0", "base")):
+        with pytest.raises(ValueError, match=re.escape("unknown reference `base`; it must be one of")):
+            call()
+
+
+def test_singular_mass_matrix_in_the_derivatives(ur5, state):
+    q, v, a = state
+    massless = np.zeros_like(ur5.params)
+    with pytest.raises(ValueError, match=re.escape("aba_derivatives: the result of row 0 is not finite")):
+        ur5.aba_derivatives(q, v, a, params=massless)
+
+
 def test_params_wrong_length(ur5, state):
     q, v, a = state
     with pytest.raises(ValueError, match=re.escape("rnea: `params` must have shape (60,) (10 per body, 6 bodies); found shape (59,)")):

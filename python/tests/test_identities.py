@@ -56,6 +56,32 @@ def test_jacobian_matches_placements(robot):
     close((t_plus - t_minus) / (2 * h), j[:3, -1], 1e-7)
 
 
+def test_derivatives_and_time_variations_are_differences(ur5):
+    """On the UR5 (one coordinate per joint, so `q + t v` is the motion): ∂τ/∂q and
+    ∂q̈/∂q, J̇ and Ȧ_g against central differences; ∂τ/∂a is M, M⁻¹ inverts it, and the
+    classical acceleration with a = 0 is J̇ v in LOCAL_WORLD_ALIGNED."""
+    q, v, a = (x[0] for x in random_states(ur5, 1, np.random.default_rng(3)))
+    h, frame = 1e-6, "tool0"
+    dq, dv, m = ur5.rnea_derivatives(q, v, a)
+    assert np.array_equal(m, ur5.crba(q))
+    along = lambda f, x, d: (f(x + h * d) - f(x - h * d)) / (2 * h)
+    for k in range(ur5.nv):
+        e = np.eye(ur5.nv)[k]
+        close(dq[:, k], along(lambda x: ur5.rnea(x, v, a), q, e), 1e-7)
+        close(dv[:, k], along(lambda x: ur5.rnea(q, x, a), v, e), 1e-7)
+    tau = ur5.rnea(q, v, a)
+    ddq, ddq_dq, _, minv = ur5.aba_derivatives(q, v, tau)
+    close(ddq, a, 1e-9)
+    close(minv @ m, np.eye(ur5.nv), 1e-9)
+    close(ddq_dq[:, 0], along(lambda x: ur5.aba(x, v, tau), q, np.eye(ur5.nv)[0]), 1e-6)
+    j, dj = ur5.frame_jacobian_time_variation(q, v, frame)
+    close(dj, along(lambda x: ur5.frame_jacobian(x, frame), q, v), 1e-7)
+    close(ur5.frame_classical_acceleration(q, v, np.zeros(ur5.nv), frame), dj @ v)
+    ag, ag_dot = ur5.centroidal_map_time_variation(q, v)
+    close(ag_dot, along(ur5.centroidal_map, q, v), 1e-7)
+    close(ur5.com_jacobian(q) * ur5.params[::10].sum(), ag[:3])
+
+
 def test_params_setter(ur5):
     q, v, a = random_states(ur5, 3, np.random.default_rng(1))
     nominal = ur5.params

@@ -225,3 +225,80 @@ def test_other_params(pair, states):
                   pair.from_v(pin.aba(pair.model, pair.data, pq, pv, pair.v(tau))))
     finally:
         pair.set_params(nominal)
+
+
+def test_rnea_derivatives(pair, states):
+    perm = np.ix_(pair.v_perm, pair.v_perm)
+    for q, v, a in zip(*states):
+        dq, dv, m = pair.robot.rnea_derivatives(q, v, a)
+        theirs = pin.computeRNEADerivatives(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(a))
+        check(pair, "rnea_derivatives dq", dq, theirs[0][perm])
+        check(pair, "rnea_derivatives dv", dv, theirs[1][perm])
+        full = np.triu(theirs[2]) + np.triu(theirs[2], 1).T  # the upper triangle, as crba
+        check(pair, "rnea_derivatives M", m, full[perm])
+
+
+# M⁻¹ and the forward-dynamics derivatives of the humanoid (M's condition number up to
+# 2.5e5) differ from Pinocchio's by up to 1.3e-12, Pinocchio's own error: the Rust
+# tests hold dyngen's to 1e-12 against an extended-precision evaluation.
+FORWARD_DERIVATIVES_TOLERANCE = 5e-12
+
+
+def test_aba_derivatives(pair, states):
+    perm = np.ix_(pair.v_perm, pair.v_perm)
+    rng = np.random.default_rng(2)
+    for q, v, _ in zip(*states):
+        tau = rng.uniform(-10.0, 10.0, pair.robot.nv)
+        ddq, dq, dv, minv = pair.robot.aba_derivatives(q, v, tau)
+        theirs = pin.computeABADerivatives(pair.model, pair.data, pair.q(q), pair.v(v), pair.v(tau))
+        check(pair, "aba_derivatives ddq", ddq, pair.from_v(pair.data.ddq))
+        for name, ours, their in [("dq", dq, theirs[0]), ("dv", dv, theirs[1]), ("Minv", minv, theirs[2])]:
+            e = error(ours, their[perm])
+            record(pair.name, f"aba_derivatives {name}", e)
+            assert e <= FORWARD_DERIVATIVES_TOLERANCE, f"{pair.name} aba_derivatives {name}: {e:.3e}"
+
+
+REFERENCES = [("local_world_aligned", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL), ("world", pin.WORLD)]
+
+
+def test_frame_velocity_acceleration_and_jacobian_time_variation(pair, states):
+    ids = frame_ids(pair)
+    for q, v, a in list(zip(*states))[:5]:
+        pq, pv, pa = pair.q(q), pair.v(v), pair.v(a)
+        pin.forwardKinematics(pair.model, pair.data, pq, pv, pa)
+        pin.updateFramePlacements(pair.model, pair.data)
+        velocities = {(fid, r): pin.getFrameVelocity(pair.model, pair.data, fid, pr).vector
+                      for _, fid in ids for r, pr in REFERENCES}
+        accelerations = {(fid, r): pin.getFrameClassicalAcceleration(pair.model, pair.data, fid, pr).vector
+                         for _, fid in ids for r, pr in REFERENCES}
+        pin.computeJointJacobiansTimeVariation(pair.model, pair.data, pq, pv)
+        pin.updateFramePlacements(pair.model, pair.data)
+        for name, fid in ids:
+            for reference, pin_reference in REFERENCES:
+                check(pair, f"frame_velocity {reference}",
+                      pair.robot.frame_velocity(q, v, name, reference), velocities[fid, reference])
+                check(pair, f"frame_classical_acceleration {reference}",
+                      pair.robot.frame_classical_acceleration(q, v, a, name, reference),
+                      accelerations[fid, reference])
+                j, dj = pair.robot.frame_jacobian_time_variation(q, v, name, reference)
+                theirs = pin.getFrameJacobianTimeVariation(pair.model, pair.data, fid, pin_reference)
+                check(pair, f"frame_jacobian_time_variation {reference}", dj, theirs[:, pair.v_perm])
+                check(pair, f"frame_jacobian (time variation) {reference}", j,
+                      pin.getFrameJacobian(pair.model, pair.data, fid, pin_reference)[:, pair.v_perm])
+
+
+def test_centroidal(pair, states):
+    for q, v, _ in zip(*states):
+        pq, pv = pair.q(q), pair.v(v)
+        check(pair, "center_of_mass", pair.robot.center_of_mass(q), pin.centerOfMass(pair.model, pair.data, pq))
+        check(pair, "com_jacobian", pair.robot.com_jacobian(q),
+              pin.jacobianCenterOfMass(pair.model, pair.data, pq)[:, pair.v_perm])
+        ag = pin.ccrba(pair.model, pair.data, pq, pv)[:, pair.v_perm]
+        check(pair, "centroidal_map", pair.robot.centroidal_map(q), ag)
+        ours, ours_dot = pair.robot.centroidal_map_time_variation(q, v)
+        # Pinocchio's dAg is another matrix with the same product with v (its angular
+        # rows leave out ċ × A_lin, whose product with v is ċ × m ċ = 0); dyngen's is
+        # the time derivative of A_g, which test_identities checks by differences.
+        their_dot = pin.computeCentroidalMapTimeVariation(pair.model, pair.data, pq, pv)
+        check(pair, "centroidal_map_time_variation", ours, ag)
+        check(pair, "centroidal_map_time_variation dAg v", ours_dot @ v, their_dot @ pv)

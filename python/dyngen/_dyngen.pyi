@@ -142,6 +142,13 @@ class Model:
         self, q: ArrayLike, v: ArrayLike, params: Optional[ArrayLike] = None
     ) -> Tuple[Array, Array]:
         """A_g and d/dt A_g(q(t)) along dq/dt = v: (6, nv) each, or (N, 6, nv)."""
+    def principal_regressor(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Array:
+        """tau = Yp @ principal_params: (nv, 4 nbodies) or (N, nv, 4 nbodies)."""
+    @property
+    def principal_params(self) -> Array:
+        """Per body (m, J1, J2, J3): shape (4 nbodies,)."""
+    def base_parameters(self, kind: str = "standard") -> Dict[str, Any]:
+        """names, independent, K (beta = K @ params), groupings, confirmed, rank_check, consistent."""
     def joint_wrenches(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, params: Optional[ArrayLike] = None) -> Array:
         """Each joint's wrench on its body, in the body frame: (nbodies, 6) or (N, nbodies, 6)."""
     def joint_torque_regressor(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Array:

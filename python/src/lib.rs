@@ -16,12 +16,12 @@ mod identify;
 use dyngen::batch::{Batch, BatchError, Input, Layout, Output, Threads};
 use dyngen::lanes::F64x8;
 use dyngen_algo::{DualWorkspace, Multibody, Real, ReferenceFrame, Se3, Workspace, PARAMS_PER_BODY};
-use dyngen_model::{LoadOptions, Model};
+use dyngen_model::{BaseParams, LoadOptions, Model, Parameterisation};
 use numpy::{IxDyn, PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 pyo3::create_exception!(
     dyngen,
@@ -103,6 +103,10 @@ struct PyModel {
     /// thread in use.
     pool: Mutex<Vec<State<f64>>>,
     max_threads: Option<usize>,
+    /// Per body, `P_i` (10 × 4, row-major) of the principal parameters: `π_i = P_i θ_i`.
+    principal: Vec<[f64; 40]>,
+    /// The base-parameter analyses, made on first use: standard, principal.
+    base: [OnceLock<BaseParams>; 2],
 }
 
 /// One input of an algorithm: its name and the number of entries per state.
@@ -272,6 +276,8 @@ struct State<S: Real> {
     /// variations (1 direction).
     dual8: Option<DualWorkspace<S, 8>>,
     dual1: Option<DualWorkspace<S, 1>>,
+    /// Room for an intermediate result (the standard regressor of the principal one).
+    scratch: Vec<S>,
 }
 
 impl<S: Real<Context = ()>> State<S> {
@@ -282,6 +288,24 @@ impl<S: Real<Context = ()>> State<S> {
             zero: vec![S::constant((), 0.0); body.nv()],
             dual8: None,
             dual1: None,
+            scratch: Vec::new(),
+        }
+    }
+}
+
+/// `Y blkdiag(P_i)` into `yp` (`nv × 4 nbodies`) from the standard regressor `y`
+/// (`nv × 10 nbodies`) and the bodies' `P_i` (10 × 4 row-major).
+fn principal_columns<S: Real<Context = ()>>(y: &[S], principal: &[[f64; 40]], yp: &mut [S]) {
+    let (np, nb) = (10 * principal.len(), principal.len());
+    for (row, out) in y.chunks_exact(np).zip(yp.chunks_exact_mut(4 * nb)) {
+        for (i, p) in principal.iter().enumerate() {
+            for c in 0..4 {
+                let mut x = row[10 * i] * S::constant((), p[c]);
+                for k in 1..10 {
+                    x = x + row[10 * i + k] * S::constant((), p[4 * k + c]);
+                }
+                out[4 * i + c] = x;
+            }
         }
     }
 }
@@ -355,12 +379,20 @@ impl PyModel {
             })
             .collect();
         Ok(PyModel {
-            model,
             body,
             frames,
             warnings,
             pool: Mutex::new(Vec::new()),
             max_threads: None,
+            principal: dyngen_model::principal_frames(&model)
+                .iter()
+                .map(|f| {
+                    let p = f.p_matrix();
+                    core::array::from_fn(|k| p[k / 4][k % 4])
+                })
+                .collect(),
+            base: [OnceLock::new(), OnceLock::new()],
+            model,
         })
     }
 
@@ -1379,6 +1411,91 @@ impl PyModel {
             |st, [q, v, a], [w]| dyngen_algo::joint_wrench_regressor(body, &mut st.plain, q, v, a, w)
         )?;
         Ok(w)
+    }
+
+    /// The principal regressor (the paper's per-body principal form): `tau = Yp @ theta`
+    /// with, per body, `theta_i = (m, J1, J2, J3)`: its mass and principal moments of
+    /// inertia about its nominal centre of mass, along its nominal principal axes
+    /// (`principal_params`). It is `joint_torque_regressor(q, v, a)` times
+    /// `blkdiag(P_i)`, `params_i = P_i theta_i`.
+    ///
+    /// Args:
+    ///     q: shape (nq,) or (N, nq).
+    ///     v, a: shape (nv,) or (N, nv).
+    ///
+    /// Returns:
+    ///     Yp, shape (nv, 4 * nbodies) or (N, nv, 4 * nbodies).
+    fn principal_regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (body, nq, nv, nb) = (&self.body, self.body.nq(), self.body.nv(), self.body.bodies());
+        let (np, principal) = (self.nparams(), &self.principal);
+        let [yp] = evaluate!(
+            self,
+            py,
+            "principal_regressor",
+            None,
+            [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
+            [&[nv, 4 * nb]],
+            |st, [q, v, a], [yp]| {
+                let State { plain, scratch, .. } = st;
+                scratch.resize(nv * np, Real::constant((), 0.0));
+                dyngen_algo::joint_torque_regressor(body, plain, q, v, a, scratch);
+                principal_columns(scratch, principal, yp);
+            }
+        )?;
+        Ok(yp)
+    }
+
+    /// The principal parameters of the description, shape (4 * nbodies,): per body
+    /// `(m, J1, J2, J3)` (see `principal_regressor`).
+    #[getter]
+    fn principal_params<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, dyngen_model::principal_params(&self.model))
+    }
+
+    /// Which combinations of the parameters the joint torques determine (the base
+    /// parameters), by a QR of the regressor stacked over random states, in parameter
+    /// order (earlier bodies absorb later ones), confirmed with a second sample and
+    /// by the singular values. Computed once per model and kind.
+    ///
+    /// Args:
+    ///     kind: `"standard"` (10 per body, `params`) or `"principal"` (4 per body,
+    ///         `principal_params`).
+    ///
+    /// Returns:
+    ///     dict: `names` (the parameters'), `independent` (the columns kept, so that
+    ///     the base regressor is `Y[..., independent]`), `K` (b × p: `beta = K @
+    ///     params`, and `Y @ params = Y[..., independent] @ beta`), `groupings` (each
+    ///     base parameter as text, e.g. `Izz1 + Iyy2`), `confirmed` and `rank_check`
+    ///     (the second sample's and the singular values' verdicts), `consistent`.
+    #[pyo3(signature = (kind = "standard"))]
+    fn base_parameters<'py>(&self, py: Python<'py>, kind: &str) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let (slot, parameterisation) = match kind {
+            "standard" => (&self.base[0], Parameterisation::Standard),
+            "principal" => (&self.base[1], Parameterisation::Principal),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "base_parameters: unknown kind `{other}`; it must be one of: standard, principal"
+                )))
+            }
+        };
+        let base = py.detach(|| slot.get_or_init(|| dyngen_model::base::analyse(&self.model, parameterisation)));
+        let out = pyo3::types::PyDict::new(py);
+        out.set_item("names", parameterisation.names_of(&self.model))?;
+        out.set_item("independent", base.independent.clone())?;
+        let p = base.k.first().map_or(0, |row| row.len());
+        let k: Vec<f64> = base.k.iter().flatten().copied().collect();
+        out.set_item("K", PyArray1::from_vec(py, k).reshape([base.k.len(), p])?)?;
+        out.set_item("groupings", base.groupings.clone())?;
+        out.set_item("confirmed", base.confirmed)?;
+        out.set_item("rank_check", base.rank_check)?;
+        out.set_item("consistent", base.is_consistent())?;
+        Ok(out)
     }
 }
 

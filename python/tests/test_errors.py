@@ -99,6 +99,11 @@ def test_singular_mass_matrix_in_the_derivatives(ur5, state):
         ur5.aba_derivatives(q, v, a, params=massless)
 
 
+def test_unknown_base_parameter_kind(ur5):
+    with pytest.raises(ValueError, match=re.escape("base_parameters: unknown kind `minimal`; it must be one of: standard, principal")):
+        ur5.base_parameters("minimal")
+
+
 def test_params_wrong_length(ur5, state):
     q, v, a = state
     with pytest.raises(ValueError, match=re.escape("rnea: `params` must have shape (60,) (10 per body, 6 bodies); found shape (59,)")):

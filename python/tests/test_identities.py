@@ -120,3 +120,26 @@ def test_docstrings():
                  "joint_torque_regressor", "joint_wrench_regressor", "joint_wrenches",
                  "nonlinear_effects", "generalized_gravity", "neutral"]:
         assert getattr(dyngen.Model, name).__doc__, name
+
+
+def test_principal_regressor_and_base_parameters(robot):
+    """Yp @ principal_params is rnea; for both kinds, the base regressor
+    Y[..., independent] times beta = K @ params is rnea too, with K's shape and the
+    analysis's own checks agreeing."""
+    q, v, a = random_states(robot, 4, np.random.default_rng(4))
+    tau = robot.rnea(q, v, a)
+    yp = robot.principal_regressor(q, v, a)
+    assert yp.shape == (4, robot.nv, 4 * robot.nbodies)
+    close(yp @ robot.principal_params, tau)
+    y = robot.joint_torque_regressor(q, v, a)
+    for kind, regressor, params, per_body in [
+        ("standard", y, robot.params, 10),
+        ("principal", yp, robot.principal_params, 4),
+    ]:
+        base = robot.base_parameters(kind)
+        p = per_body * robot.nbodies
+        b = len(base["independent"])
+        assert base["K"].shape == (b, p) and len(base["groupings"]) == b and len(base["names"]) == p
+        assert base["consistent"] and base["confirmed"] and base["rank_check"] == b
+        assert 0 < b < p
+        close(regressor[..., base["independent"]] @ (base["K"] @ params), tau)

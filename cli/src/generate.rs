@@ -13,7 +13,11 @@ Examples:
   dyngen generate arm.urdf --name Arm -o arm.rs --force   # replace arm.rs
   dyngen generate arm.urdf --name Arm -o arm.rs --functions rnea,crba,aba,frame_jacobian
 
-Use the file with `include!(\"arm.rs\");` in a crate that depends on `dyngen`.";
+  dyngen generate robots/ur5/ur5.urdf --name Ur5 --python ur5-python && pip install ./ur5-python
+
+Use the file with `include!(\"arm.rs\");` in a crate that depends on `dyngen`. With
+--python the folder is a Python package (the module `ur5`: rnea, crba, aba, ... on
+numpy arrays, a batch on SIMD lanes and threads) that `pip install` builds.";
 
 #[derive(Debug, clap::Args)]
 pub struct GenerateArgs {
@@ -25,8 +29,20 @@ pub struct GenerateArgs {
     pub name: String,
 
     /// Output file (default: stdout). An existing file is kept unless --force.
-    #[arg(long, short)]
+    #[arg(long, short, conflicts_with = "python")]
     pub output: Option<PathBuf>,
+
+    /// Write a Python package to this folder instead: the generated code and a
+    /// module of the same name in snake case (`Ur5` → `ur5`) with the batched
+    /// kernels on numpy arrays; `pip install DIR` builds it (Rust toolchain needed).
+    /// An existing non-empty folder is kept unless --force.
+    #[arg(long, value_name = "DIR")]
+    pub python: Option<PathBuf>,
+
+    /// With --python: the `dyngen` crate the package builds against (the `core`
+    /// folder of a dyngen checkout; default: the one this program was built from).
+    #[arg(long, value_name = "PATH", requires = "python")]
+    pub dyngen_path: Option<PathBuf>,
 
     /// Replace the output file if it exists.
     #[arg(long)]
@@ -64,6 +80,10 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
     if let Some(out) = &args.output {
         check_overwrite(out, args.force)?;
     }
+    let python = match &args.python {
+        Some(dir) => Some(python_package(dir, args)?),
+        None => None,
+    };
     let model = load_model(&args.urdf, &args.gravity)?;
     let mut config = Config::new();
     if let Some(g) = args.gravity.get()? {
@@ -90,6 +110,9 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
         dyngen_codegen::Error::TypeName(_) => CliError::usage(e.to_string()),
         e => CliError::failed(e),
     })?;
+    if let Some(package) = python {
+        return package.write(&content, &args.name, &model.name, model.dof());
+    }
     match &args.output {
         None => out!("{content}"),
         Some(path) => {
@@ -104,4 +127,113 @@ pub fn run(args: &GenerateArgs, progress: &Progress) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A Python package to write (`--python`): its folder, module name and the `dyngen`
+/// crate it builds against, checked before anything is generated.
+struct PythonPackage {
+    dir: PathBuf,
+    module: String,
+    dyngen: PathBuf,
+}
+
+/// The templates of the package; `@MODULE@`, `@ROBOT@`, `@TYPE@` and `@DYNGEN@` are
+/// replaced.
+const PYTHON_LIB: &str = include_str!("../templates/python/lib.rs");
+const PYTHON_CARGO: &str = include_str!("../templates/python/Cargo.toml");
+const PYTHON_PYPROJECT: &str = include_str!("../templates/python/pyproject.toml");
+
+/// `Ur5Arm` → `ur5_arm`: the module name of a type name (a Rust identifier, so an
+/// ASCII letter or `_` first, then letters, digits and `_`).
+pub fn snake_case(name: &str) -> String {
+    let mut out = String::with_capacity(name.len() + 4);
+    let mut previous_lower = false;
+    for c in name.chars() {
+        if c.is_ascii_uppercase() {
+            if previous_lower {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+            previous_lower = false;
+        } else {
+            out.push(c);
+            previous_lower = c.is_ascii_lowercase() || c.is_ascii_digit();
+        }
+    }
+    out
+}
+
+fn python_package(dir: &std::path::Path, args: &GenerateArgs) -> Result<PythonPackage> {
+    let module = snake_case(&args.name);
+    let valid = module
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && module.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid {
+        return Err(CliError::usage(format!(
+            "--python: the module name `{module}` (from --name `{}`) is not a Python identifier; \
+             give --name as ASCII letters, digits and `_`, starting with a letter",
+            args.name
+        )));
+    }
+    let non_empty = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
+    if non_empty && !args.force {
+        return Err(CliError::usage(format!(
+            "--python: `{}` exists and is not empty; choose a new folder, or pass --force to write over its files",
+            dir.display()
+        )));
+    }
+    if dir.exists() && !dir.is_dir() {
+        return Err(CliError::usage(format!(
+            "--python: `{}` is a file, not a folder",
+            dir.display()
+        )));
+    }
+    let dyngen = match &args.dyngen_path {
+        Some(path) => path.clone(),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("core"),
+    };
+    let manifest = std::fs::read_to_string(dyngen.join("Cargo.toml")).unwrap_or_default();
+    if !manifest.lines().any(|l| l.trim() == "name = \"dyngen\"") {
+        return Err(CliError::usage(format!(
+            "--dyngen-path: `{}` is not the `dyngen` crate (the `core` folder of a dyngen checkout, with its Cargo.toml)",
+            dyngen.display()
+        )));
+    }
+    let dyngen = dyngen.canonicalize().map_err(|e| CliError::input(&dyngen, e))?;
+    Ok(PythonPackage {
+        dir: dir.to_path_buf(),
+        module,
+        dyngen,
+    })
+}
+
+impl PythonPackage {
+    fn write(&self, code: &str, type_name: &str, robot: &str, dof: usize) -> Result<()> {
+        let fill = |template: &str| {
+            template
+                .replace("@MODULE@", &self.module)
+                .replace("@TYPE@", type_name)
+                .replace("@ROBOT@", robot)
+                .replace("@DYNGEN@", &self.dyngen.display().to_string().replace('\\', "/"))
+        };
+        let src = self.dir.join("src");
+        std::fs::create_dir_all(&src).map_err(|e| CliError::output(&src, e))?;
+        for (path, text) in [
+            (src.join("robot.rs"), code.to_string()),
+            (src.join("lib.rs"), fill(PYTHON_LIB)),
+            (self.dir.join("Cargo.toml"), fill(PYTHON_CARGO)),
+            (self.dir.join("pyproject.toml"), fill(PYTHON_PYPROJECT)),
+        ] {
+            std::fs::write(&path, text).map_err(|e| CliError::output(&path, e))?;
+        }
+        eprintln!(
+            "wrote the Python package of `{type_name}` ({dof} joints; module `{}`) to {}; build it with `pip install {}`",
+            self.module,
+            self.dir.display(),
+            self.dir.display()
+        );
+        Ok(())
+    }
 }

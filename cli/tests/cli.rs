@@ -97,6 +97,72 @@ fn generate_writes_header_and_refuses_to_overwrite() {
     assert_error(&o, "not a valid Rust type name");
 }
 
+/// `--python DIR`: a Python package (the generated code, the module's glue, its
+/// Cargo.toml and pyproject.toml against this checkout's `dyngen`); a non-empty folder
+/// is kept unless --force, and a wrong `--dyngen-path`, `-o` beside it or a name that
+/// is no Python identifier are refused. (The package is built and imported by the
+/// Python tests, `python/tests/test_generated.py`.)
+#[test]
+fn generate_writes_a_python_package() {
+    let dir = temp_dir("dyngen-cli", "generate_python");
+    let package = dir.join("arm");
+    let o = run!("generate", ur5(), "--name", "Ur5Arm", "--python", &package);
+    assert_ok(&o);
+    assert!(stderr(&o).contains("module `ur5_arm`"), "{}", stderr(&o));
+    let code = std::fs::read_to_string(package.join("src/robot.rs")).unwrap();
+    assert!(code.contains("pub struct Ur5Arm"));
+    let lib = std::fs::read_to_string(package.join("src/lib.rs")).unwrap();
+    assert!(lib.contains("fn ur5_arm(m: &Bound<'_, PyModule>)") && lib.contains("use robot::Ur5Arm as R;"));
+    for placeholder in ["@MODULE@", "@TYPE@", "@ROBOT@", "@DYNGEN@"] {
+        assert!(!lib.contains(placeholder), "{placeholder} is left: {lib}");
+    }
+    let cargo = std::fs::read_to_string(package.join("Cargo.toml")).unwrap();
+    let path = cargo
+        .lines()
+        .find_map(|l| l.strip_prefix("dyngen = { path = \""))
+        .and_then(|rest| rest.split('"').next())
+        .unwrap();
+    assert!(std::path::Path::new(path).join("src/batch.rs").exists(), "{path}");
+    let pyproject = std::fs::read_to_string(package.join("pyproject.toml")).unwrap();
+    assert!(pyproject.contains("module-name = \"ur5_arm\""));
+
+    std::fs::write(package.join("src/lib.rs"), "keep me").unwrap();
+    let o = run!("generate", ur5(), "--name", "Ur5Arm", "--python", &package);
+    assert_error(&o, "exists and is not empty");
+    assert_error(&o, "--force");
+    assert_eq!(std::fs::read_to_string(package.join("src/lib.rs")).unwrap(), "keep me");
+    let o = run!("generate", ur5(), "--name", "Ur5Arm", "--python", &package, "--force");
+    assert_ok(&o);
+    assert_eq!(std::fs::read_to_string(package.join("src/lib.rs")).unwrap(), lib);
+
+    let other = dir.join("other");
+    let o = run!(
+        "generate",
+        ur5(),
+        "--name",
+        "Ur5",
+        "--python",
+        &other,
+        "--dyngen-path",
+        &dir
+    );
+    assert_error(&o, "is not the `dyngen` crate");
+    assert!(!other.exists(), "nothing written after a refusal");
+    let o = run!(
+        "generate",
+        ur5(),
+        "--name",
+        "Ur5",
+        "--python",
+        &other,
+        "-o",
+        dir.join("x.rs")
+    );
+    assert_error(&o, "cannot be used with");
+    let o = run!("generate", ur5(), "--name", "Ur5", "--dyngen-path", &dir);
+    assert_error(&o, "--python");
+}
+
 /// `--compose-above N` composes the functions whose graphs repeat others' on a robot
 /// of more than N coordinates: the UR5 (6) with `--compose-above 5` has no graph of
 /// its own for `aba_derivatives` and says so in `aba`'s doc; by default it has.

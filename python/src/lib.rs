@@ -454,7 +454,7 @@ impl PyModel {
     }
 
     /// Runs a kernel on every state of the inputs `args` (one state or a batch) with
-    /// the parameters `params` (the model's for `None`), with the GIL released, into
+    /// the parameters `params` (read and checked; the model's for `None`), with the GIL released, into
     /// new arrays of the per-state shapes `outputs` (with a leading `N` for a batch).
     /// One state runs `one` on `f64` (in a pooled [`State`]); a batch runs `lanes` on
     /// [`Lane`]s, eight states per call, split across threads by
@@ -465,7 +465,7 @@ impl PyModel {
         &self,
         py: Python<'py>,
         algorithm: &str,
-        params: Option<&[f64]>,
+        params: Option<&Bound<'py, PyAny>>,
         args: [Arg<'_, 'py>; I],
         outputs: [&[usize]; O],
         one: F,
@@ -475,7 +475,11 @@ impl PyModel {
         F: Fn(&mut State<f64>, [&[f64]; I], [&mut [f64]; O]) + Sync,
         L: Fn(&mut State<Lane>, [&[Lane]; I], [&mut [Lane]; O]) + Sync,
     {
-        let params = params.unwrap_or(&self.body.params);
+        let params = self.read_params(algorithm, params)?;
+        let params = match &params {
+            Some(p) => slice(p, "params")?,
+            None => &self.body.params,
+        };
         let (read, batch) = read_all(algorithm, &args)?;
         let rows = batch.unwrap_or(1);
         let mut data: Vec<Rows<'_>> = Vec::with_capacity(I);
@@ -736,14 +740,12 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("rnea", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [tau] = evaluate!(
             self,
             py,
             "rnea",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv]],
             |st, [q, v, a], [tau]| dyngen_algo::rnea(body, &mut st.plain, q, v, a, &st.params, tau)
@@ -768,14 +770,12 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("nonlinear_effects", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [h] = evaluate!(
             self,
             py,
             "nonlinear_effects",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv)],
             [&[nv]],
             |st, [q, v], [h]| dyngen_algo::rnea(body, &mut st.plain, q, v, &st.zero, &st.params, h)
@@ -798,14 +798,12 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("generalized_gravity", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [g] = evaluate!(
             self,
             py,
             "generalized_gravity",
-            p,
+            params,
             [arg("q", q, nq)],
             [&[nv]],
             |st, [q], [g]| dyngen_algo::rnea(body, &mut st.plain, q, &st.zero, &st.zero, &st.params, g)
@@ -829,12 +827,16 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("crba", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
-        let [m] = evaluate!(self, py, "crba", p, [arg("q", q, nq)], [&[nv, nv]], |st, [q], [m]| {
-            dyngen_algo::crba(body, &mut st.plain, q, &st.params, m)
-        })?;
+        let [m] = evaluate!(
+            self,
+            py,
+            "crba",
+            params,
+            [arg("q", q, nq)],
+            [&[nv, nv]],
+            |st, [q], [m]| { dyngen_algo::crba(body, &mut st.plain, q, &st.params, m) }
+        )?;
         Ok(m)
     }
 
@@ -861,14 +863,12 @@ impl PyModel {
         tau: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("aba", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [qdd] = evaluate!(
             self,
             py,
             "aba",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
             [&[nv]],
             |st, [q, v, tau], [qdd]| dyngen_algo::aba(body, &mut st.plain, q, v, tau, &st.params, &[], qdd)
@@ -898,14 +898,12 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Matrices3<'py>> {
-        let p = self.read_params("rnea_derivatives", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [dq, dv, m] = evaluate!(
             self,
             py,
             "rnea_derivatives",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nv, nv], &[nv, nv], &[nv, nv]],
             |st, [q, v, a], [dq, dv, m]| {
@@ -942,14 +940,12 @@ impl PyModel {
         tau: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Arrays4<'py>> {
-        let p = self.read_params("aba_derivatives", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [ddq, dq, dv, minv] = evaluate!(
             self,
             py,
             "aba_derivatives",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
             [&[nv], &[nv, nv], &[nv, nv], &[nv, nv]],
             |st, [q, v, tau], [ddq, dq, dv, minv]| {
@@ -1193,14 +1189,12 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("center_of_mass", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq) = (&self.body, self.body.nq());
         let [c] = evaluate!(
             self,
             py,
             "center_of_mass",
-            p,
+            params,
             [arg("q", q, nq)],
             [&[3]],
             |st, [q], [c]| c.copy_from_slice(&dyngen_algo::center_of_mass(body, &mut st.plain, q, &st.params))
@@ -1224,14 +1218,12 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("com_jacobian", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [j] = evaluate!(
             self,
             py,
             "com_jacobian",
-            p,
+            params,
             [arg("q", q, nq)],
             [&[3, nv]],
             |st, [q], [j]| {
@@ -1258,14 +1250,12 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("centroidal_map", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [ag] = evaluate!(
             self,
             py,
             "centroidal_map",
-            p,
+            params,
             [arg("q", q, nq)],
             [&[6, nv]],
             |st, [q], [ag]| {
@@ -1295,14 +1285,12 @@ impl PyModel {
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Matrices2<'py>> {
         let name = "centroidal_map_time_variation";
-        let p = self.read_params(name, params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv) = (&self.body, self.body.nq(), self.body.nv());
         let [ag, ag_dot] = evaluate!(
             self,
             py,
             name,
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv)],
             [&[6, nv], &[6, nv]],
             |st, [q, v], [ag, ag_dot]| {
@@ -1333,14 +1321,12 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let p = self.read_params("joint_wrenches", params)?;
-        let p = p.as_ref().map(|p| slice(p, "params")).transpose()?;
         let (body, nq, nv, nb) = (&self.body, self.body.nq(), self.body.nv(), self.body.bodies());
         let [f] = evaluate!(
             self,
             py,
             "joint_wrenches",
-            p,
+            params,
             [arg("q", q, nq), arg("v", v, nv), arg("a", a, nv)],
             [&[nb, 6]],
             |st, [q, v, a], [f]| {

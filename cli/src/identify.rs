@@ -8,7 +8,7 @@ use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::pipeline::{
     self, Estimator, Identification, IdentifyOptions, JointTerms, PipelineError, Prediction,
 };
-use dyngen_identify::report::{self, DataSpan, MergedLinks};
+use dyngen_identify::report::{self, DataSpan, MergedLinks, Parameterisation};
 use dyngen_identify::{Accumulation, Estimate};
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::Model;
@@ -32,6 +32,10 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv \
       --urdf-out ur5-identified.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --rotor-inertia no
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --partial run1.part
+  dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --method wls \
+      --params-json fleet.json
+  dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --partial both.part
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
@@ -82,7 +86,22 @@ usually few bodies, if any, are fully identifiable; by MIM usually all. With joi
 terms, each joint's Fv and Fc go to its <dynamics damping friction>, and every
 identified joint term (Ia, Fv, Fc, F0, Fs, vs, the Coulomb model and its ε) to
 NAME.joint-params.json beside NAME.urdf (schema dyngen-joint-params/1).
-Existing files are kept unless --force.";
+Existing files are kept unless --force.
+
+Many recordings (a fleet, or one long log in pieces): --partial OUT writes a
+recording's partial factor instead of an estimate, the sufficient statistics of its
+joint-torque rows (per joint the triangular factor of [A y], the robot, and every
+option that shapes the rows), on whichever machine holds the recording. --merge
+PART… merges partials of the same robot and row options exactly (in any grouping:
+--merge with --partial writes the merged partial, a reduce tree) and solves with
+--method, as one run on all their samples would: each recording is read, filtered
+and differentiated on its own, so the result equals one run on one file holding
+them all when that run's preprocessing sees the same rows (measured velocities and
+accelerations with --raw-states). Partials made for another robot or with other row
+options are refused, naming both files and the difference. What needs the rows
+themselves has no partial: --friction auto (use --friction smooth --epsilon E),
+stribeck, --mode mim; --svg and --validate with --merge (use `dyngen validate` on
+the --params-json).";
 
 /// What is identified, from what.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -154,8 +173,28 @@ pub struct IdentifyArgs {
     /// The robot description (URDF, or MJCF as `.xml`); its inertials are the nominal parameters.
     pub urdf: PathBuf,
 
-    /// Measured data (CSV: t, q1..qn[, v1..vn, a1..an], tau1..taun[, wrenches]).
-    pub data: PathBuf,
+    /// Measured data (CSV: t, q1..qn[, v1..vn, a1..an], tau1..taun[, wrenches]);
+    /// not with --merge.
+    #[arg(required_unless_present = "merge")]
+    pub data: Option<PathBuf>,
+
+    /// Write the recording's partial factor (the sufficient statistics of its
+    /// joint-torque rows, JSON schema dyngen-partial/1) to this file instead of
+    /// identifying; with --merge, the merged partial (a reduce tree). Refused with
+    /// the options that need the rows themselves: --friction auto, stribeck and
+    /// stribeck-smooth, --mode mim; and with those of the estimate (--method,
+    /// --lambda, --params-json, --urdf-out, --svg, --validate, --truth-from-urdf),
+    /// which belong to the run that merges.
+    #[arg(long, value_name = "OUT")]
+    pub partial: Option<PathBuf>,
+
+    /// Identify from these partial factors (written by --partial) instead of a
+    /// recording: merged exactly, then solved with --method as one run on all
+    /// their samples would. They must be of this robot and share the options that
+    /// shape the rows (mode, friction and ε, rotor inertia, accumulation,
+    /// exclude-below, cutoff, raw states, recipe), which are taken from them.
+    #[arg(long, value_name = "PART", num_args = 1.., conflicts_with = "data")]
+    pub merge: Vec<PathBuf>,
 
     /// What to identify, from what.
     #[arg(long, value_enum, default_value_t = Mode::Standard)]
@@ -208,7 +247,7 @@ pub struct IdentifyArgs {
 
     /// Ridge: weight of the pull toward the nominal parameters, dimensionless (the
     /// penalty is λ·Σ ‖column j‖²·(x_j − x0_j)², so units do not matter), 0 to 1e12.
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true, value_parser = crate::ranges::LAMBDA)]
+    #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true, value_parser = crate::ranges::LAMBDA)]
     pub lambda: f64,
 
     /// Leave a joint's rows out of its equations where its |velocity| is below
@@ -274,6 +313,9 @@ pub struct RecordingArgs {
     #[command(flatten)]
     pub recipe: RecipeArgs,
 }
+
+/// --lambda when not given.
+pub const DEFAULT_LAMBDA: f64 = 1e-6;
 
 /// The cutoff when --cutoff is not given (and no parameters file records one).
 pub const DEFAULT_CUTOFF_HZ: f64 = 10.0;
@@ -398,15 +440,6 @@ pub fn load_recording(
     Ok(loaded.trajectory)
 }
 
-/// `recipe` without its time and row windows.
-pub fn without_window(recipe: &Recipe) -> Recipe {
-    Recipe {
-        window: None,
-        rows: None,
-        ..recipe.clone()
-    }
-}
-
 /// Only the time and row windows of `recipe`, as recipe lines (`window = 5:65`);
 /// `None` when it has neither.
 pub fn window_lines(recipe: &Recipe) -> Option<String> {
@@ -417,19 +450,6 @@ pub fn window_lines(recipe: &Recipe) -> Option<String> {
     };
     let text = windows.to_text();
     (!text.is_empty()).then(|| text.trim_end().replace('\n', "; "))
-}
-
-/// Which samples of `path` `traj` holds.
-pub fn data_span(path: &Path, traj: &Trajectory) -> DataSpan {
-    let last = traj.len().saturating_sub(1);
-    DataSpan {
-        file: path.display().to_string(),
-        samples: traj.len(),
-        first: traj.location(0).to_string(),
-        last: traj.location(last).to_string(),
-        t_first: traj.t().first().copied(),
-        t_last: traj.t().last().copied(),
-    }
 }
 
 /// `1000 samples of run.csv, line 2 to line 1001 (t = 0 … 9.99 s)`.
@@ -471,7 +491,7 @@ pub fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
 }
 
 impl IdentifyArgs {
-    fn options(&self) -> IdentifyOptions {
+    pub fn options(&self) -> IdentifyOptions {
         IdentifyOptions {
             mode: match self.mode {
                 Mode::Standard => pipeline::Mode::Standard,
@@ -519,8 +539,15 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             "--accumulation applies to --mode standard and principal; MIM accumulates by QR",
         ));
     }
+    if args.partial.is_some() || !args.merge.is_empty() {
+        return crate::partial::run(args, progress);
+    }
+    let data = args
+        .data
+        .as_deref()
+        .ok_or_else(|| CliError::usage("give the recording DATA, or --merge PART…"))?;
     let options = args.options();
-    options.check().map_err(|e| pipeline_error(&args.data, e))?;
+    options.check().map_err(|e| pipeline_error(data, e))?;
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
     let n = model.dof();
@@ -528,7 +555,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     // The validation recording's recipe, checked before any work.
     let validation_recipe = match &args.validate_recipe {
         Some(path) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,
-        None => without_window(&recipe),
+        None => recipe.without_window(),
     };
     let validation_recipe = match &args.validate_window {
         Some(window) => {
@@ -544,25 +571,25 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         .map_err(|e| CliError::Input(format!("validation recipe: {e}")))?;
     let cutoff = args.recording.cutoff();
     let low_pass_states = !args.recording.raw_states;
-    let traj = load_recording(&args.data, &recipe, n, cutoff, low_pass_states)?;
+    let traj = load_recording(data, &recipe, n, cutoff, low_pass_states)?;
     if args.mode == Mode::Mim && traj.joint_wrenches().is_none() {
-        return Err(pipeline_error(&args.data, PipelineError::MissingWrenches { dof: n }));
+        return Err(pipeline_error(data, PipelineError::MissingWrenches { dof: n }));
     }
-    outln!("{} samples of {} joints from {}", traj.len(), n, args.data.display());
-    let training = data_span(&args.data, &traj);
+    outln!("{} samples of {} joints from {}", traj.len(), n, data.display());
+    let training = DataSpan::of(data, &traj);
     if args.validate.is_some() {
         outln!("training: {}", describe_span(&training));
     }
     let robot = Reference::new(&model);
     let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
-        .map_err(|e| pipeline_error(&args.data, e))?;
+        .map_err(|e| pipeline_error(data, e))?;
     for w in &identified.warnings {
         eprintln!("warning: {w}");
     }
     let mut identified = identified;
     if let Some(prediction) = identified.report.prediction.as_mut() {
         if let Some(pre) = prediction.preprocessing.as_mut() {
-            pre.recipe = Some(without_window(&recipe).to_text());
+            pre.recipe = Some(recipe.without_window().to_text());
             pre.window = window_lines(&recipe);
             pre.data = Some(training.clone());
             pre.gravity = args.recording.gravity.get()?;
@@ -592,6 +619,48 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             per_joint.join(", ")
         );
     }
+    print_identification(args, &model, &identified, Some(&traj))?;
+    write_outputs(args, data, &model, &identified)?;
+    if let Some(path) = &args.svg {
+        write_svg(args, data, path, &robot, &traj, &identified, progress)?;
+    }
+    if let Some(path) = &args.validate {
+        let other = load_recording(path, &validation_recipe, n, cutoff, low_pass_states)?;
+        let how = match (&args.validate_recipe, &args.validate_window) {
+            (Some(r), _) => format!("read through --validate-recipe {}", r.display()),
+            (None, _) => "read through the training recipe".to_string(),
+        };
+        let window = match (&args.validate_window, window_lines(&recipe)) {
+            (Some(w), _) => format!("--validate-window {w}"),
+            (None, Some(training)) => format!("all of it: the training window ({training}) is not applied to it"),
+            (None, None) => "all of it".to_string(),
+        };
+        outln!(
+            "validation: {} ({how}; {window})",
+            describe_span(&DataSpan::of(path, &other))
+        );
+        let predicted = with_spinner(progress, "predicting the validation recording", || {
+            identified.predict(&robot, &other)
+        })
+        .map_err(|e| pipeline_error(path, e))?;
+        let validation = crate::validate::validation(&model, &other, &predicted, None)?;
+        outln!(
+            "prediction of {}:\n{validation}\n{}",
+            path.display(),
+            crate::validate::exact_overall(&validation)
+        );
+    }
+    Ok(())
+}
+
+/// The estimate's table, fit and notes (`traj`: the recording, for the friction
+/// hint; `None` for merged partial factors).
+pub fn print_identification(
+    args: &IdentifyArgs,
+    model: &Model,
+    identified: &Identification,
+    traj: Option<&Trajectory>,
+) -> Result<()> {
     match (&identified.prediction, &identified.mim) {
         (_, Some(mim)) => outln!("{mim}"),
         (Prediction::Regressor(torque), None) => {
@@ -613,15 +682,22 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
                 out!("{fit}");
             }
             if args.mode == Mode::Standard && args.friction == Friction::None {
-                hint_friction(&torque.estimate, &traj)?;
+                if let Some(traj) = traj {
+                    hint_friction(&torque.estimate, traj)?;
+                }
             }
             if args.truth_from_urdf {
-                print_errors(&identified, &model)?;
+                print_errors(identified, model)?;
             }
         }
         (Prediction::Parameters(_), None) => {}
     }
 
+    Ok(())
+}
+
+/// --params-json and --urdf-out; `source` names the data in errors.
+pub fn write_outputs(args: &IdentifyArgs, source: &Path, model: &Model, identified: &Identification) -> Result<()> {
     if let Some(path) = &args.params_json {
         identified
             .report
@@ -629,37 +705,8 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             .map_err(|e| CliError::report(path, e))?;
         outln!("wrote the parameters to {}", path.display());
     }
-    if let Some(path) = &args.svg {
-        write_svg(args, path, &robot, &traj, &identified, progress)?;
-    }
     if let Some(path) = &args.urdf_out {
-        write_urdf(args, path, &model, &identified)?;
-    }
-    if let Some(path) = &args.validate {
-        let other = load_recording(path, &validation_recipe, n, cutoff, low_pass_states)?;
-        let how = match (&args.validate_recipe, &args.validate_window) {
-            (Some(r), _) => format!("read through --validate-recipe {}", r.display()),
-            (None, _) => "read through the training recipe".to_string(),
-        };
-        let window = match (&args.validate_window, window_lines(&recipe)) {
-            (Some(w), _) => format!("--validate-window {w}"),
-            (None, Some(training)) => format!("all of it: the training window ({training}) is not applied to it"),
-            (None, None) => "all of it".to_string(),
-        };
-        outln!(
-            "validation: {} ({how}; {window})",
-            describe_span(&data_span(path, &other))
-        );
-        let predicted = with_spinner(progress, "predicting the validation recording", || {
-            identified.predict(&robot, &other)
-        })
-        .map_err(|e| pipeline_error(path, e))?;
-        let validation = crate::validate::validation(&model, &other, &predicted, None)?;
-        outln!(
-            "prediction of {}:\n{validation}\n{}",
-            path.display(),
-            crate::validate::exact_overall(&validation)
-        );
+        write_urdf(args, source, path, model, identified)?;
     }
     Ok(())
 }
@@ -680,7 +727,7 @@ fn print_errors(identified: &Identification, model: &Model) -> Result<()> {
 
 /// Refuses, before any work, existing output files without --force and two
 /// outputs to the same file.
-fn check_outputs(args: &IdentifyArgs) -> Result<()> {
+pub fn check_outputs(args: &IdentifyArgs) -> Result<()> {
     let beside = joint_params_output(args);
     let outputs: Vec<(&str, &PathBuf)> = [
         ("--params-json", &args.params_json),
@@ -733,6 +780,7 @@ pub fn joint_params_path(urdf: &Path) -> PathBuf {
 /// parameters that have a value.
 fn write_svg(
     args: &IdentifyArgs,
+    data: &Path,
     path: &Path,
     robot: &Reference,
     traj: &Trajectory,
@@ -741,7 +789,7 @@ fn write_svg(
 ) -> Result<()> {
     let model = dyngen_reference::Dynamics::model(robot);
     let predicted = with_spinner(progress, "predicting torques", || identified.predict(robot, traj))
-        .map_err(|e| pipeline_error(&args.data, e))?;
+        .map_err(|e| pipeline_error(data, e))?;
     let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
     let errors = match args.truth_from_urdf {
         true => {
@@ -760,9 +808,8 @@ fn write_svg(
         "{}: {} on {}",
         model.name,
         identified.report.method,
-        args.data
-            .file_name()
-            .map_or_else(|| args.data.display().to_string(), |f| f.to_string_lossy().into_owned())
+        data.file_name()
+            .map_or_else(|| data.display().to_string(), |f| f.to_string_lossy().into_owned())
     );
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     let svg = crate::svg::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
@@ -774,7 +821,13 @@ fn write_svg(
 
 /// The input URDF with the inertials of the fully identified, physically valid
 /// bodies replaced; every other byte is kept.
-fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Identification) -> Result<()> {
+fn write_urdf(
+    args: &IdentifyArgs,
+    source: &Path,
+    path: &Path,
+    model: &Model,
+    identified: &Identification,
+) -> Result<()> {
     let text = std::fs::read_to_string(&args.urdf).map_err(|e| CliError::input(&args.urdf, e))?;
     let merged = if args.lump_merged {
         MergedLinks::Lump
@@ -783,7 +836,7 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
     };
     let rewrite = identified.rewrite_urdf(&text, model, merged).map_err(|e| match e {
         PipelineError::Report(e) => CliError::input(&args.urdf, e),
-        e => pipeline_error(&args.data, e),
+        e => pipeline_error(source, e),
     })?;
     report::write_new(path, &rewrite.text, args.force).map_err(|e| CliError::report(path, e))?;
     if rewrite.updated.is_empty() {
@@ -811,7 +864,10 @@ fn write_urdf(args: &IdentifyArgs, path: &Path, model: &Model, identified: &Iden
     for (joint, why) in &rewrite.dynamics_kept {
         outln!("note: kept the URDF's <dynamics> of {joint}: {why}");
     }
-    if let Some(beside) = joint_params_output(args) {
+    // Beside the URDF when the identification has joint terms (with --merge, the
+    // partials' friction decides, not the flags).
+    let joint_terms = identified.report.parameterisation == Parameterisation::StandardAndJoints;
+    if let Some(beside) = joint_terms.then(|| joint_params_path(path)) {
         let in_urdf: Vec<&str> = rewrite.dynamics.iter().map(|(j, _, _)| j.as_str()).collect();
         let name = path.file_name().map(|f| f.to_string_lossy().into_owned());
         let file = identified

@@ -21,6 +21,7 @@ mod generate;
 mod identify;
 mod info;
 mod nim;
+mod partial;
 mod ranges;
 mod simulate;
 mod svg;

@@ -54,7 +54,8 @@ pub struct Accumulator {
 }
 
 /// How an [`Accumulator`] compresses its rows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Accumulation {
     /// Householder QR of `[A y]` per channel, folded block by block: backward
     /// stable at any condition number.
@@ -77,6 +78,35 @@ pub enum Accumulation {
 /// [`Accumulation::NormalEquations`] resolves (unless `√(max(m, p) ε)` is larger):
 /// its squared condition number then costs at most 12 of the 16 digits of a double.
 pub const NORMAL_EQUATIONS_RESOLUTION: f64 = 1e-6;
+
+/// An [`Accumulator`]'s content ([`Accumulator::to_state`]), serialisable.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AccumulatorState {
+    /// The number of parameters `p` (columns of `A`).
+    pub parameters: usize,
+    pub channels: Channels,
+    pub accumulation: Accumulation,
+    /// One entry per channel.
+    pub per_channel: Vec<ChannelState>,
+}
+
+/// One channel of an [`AccumulatorState`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChannelState {
+    /// Rows taken.
+    pub rows: usize,
+    /// Rows left out ([`Accumulator::push_rows_masked`]).
+    pub excluded: usize,
+    /// The columns the channel's rows may be non-zero in
+    /// ([`Accumulator::with_column_support`]); `None`: all.
+    pub support: Option<Vec<usize>>,
+    /// Over the supported columns and `y` (`width` numbers): for
+    /// [`Accumulation::Qr`] the rows of the upper-trapezoidal factor `R` of the
+    /// channel's rows of `[A y]` (at most `width`); for
+    /// [`Accumulation::NormalEquations`] the upper triangle of `[A y]ᵀ[A y]`, row
+    /// `i` from the diagonal on (`width − i` numbers).
+    pub factor: Vec<Vec<f64>>,
+}
 
 #[derive(Clone, Debug)]
 struct Block {
@@ -329,6 +359,153 @@ impl Accumulator {
         }
         self.rows += other.rows;
         Ok(())
+    }
+
+    /// Everything the accumulator holds, with the rows still buffered folded in, as
+    /// plain numbers: what a partial factor file stores
+    /// ([`crate::partial::Partial`]). [`Accumulator::from_state`] gives back an
+    /// accumulator whose estimates, and whose merges with others, are this one's.
+    ///
+    /// Errors: channels given by labels (their rows are numbered globally, so they
+    /// cannot be merged either).
+    pub fn to_state(&self) -> Result<AccumulatorState, IdentifyError> {
+        if let Channels::Labels(_) = self.channels {
+            return Err(IdentifyError::InvalidArgument {
+                what: "accumulator state",
+                reason: "channels given by labels number rows globally".into(),
+            });
+        }
+        let channels = self
+            .blocks
+            .iter()
+            .map(|b| {
+                let mut b = b.clone();
+                let width = b.width(self.p);
+                let factor = match self.accumulation {
+                    Accumulation::Qr => {
+                        fold(&mut b);
+                        (0..b.k).map(|i| (0..width).map(|j| b.work[(i, j)]).collect()).collect()
+                    }
+                    Accumulation::NormalEquations => {
+                        add_gram(&mut b);
+                        (0..width)
+                            .map(|i| (i..width).map(|j| b.work[(i, j)]).collect())
+                            .collect()
+                    }
+                };
+                ChannelState {
+                    rows: b.rows,
+                    excluded: b.excluded,
+                    support: b.support,
+                    factor,
+                }
+            })
+            .collect();
+        Ok(AccumulatorState {
+            parameters: self.p,
+            channels: self.channels.clone(),
+            accumulation: self.accumulation,
+            per_channel: channels,
+        })
+    }
+
+    /// The accumulator [`Accumulator::to_state`] describes, checked: one entry per
+    /// channel, the same column support form in each, factor rows of the channel's
+    /// width (at most width rows for QR; the upper triangle row by row for the
+    /// normal equations), finite numbers, and interleaved channels holding whole
+    /// samples.
+    pub fn from_state(state: &AccumulatorState) -> Result<Self, IdentifyError> {
+        let invalid = |reason: String| IdentifyError::InvalidArgument {
+            what: "accumulator state",
+            reason,
+        };
+        if let Channels::Labels(_) = state.channels {
+            return Err(invalid("channels given by labels cannot be stored".into()));
+        }
+        let p = state.parameters;
+        let mut acc = Self::with_accumulation(p, state.channels.clone(), state.accumulation)?;
+        if state.per_channel.len() != acc.blocks.len() {
+            return Err(invalid(format!(
+                "{} channels, but {} channel entries",
+                acc.blocks.len(),
+                state.per_channel.len()
+            )));
+        }
+        let supported = state.per_channel.iter().filter(|c| c.support.is_some()).count();
+        if supported == state.per_channel.len() && supported > 0 {
+            let support = state
+                .per_channel
+                .iter()
+                .map(|c| c.support.clone().unwrap_or_default())
+                .collect();
+            acc = acc.with_column_support(support)?;
+        } else if supported != 0 {
+            return Err(invalid("a column support for some channels but not for others".into()));
+        }
+        let mut total = 0;
+        for (c, (block, given)) in acc.blocks.iter_mut().zip(&state.per_channel).enumerate() {
+            if block.support != given.support {
+                return Err(invalid(format!(
+                    "channel {c}: the column support is not increasing without repeats"
+                )));
+            }
+            let width = block.width(p);
+            let expected_rows = |i: usize| match state.accumulation {
+                Accumulation::Qr => width,
+                Accumulation::NormalEquations => width - i,
+            };
+            match state.accumulation {
+                Accumulation::Qr if given.factor.len() > width => {
+                    return Err(invalid(format!(
+                        "channel {c}: a QR factor of {} rows; at most {width}",
+                        given.factor.len()
+                    )))
+                }
+                Accumulation::NormalEquations if given.factor.len() != width => {
+                    return Err(invalid(format!(
+                        "channel {c}: a Gram triangle of {} rows; expected {width}",
+                        given.factor.len()
+                    )))
+                }
+                _ => {}
+            }
+            for (i, row) in given.factor.iter().enumerate() {
+                if row.len() != expected_rows(i) {
+                    return Err(invalid(format!(
+                        "channel {c}: factor row {i} has {} numbers; expected {}",
+                        row.len(),
+                        expected_rows(i)
+                    )));
+                }
+                if let Some(j) = row.iter().position(|x| !x.is_finite()) {
+                    return Err(invalid(format!("channel {c}: factor row {i}, entry {j} is not finite")));
+                }
+            }
+            block.work = match state.accumulation {
+                Accumulation::Qr => Mat::from_fn(given.factor.len(), width, |i, j| given.factor[i][j]),
+                Accumulation::NormalEquations => {
+                    Mat::from_fn(width, width, |i, j| if j >= i { given.factor[i][j - i] } else { 0.0 })
+                }
+            };
+            block.k = match state.accumulation {
+                Accumulation::Qr => given.factor.len(),
+                Accumulation::NormalEquations => 0,
+            };
+            block.rows = given.rows;
+            block.excluded = given.excluded;
+            total += given.rows + given.excluded;
+        }
+        if let Channels::Interleaved(n) = state.channels {
+            let per = state.per_channel.iter().map(|c| c.rows + c.excluded);
+            if per.clone().any(|r| n * r != total) {
+                return Err(invalid(format!(
+                    "rows per channel (taken and left out) {:?} are not whole samples of {n} rows",
+                    per.collect::<Vec<_>>()
+                )));
+            }
+        }
+        acc.rows = total;
+        Ok(acc)
     }
 
     /// How the rows are compressed.

@@ -33,6 +33,7 @@ pub mod floating;
 pub mod friction;
 pub mod gains;
 pub mod mim;
+pub mod partial;
 pub mod payload;
 pub mod pipeline;
 pub mod report;
@@ -54,7 +55,7 @@ mod subspace;
 
 pub use faer;
 
-pub use accumulate::{Accumulation, Accumulator, NORMAL_EQUATIONS_RESOLUTION};
+pub use accumulate::{Accumulation, Accumulator, AccumulatorState, ChannelState, NORMAL_EQUATIONS_RESOLUTION};
 pub use error::{IdentifyError, Input};
 pub use estimate::{
     ActiveConstraint, Combination, ConstraintKind, Estimate, Method, ParamEstimate, Residuals, Status, Table,
@@ -84,7 +85,8 @@ pub fn relative_error(estimate: f64, truth: f64) -> f64 {
 
 /// How rows are grouped into channels (e.g. joints) for per-channel weights and
 /// residual RMS.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Channels {
     /// One channel.
     #[default]

@@ -263,7 +263,9 @@ pub enum PipelineError {
     /// The estimate is not finite although every input was: values so large that
     /// the arithmetic overflowed. `largest`: the input of largest magnitude, where
     /// it is and what it is.
-    NonFiniteEstimate { largest: (f64, Location, &'static str) },
+    NonFiniteEstimate {
+        largest: Option<(f64, Location, &'static str)>,
+    },
 }
 
 impl fmt::Display for PipelineError {
@@ -286,8 +288,13 @@ impl fmt::Display for PipelineError {
             ),
             Self::Identify { at: Some(at), error } => write!(f, "{at}: {error}"),
             Self::Identify { at: None, error } => write!(f, "{error}"),
+            Self::NonFiniteEstimate { largest: None } => write!(
+                f,
+                "the estimate is not finite: the merged factors overflow the arithmetic (values of a robot's motion \
+                 and torques are below 1e6 in SI units)"
+            ),
             Self::NonFiniteEstimate {
-                largest: (value, at, what),
+                largest: Some((value, at, what)),
             } => write!(
                 f,
                 "the estimate is not finite: the recording's values overflow the arithmetic; the largest is the \
@@ -403,20 +410,9 @@ fn from_torques(
     traj: &Trajectory,
     options: &IdentifyOptions,
 ) -> Result<Identification, PipelineError> {
-    let model = dynamics.model();
-    let n = dynamics.nv();
-    let principal = options.mode == Mode::Principal;
     let mut chosen_epsilon = None;
-    let regressor = match (principal, options.joints) {
-        (true, _) => TorqueRegressor::Principal,
-        (false, JointTerms::None) if options.rotor_inertia == Some(true) => {
-            TorqueRegressor::StandardAndJoints(Coulomb::Sign)
-        }
-        (false, JointTerms::None) => TorqueRegressor::Standard,
-        (false, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
-            TorqueRegressor::StandardAndJoints(coulomb)
-        }
-        (false, JointTerms::FrictionAuto) => {
+    let regressor = match options.joints {
+        JointTerms::FrictionAuto if options.mode == Mode::Standard => {
             let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
             let mut failure = None;
             let (epsilon, _) = crate::friction::best_epsilon(|epsilon| {
@@ -435,197 +431,297 @@ fn from_torques(
             chosen_epsilon = Some(epsilon);
             TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon })
         }
+        _ => torque_regressor(options),
     };
     let acc = accumulate(dynamics, traj, regressor, 1, options)?;
-    let excluded_rows = acc.excluded_per_channel();
-    if acc.rows_per_channel().iter().all(|&r| r == 0) {
-        return Err(PipelineError::InvalidOption {
-            option: "exclude-below",
-            reason: format!(
-                "{} leaves no torque row: every joint moves slower than that at every sample",
-                options.exclude_below.unwrap_or(0.0)
-            ),
-        });
-    }
-    let opts = &options.tolerances;
-    let mut nominal = nominal(model, options.mode);
-    if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
-        nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
-    }
-    let fitted = fitted_joint_terms(options);
-    let excluded = excluded_columns(regressor, n, fitted);
-    for &c in &excluded {
-        // Ridge pulls a term left out toward 0, where it is held.
-        nominal[c] = 0.0;
-    }
-    let solve = |acc: &Accumulator| {
-        let mut estimate = match options.estimator {
-            Estimator::Ols => acc.ols(opts),
-            Estimator::Wls => acc.wls(opts),
-            Estimator::Tls { column_scaling: true } => acc.tls(opts),
-            Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
-            Estimator::Ridge { lambda } => acc.ridge(&nominal, lambda, opts),
-            Estimator::Consistent if principal => acc.principal_consistent(&PrincipalOptions::default(), opts),
-            Estimator::Consistent => acc.standard_consistent(&consistent_options(regressor, n, fitted), opts),
-        }?;
-        // The columns held at 0 are no parameters of the model.
-        for &c in &excluded {
-            estimate.solution[c] = 0.0;
-            let p = &mut estimate.params[c];
-            (p.value, p.sigma, p.status) = (None, None, crate::Status::Excluded);
-        }
-        Ok::<_, IdentifyError>(estimate)
-    };
-    let estimate = solve(&acc)?;
-    if !(estimate.solution.iter().all(|x| x.is_finite()) && estimate.residuals.rms.is_finite()) {
-        return Err(PipelineError::NonFiniteEstimate {
-            largest: largest_input(traj),
-        });
-    }
-    // The rows taken: those left out below a speed (--exclude-below) do not count.
-    let rows: usize = acc.rows_per_channel().iter().sum();
-    if rows <= estimate.solution.len() {
-        return Err(PipelineError::TooFewRows {
-            samples: traj.len(),
-            rows,
-            params: estimate.solution.len(),
-        });
-    }
-    let mut warnings = Vec::new();
-    if let Estimator::Tls { column_scaling } = options.estimator {
-        let ols = acc.ols(opts)?;
-        let ratio = estimate.residuals.rms / ols.residuals.rms;
-        if ratio > TLS_RESIDUAL_WARNING {
-            let assumption = if column_scaling {
-                "the same relative noise in every regressor column and the torques"
-            } else {
-                "equal noise in every regressor column and the torques"
-            };
-            warnings.push(format!(
-                "total least squares fits the torques {ratio:.1}× worse than ordinary least squares (residual RMS \
-                 {:.4e} against {:.4e}): its assumption of {assumption} does not hold for these data, and its \
-                 parameters can be far off; prefer ols or wls",
-                estimate.residuals.rms, ols.residuals.rms
-            ));
-        }
-    }
+    let fit = TorqueFit::new(dynamics.model(), regressor, options);
+    let (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
     let (estimate, stribeck) = match options.joints {
-        JointTerms::Stribeck(coulomb) if !principal => {
+        JointTerms::Stribeck(coulomb) if options.mode == Mode::Standard => {
             let constraints = crate::stribeck::JointConstraints {
-                fitted,
+                fitted: fit.fitted,
                 nonnegative: options.estimator == Estimator::Consistent,
             };
-            let (estimate, fit) = crate::stribeck::refine(dynamics, traj, coulomb, constraints, estimate, |t| {
+            let (estimate, stribeck) = crate::stribeck::refine(dynamics, traj, coulomb, constraints, estimate, |t| {
                 let acc = accumulate(dynamics, t, regressor, 1, options)?;
-                Ok::<_, PipelineError>(solve(&acc)?)
+                Ok::<_, PipelineError>(fit.solve(&acc)?)
             })?;
             let finite = estimate.solution.iter().all(|x| x.is_finite())
-                && fit.joints.iter().all(|s| s.fs.is_finite() && s.vs.is_finite())
-                && fit.cost.is_finite();
+                && stribeck.joints.iter().all(|s| s.fs.is_finite() && s.vs.is_finite())
+                && stribeck.cost.is_finite();
             if !finite {
                 return Err(PipelineError::NonFiniteEstimate {
-                    largest: largest_input(traj),
+                    largest: Some(largest_input(traj)),
                 });
             }
-            (estimate, Some(fit))
+            (estimate, Some(stribeck))
         }
         _ => (estimate, None),
     };
-    let mut names = if principal {
-        dyngen_model::names::principal_param_names(n)
-    } else {
-        dyngen_model::names::standard_param_names(n)
+    Ok(fit.identification(
+        (estimate, warnings),
+        acc.excluded_per_channel(),
+        stribeck,
+        chosen_epsilon,
+    ))
+}
+
+/// The names of `regressor`'s columns on `n` joints.
+pub(crate) fn param_names(n: usize, regressor: TorqueRegressor) -> Vec<String> {
+    let mut names = match regressor {
+        TorqueRegressor::Principal => dyngen_model::names::principal_param_names(n),
+        _ => dyngen_model::names::standard_param_names(n),
     };
     if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
         names.extend(dyngen_model::joint_params::joint_param_names(n));
     }
-    let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    let (parameterisation, coulomb) = match regressor {
-        TorqueRegressor::Principal => (Parameterisation::Principal, None),
-        TorqueRegressor::StandardAndJoints(c) => (
-            Parameterisation::StandardAndJoints,
-            Some(match c {
-                Coulomb::Sign => CoulombReport::Sign,
-                Coulomb::Smooth { epsilon } => CoulombReport::Tanh { epsilon },
-            }),
-        ),
-        _ => (Parameterisation::Standard, None),
-    };
-    let mut report = ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
-    let nonphysical = match regressor {
-        TorqueRegressor::StandardAndJoints(_) => {
-            let values: Vec<Option<f64>> = report.parameters[10 * n..10 * n + PER_JOINT * n]
-                .iter()
-                .map(|p| match p.status {
-                    // Not told apart from zero (or from the prior): not reported as identified.
-                    ParamStatus::NotSignificant | ParamStatus::FromPrior => None,
-                    _ => p.value,
-                })
-                .collect();
-            nonphysical_joint_terms(&values, &joint_names)
+    names
+}
+
+/// The regressor `options` ask for, but for [`JointTerms::FrictionAuto`], whose ε
+/// the data choose (it gets `Fc·sign(q̇)` here).
+pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
+    match (options.mode, options.joints) {
+        (Mode::Principal | Mode::Mim, _) => TorqueRegressor::Principal,
+        (Mode::Standard, JointTerms::None) if options.rotor_inertia == Some(true) => {
+            TorqueRegressor::StandardAndJoints(Coulomb::Sign)
         }
-        _ => Vec::new(),
-    };
-    if !nonphysical.is_empty() {
-        let list: Vec<String> = nonphysical
-            .iter()
-            .map(|p| format!("{} = {:.4e} (`{}`)", p.parameter, p.value, p.joint))
-            .collect();
-        let remedy = if options.estimator == Estimator::Consistent {
-            "--method consistent was used, which keeps Ia, Fv and Fc >= 0 only to its numerical tolerance: \
-             treat these as zero"
-        } else {
-            "--method consistent keeps every joint's Ia, Fv and Fc >= 0 (and every body physical): try it"
-        };
-        warnings.push(format!(
-            "non-physical joint parameters reported: {} (a negative rotor inertia, viscous or Coulomb friction is \
-             not physical); {remedy}",
-            list.join("; ")
-        ));
+        (Mode::Standard, JointTerms::None) => TorqueRegressor::Standard,
+        (Mode::Standard, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
+            TorqueRegressor::StandardAndJoints(coulomb)
+        }
+        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(Coulomb::Sign),
     }
-    let (coulomb_epsilon, friction) = match options.joints {
-        JointTerms::None => (None, "none"),
-        JointTerms::Friction(Coulomb::Sign) => (None, "sign"),
-        JointTerms::Friction(Coulomb::Smooth { epsilon }) => (Some(epsilon), "smooth"),
-        JointTerms::FrictionAuto => (chosen_epsilon, "auto"),
-        JointTerms::Stribeck(Coulomb::Sign) => (None, "stribeck"),
-        JointTerms::Stribeck(Coulomb::Smooth { epsilon }) => (Some(epsilon), "stribeck_smooth"),
-    };
-    report.prediction = Some(PredictionModel {
-        regressor: parameterisation,
-        coulomb,
-        solution: estimate.solution.clone(),
-        stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
-        preprocessing: Some(Preprocessing {
-            cutoff_hz: Some(options.cutoff_hz),
-            low_pass_states: Some(options.low_pass_states),
-            friction: Some(friction.to_string()),
-            coulomb_epsilon,
-            epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
-            exclude_below: options.exclude_below,
-            rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(_)).then_some(fitted[0]),
-            ..Preprocessing::default()
-        }),
-        nonphysical,
-    });
-    if let Some(fit) = &stribeck {
-        report.parameters.extend(fit.param_reports());
-    }
-    Ok(Identification {
-        mode: options.mode,
-        report,
-        mim: None,
-        prediction: Prediction::Regressor(Box::new(TorqueEstimate {
+}
+
+/// Identifies from accumulated joint-torque rows of `regressor` (standard or
+/// principal mode; no Stribeck terms and no data-chosen ε, which need the rows
+/// themselves): what a merge of partial factors solves ([`crate::partial`]).
+pub(crate) fn from_accumulator(
+    model: &Model,
+    acc: &Accumulator,
+    regressor: TorqueRegressor,
+    options: &IdentifyOptions,
+) -> Result<Identification, PipelineError> {
+    let fit = TorqueFit::new(model, regressor, options);
+    let first = fit.first(acc, || None)?;
+    Ok(fit.identification(first, acc.excluded_per_channel(), None, None))
+}
+
+/// The estimator and the report of an identification from joint torques, on a
+/// model and a regressor: one home for what a recording and merged partial
+/// factors share.
+struct TorqueFit<'a> {
+    model: &'a Model,
+    regressor: TorqueRegressor,
+    options: &'a IdentifyOptions,
+    /// The model's parameters, those held at 0 set to 0 (ridge's prior).
+    nominal: Vec<f64>,
+    /// Which of each joint's `[Ia, Fv, Fc, F0]` are fitted.
+    fitted: [bool; PER_JOINT],
+    /// The columns held at 0.
+    excluded: Vec<usize>,
+}
+
+impl<'a> TorqueFit<'a> {
+    fn new(model: &'a Model, regressor: TorqueRegressor, options: &'a IdentifyOptions) -> Self {
+        let n = model.dof();
+        let mut nominal = nominal(model, options.mode);
+        if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+            nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
+        }
+        let fitted = fitted_joint_terms(options);
+        let excluded = excluded_columns(regressor, n, fitted);
+        for &c in &excluded {
+            // Ridge pulls a term left out toward 0, where it is held.
+            nominal[c] = 0.0;
+        }
+        TorqueFit {
+            model,
             regressor,
-            names,
-            estimate,
-            truth: options.model_is_truth.then_some(nominal),
-        })),
-        warnings,
-        excluded_rows,
-        stribeck,
-    })
+            options,
+            nominal,
+            fitted,
+            excluded,
+        }
+    }
+
+    /// The estimator of the options on `acc`, the columns held at 0 excluded.
+    fn solve(&self, acc: &Accumulator) -> Result<crate::Estimate, IdentifyError> {
+        let (opts, n) = (&self.options.tolerances, self.model.dof());
+        let mut estimate = match self.options.estimator {
+            Estimator::Ols => acc.ols(opts),
+            Estimator::Wls => acc.wls(opts),
+            Estimator::Tls { column_scaling: true } => acc.tls(opts),
+            Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
+            Estimator::Ridge { lambda } => acc.ridge(&self.nominal, lambda, opts),
+            Estimator::Consistent if matches!(self.regressor, TorqueRegressor::Principal) => {
+                acc.principal_consistent(&PrincipalOptions::default(), opts)
+            }
+            Estimator::Consistent => acc.standard_consistent(&consistent_options(self.regressor, n, self.fitted), opts),
+        }?;
+        // The columns held at 0 are no parameters of the model.
+        for &c in &self.excluded {
+            estimate.solution[c] = 0.0;
+            let p = &mut estimate.params[c];
+            (p.value, p.sigma, p.status) = (None, None, crate::Status::Excluded);
+        }
+        Ok(estimate)
+    }
+
+    /// The first estimate on all of `acc`, checked: some row taken, a finite
+    /// estimate (else the error names `largest()`, the input of largest magnitude
+    /// when the data are at hand), more rows than parameters. TLS far worse than
+    /// OLS is a warning (the second value).
+    fn first(
+        &self,
+        acc: &Accumulator,
+        largest: impl Fn() -> Option<(f64, Location, &'static str)>,
+    ) -> Result<(crate::Estimate, Vec<String>), PipelineError> {
+        let options = self.options;
+        if acc.rows_per_channel().iter().all(|&r| r == 0) {
+            return Err(PipelineError::InvalidOption {
+                option: "exclude-below",
+                reason: format!(
+                    "{} leaves no torque row: every joint moves slower than that at every sample",
+                    options.exclude_below.unwrap_or(0.0)
+                ),
+            });
+        }
+        let estimate = self.solve(acc)?;
+        if !(estimate.solution.iter().all(|x| x.is_finite()) && estimate.residuals.rms.is_finite()) {
+            return Err(PipelineError::NonFiniteEstimate { largest: largest() });
+        }
+        // The rows taken: those left out below a speed (--exclude-below) do not count.
+        let rows: usize = acc.rows_per_channel().iter().sum();
+        if rows <= estimate.solution.len() {
+            return Err(PipelineError::TooFewRows {
+                samples: acc.rows() / self.model.dof().max(1),
+                rows,
+                params: estimate.solution.len(),
+            });
+        }
+        let mut warnings = Vec::new();
+        if let Estimator::Tls { column_scaling } = options.estimator {
+            let ols = acc.ols(&options.tolerances)?;
+            let ratio = estimate.residuals.rms / ols.residuals.rms;
+            if ratio > TLS_RESIDUAL_WARNING {
+                let assumption = if column_scaling {
+                    "the same relative noise in every regressor column and the torques"
+                } else {
+                    "equal noise in every regressor column and the torques"
+                };
+                warnings.push(format!(
+                    "total least squares fits the torques {ratio:.1}× worse than ordinary least squares (residual \
+                     RMS {:.4e} against {:.4e}): its assumption of {assumption} does not hold for these data, and \
+                     its parameters can be far off; prefer ols or wls",
+                    estimate.residuals.rms, ols.residuals.rms
+                ));
+            }
+        }
+        Ok((estimate, warnings))
+    }
+
+    /// The identification of `estimate` with its report.
+    fn identification(
+        self,
+        (estimate, mut warnings): (crate::Estimate, Vec<String>),
+        excluded_rows: Vec<usize>,
+        stribeck: Option<StribeckFit>,
+        chosen_epsilon: Option<f64>,
+    ) -> Identification {
+        let (model, regressor, options) = (self.model, self.regressor, self.options);
+        let n = model.dof();
+        let names = param_names(n, regressor);
+        let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let (parameterisation, coulomb) = match regressor {
+            TorqueRegressor::Principal => (Parameterisation::Principal, None),
+            TorqueRegressor::StandardAndJoints(c) => (
+                Parameterisation::StandardAndJoints,
+                Some(match c {
+                    Coulomb::Sign => CoulombReport::Sign,
+                    Coulomb::Smooth { epsilon } => CoulombReport::Tanh { epsilon },
+                }),
+            ),
+            _ => (Parameterisation::Standard, None),
+        };
+        let mut report =
+            ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
+        let nonphysical = match regressor {
+            TorqueRegressor::StandardAndJoints(_) => {
+                let values: Vec<Option<f64>> = report.parameters[10 * n..10 * n + PER_JOINT * n]
+                    .iter()
+                    .map(|p| match p.status {
+                        // Not told apart from zero (or from the prior): not reported as identified.
+                        ParamStatus::NotSignificant | ParamStatus::FromPrior => None,
+                        _ => p.value,
+                    })
+                    .collect();
+                nonphysical_joint_terms(&values, &joint_names)
+            }
+            _ => Vec::new(),
+        };
+        if !nonphysical.is_empty() {
+            let list: Vec<String> = nonphysical
+                .iter()
+                .map(|p| format!("{} = {:.4e} (`{}`)", p.parameter, p.value, p.joint))
+                .collect();
+            let remedy = if options.estimator == Estimator::Consistent {
+                "--method consistent was used, which keeps Ia, Fv and Fc >= 0 only to its numerical tolerance: \
+                 treat these as zero"
+            } else {
+                "--method consistent keeps every joint's Ia, Fv and Fc >= 0 (and every body physical): try it"
+            };
+            warnings.push(format!(
+                "non-physical joint parameters reported: {} (a negative rotor inertia, viscous or Coulomb friction is \
+                 not physical); {remedy}",
+                list.join("; ")
+            ));
+        }
+        let (coulomb_epsilon, friction) = match options.joints {
+            JointTerms::None => (None, "none"),
+            JointTerms::Friction(Coulomb::Sign) => (None, "sign"),
+            JointTerms::Friction(Coulomb::Smooth { epsilon }) => (Some(epsilon), "smooth"),
+            JointTerms::FrictionAuto => (chosen_epsilon, "auto"),
+            JointTerms::Stribeck(Coulomb::Sign) => (None, "stribeck"),
+            JointTerms::Stribeck(Coulomb::Smooth { epsilon }) => (Some(epsilon), "stribeck_smooth"),
+        };
+        report.prediction = Some(PredictionModel {
+            regressor: parameterisation,
+            coulomb,
+            solution: estimate.solution.clone(),
+            stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
+            preprocessing: Some(Preprocessing {
+                cutoff_hz: Some(options.cutoff_hz),
+                low_pass_states: Some(options.low_pass_states),
+                friction: Some(friction.to_string()),
+                coulomb_epsilon,
+                epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
+                exclude_below: options.exclude_below,
+                rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(_)).then_some(self.fitted[0]),
+                ..Preprocessing::default()
+            }),
+            nonphysical,
+        });
+        if let Some(fit) = &stribeck {
+            report.parameters.extend(fit.param_reports());
+        }
+        Identification {
+            mode: options.mode,
+            report,
+            mim: None,
+            prediction: Prediction::Regressor(Box::new(TorqueEstimate {
+                regressor,
+                names,
+                estimate,
+                truth: options.model_is_truth.then_some(self.nominal),
+            })),
+            warnings,
+            excluded_rows,
+            stribeck,
+        }
+    }
 }
 
 /// The joint parameters among `values` (per joint `[Ia, Fv, Fc, F0]`, `None` where
@@ -658,7 +754,7 @@ pub fn nonphysical_joint_terms(values: &[Option<f64>], joints: &[&str]) -> Vec<N
 }
 
 /// The input of `traj` of largest magnitude: its value, where it is and what it is.
-fn largest_input(traj: &Trajectory) -> (f64, Location, &'static str) {
+pub(crate) fn largest_input(traj: &Trajectory) -> (f64, Location, &'static str) {
     let n = traj.dof();
     let columns: [(Option<&[f64]>, &'static str); 4] = [
         (Some(traj.positions()), "position"),
@@ -720,6 +816,25 @@ fn consistent_options(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_J
         nonnegative,
         ..StandardOptions::default()
     }
+}
+
+/// The rows of `regressor` over every sample of `traj`, accumulated as `options`
+/// say, after checking that `traj` fits `dynamics` and has velocities and
+/// accelerations: a recording's partial factor ([`crate::partial`]).
+pub(crate) fn accumulate_recording(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    regressor: TorqueRegressor,
+    options: &IdentifyOptions,
+) -> Result<Accumulator, PipelineError> {
+    if traj.dof() != dynamics.nv() {
+        return Err(PipelineError::DofMismatch {
+            expected: dynamics.nv(),
+            found: traj.dof(),
+        });
+    }
+    need_derivatives(traj)?;
+    accumulate(dynamics, traj, regressor, 1, options)
 }
 
 /// The rows of `regressor` over every `stride`-th sample of `traj`, accumulated
@@ -1452,7 +1567,7 @@ mod tests {
         let PipelineError::NonFiniteEstimate { largest } = &err else {
             panic!("{err:?}");
         };
-        assert_eq!(*largest, (1e300, Location::Sample(17), "torque"));
+        assert_eq!(*largest, Some((1e300, Location::Sample(17), "torque")));
         assert!(
             err.to_string().contains("the largest is the torque 1e300 at sample 17"),
             "{err}"

@@ -14,9 +14,33 @@ flyer's quaternion ``[x, y, z, w]``; but a continuous joint has one coordinate, 
 angle, where Pinocchio has ``(cos, sin)``.
 
 :func:`identify` runs the identification of ``dyngen identify`` on a recording and
-returns its estimate as a dict of numpy arrays.
+returns its estimate as a dict of numpy arrays. For many recordings,
+:func:`identify_partial` compresses each into a :class:`Partial` (on any machine;
+picklable), :func:`merge_partials` or :meth:`Partial.merge` merge them exactly, and
+:meth:`Partial.solve` gives what :func:`identify` gives on all their samples (see
+``examples/fleet_dask.py``).
 """
 
-from ._dyngen import LoadError, Model, __version__, identify, load
+from ._dyngen import (
+    LoadError,
+    Model,
+    Partial,
+    __version__,
+    identify,
+    identify_partial,
+    load,
+    load_partial,
+    merge_partials,
+)
 
-__all__ = ["LoadError", "Model", "__version__", "identify", "load"]
+__all__ = [
+    "LoadError",
+    "Model",
+    "Partial",
+    "__version__",
+    "identify",
+    "identify_partial",
+    "load",
+    "load_partial",
+    "merge_partials",
+]

@@ -45,6 +45,64 @@ def identify(
     ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
     ``warnings``. Raises :class:`LoadError` or ``ValueError``."""
 
+def identify_partial(
+    robot_path: Union[str, "os.PathLike[str]"],
+    data_path: Union[str, "os.PathLike[str]"],
+    *,
+    mode: str = "standard",
+    friction: str = "none",
+    epsilon: float = 0.01,
+    cutoff: float = 10.0,
+    raw_states: bool = False,
+    recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Partial:
+    """The partial factor of one recording (``dyngen identify ROBOT DATA --partial
+    OUT``): the options of :func:`identify` that shape the rows; ``mode`` ``"standard"``
+    or ``"principal"``, ``friction`` ``"none"``, ``"sign"`` or ``"smooth"`` (``"mim"``,
+    ``"auto"`` and the Stribeck models need the rows themselves and are refused).
+    Raises :class:`LoadError` or ``ValueError``."""
+
+def merge_partials(partials: List[Partial]) -> Partial:
+    """The partials merged in order; ``ValueError`` names two that were made for
+    other robots or with other row options."""
+
+def load_partial(path: Union[str, "os.PathLike[str]"]) -> Partial:
+    """A partial factor file (``--partial OUT`` or :meth:`Partial.save`). Raises
+    ``OSError`` or ``ValueError`` (not a partial, another schema version)."""
+
+class Partial:
+    """The sufficient statistics of the joint-torque rows of one or more recordings:
+    per joint the triangular factor of its rows of ``[A y]``, the robot, and the
+    options that shaped the rows. Partials merge exactly; :meth:`solve` gives what
+    :func:`identify` gives on all their samples. Picklable (as its JSON text)."""
+
+    def __init__(self, text: str) -> None:
+        """The partial in ``text``, the JSON of :meth:`to_json` or a ``--partial`` file."""
+    def to_json(self) -> str:
+        """The partial as JSON (schema ``dyngen-partial/1``); numbers read back bit for bit."""
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes the partial to ``path`` (read by ``dyngen identify ROBOT --merge``)."""
+    def merge(self, other: Partial) -> Partial:
+        """A new partial holding the rows of both; ``ValueError`` for other robots or row options."""
+    def solve(
+        self, robot_path: Union[str, "os.PathLike[str]"], *, method: str = "ols", ridge_lambda: float = 1e-6
+    ) -> Dict[str, Any]:
+        """Identifies the robot the partial was made for from its rows: ``method`` as in
+        :func:`identify`; returns the dict of :func:`identify`. Raises
+        :class:`LoadError` or ``ValueError`` (another robot, a failing estimate)."""
+    @property
+    def recordings(self) -> List[str]:
+        """The recordings whose rows it holds, in merge order."""
+    @property
+    def samples(self) -> int:
+        """Samples of all its recordings."""
+    @property
+    def robot(self) -> str:
+        """The robot's name."""
+    @property
+    def parameters(self) -> List[str]:
+        """The parameter names, in the regressor's column order."""
+
 class Model:
     """A robot loaded by :func:`load` and the rigid-body algorithms on it.
 

@@ -3,18 +3,22 @@
 
 use crate::LoadError;
 use dyngen_identify::data::Recipe;
-use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, Mode};
+use dyngen_identify::partial::{self, Partial, PartialError};
+use dyngen_identify::pipeline::{self, Estimator, Identification, IdentifyOptions, JointTerms, Mode};
+use dyngen_identify::report::DataSpan;
 use dyngen_model::joint_params::Coulomb;
-use dyngen_model::LoadOptions;
+use dyngen_model::{LoadOptions, Model};
 use dyngen_reference::Reference;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use std::path::PathBuf;
+use pyo3::types::{PyDict, PyTuple, PyType};
+use std::path::{Path, PathBuf};
 
 /// The options of `identify`, as given from Python.
 struct Choices<'a> {
+    /// The Python function, for the messages.
+    function: &'a str,
     mode: &'a str,
     method: &'a str,
     friction: &'a str,
@@ -24,9 +28,9 @@ struct Choices<'a> {
     raw_states: bool,
 }
 
-fn invalid(option: &str, value: &str, valid: &[&str]) -> PyErr {
+fn invalid(function: &str, option: &str, value: &str, valid: &[&str]) -> PyErr {
     PyValueError::new_err(format!(
-        "identify: unknown {option} `{value}`; it must be one of: {}",
+        "{function}: unknown {option} `{value}`; it must be one of: {}",
         valid.join(", ")
     ))
 }
@@ -37,7 +41,7 @@ impl Choices<'_> {
             "standard" => Mode::Standard,
             "principal" => Mode::Principal,
             "mim" => Mode::Mim,
-            other => return Err(invalid("mode", other, &["standard", "principal", "mim"])),
+            other => return Err(invalid(self.function, "mode", other, &["standard", "principal", "mim"])),
         };
         let estimator = match self.method {
             "ols" => Estimator::Ols,
@@ -50,6 +54,7 @@ impl Choices<'_> {
             "consistent" => Estimator::Consistent,
             other => {
                 return Err(invalid(
+                    self.function,
                     "method",
                     other,
                     &["ols", "wls", "tls", "tls-unscaled", "ridge", "consistent"],
@@ -66,6 +71,7 @@ impl Choices<'_> {
             "stribeck-smooth" => JointTerms::Stribeck(smooth),
             other => {
                 return Err(invalid(
+                    self.function,
                     "friction",
                     other,
                     &["none", "sign", "smooth", "auto", "stribeck", "stribeck-smooth"],
@@ -82,7 +88,7 @@ impl Choices<'_> {
         };
         options
             .check()
-            .map_err(|e| PyValueError::new_err(format!("identify: {e}")))?;
+            .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.function)))?;
         Ok(options)
     }
 }
@@ -152,6 +158,7 @@ pub fn identify<'py>(
     recipe: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = Choices {
+        function: "identify",
         mode,
         method,
         friction,
@@ -161,12 +168,29 @@ pub fn identify<'py>(
         raw_states,
     }
     .options()?;
-    let recipe = match &recipe {
+    let recipe = read_recipe("identify", recipe.as_deref())?;
+    let model = load_robot(&robot_path)?;
+    let failed = |e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", data_path.display()));
+    let identified = py.detach(|| {
+        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(failed)?;
+        let robot = Reference::new(&model);
+        pipeline::identify(&robot, &loaded.trajectory, &options).map_err(failed)
+    })?;
+    to_dict(py, &identified)
+}
+
+/// The recipe at `path`, or the default.
+fn read_recipe(function: &str, path: Option<&Path>) -> PyResult<Recipe> {
+    match path {
         Some(path) => Recipe::from_file(path)
-            .map_err(|e| PyValueError::new_err(format!("identify: recipe {}: {e}", path.display())))?,
-        None => Recipe::default(),
-    };
-    let model = dyngen_model::load_robot_options(&robot_path, LoadOptions::default())
+            .map_err(|e| PyValueError::new_err(format!("{function}: recipe {}: {e}", path.display()))),
+        None => Ok(Recipe::default()),
+    }
+}
+
+/// The robot at `robot_path`, with joints of one degree of freedom each.
+fn load_robot(robot_path: &Path) -> PyResult<Model> {
+    let model = dyngen_model::load_robot_options(robot_path, LoadOptions::default())
         .map_err(|e| LoadError::new_err(e.to_string()))?;
     if model.dof() == 0 {
         return Err(LoadError::new_err(format!(
@@ -182,12 +206,11 @@ pub fn identify<'py>(
             j.kind.urdf_name()
         )));
     }
-    let failed = |e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", data_path.display()));
-    let identified = py.detach(|| {
-        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(failed)?;
-        let robot = Reference::new(&model);
-        pipeline::identify(&robot, &loaded.trajectory, &options).map_err(failed)
-    })?;
+    Ok(model)
+}
+
+/// An identification as the dict `identify` returns.
+fn to_dict<'py>(py: Python<'py>, identified: &Identification) -> PyResult<Bound<'py, PyDict>> {
     let report = &identified.report;
     let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
     let out = PyDict::new(py);
@@ -238,4 +261,272 @@ pub fn identify<'py>(
     )?;
     out.set_item("warnings", identified.warnings.clone())?;
     Ok(out)
+}
+
+/// The sufficient statistics of the joint-torque rows of one or more recordings:
+/// per joint the triangular factor of its rows of `[A y]`, with the robot it was
+/// made for and every option that shaped the rows. Partials of the same robot and
+/// options merge exactly (`merge`, `merge_partials`, in any grouping) and `solve`
+/// then gives what `identify` gives on all their samples.
+///
+/// Made by `identify_partial`, read by `load_partial` (the files of
+/// `dyngen identify ROBOT DATA --partial OUT`), or `Partial(text)` from the JSON
+/// text of `to_json()`. Picklable (as that text), so it travels between processes
+/// and machines (e.g. Dask workers).
+#[pyclass(name = "Partial", module = "dyngen", frozen)]
+pub struct PyPartial {
+    inner: Partial,
+}
+
+/// How a Python error names `partial`: by its recordings.
+fn label(partial: &Partial) -> String {
+    let files: Vec<&str> = partial.recordings.iter().map(|r| r.file.as_str()).collect();
+    match files.as_slice() {
+        [] => "a partial without recordings".to_string(),
+        [one] => format!("the partial of {one}"),
+        [first, rest @ ..] => format!("the partial of {first} and {} more recordings", rest.len()),
+    }
+}
+
+fn partial_error(function: &str, e: PartialError) -> PyErr {
+    PyValueError::new_err(format!("{function}: {e}"))
+}
+
+/// `partials` merged in order; an error names the two that differ.
+fn merge(function: &str, partials: &[&Partial]) -> PyResult<Partial> {
+    let labels: Vec<String> = partials.iter().map(|p| label(p)).collect();
+    let owned: Vec<Partial> = partials.iter().map(|p| (*p).clone()).collect();
+    partial::merge_all(&owned, &labels).map_err(|e| PyValueError::new_err(format!("{function}: {e}")))
+}
+
+#[pymethods]
+impl PyPartial {
+    /// The partial in `text`, the JSON of `to_json()` or of a `--partial` file.
+    ///
+    /// Raises:
+    ///     ValueError: not a partial, another schema version, inconsistent factors.
+    #[new]
+    fn new(text: &str) -> PyResult<Self> {
+        Partial::from_json(text)
+            .map(|inner| PyPartial { inner })
+            .map_err(|e| partial_error("Partial", e))
+    }
+
+    /// The partial as JSON text (schema `dyngen-partial/1`); numbers read back bit
+    /// for bit.
+    fn to_json(&self) -> PyResult<String> {
+        self.inner.to_json().map_err(|e| partial_error("Partial.to_json", e))
+    }
+
+    /// Pickled as its JSON text.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyType>, Bound<'py, PyTuple>)> {
+        let text = slf.get().to_json()?;
+        Ok((slf.get_type(), PyTuple::new(slf.py(), [text])?))
+    }
+
+    /// Writes the partial to `path` (a file `dyngen identify ROBOT --merge` reads),
+    /// replacing it if it exists.
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        let text = self.to_json()?;
+        std::fs::write(&path, text)
+            .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("Partial.save: {}: {e}", path.display())))
+    }
+
+    /// This partial merged with `other` (a new partial; neither is changed): the
+    /// rows of both, as if `other`'s recordings had been read after these.
+    ///
+    /// Raises:
+    ///     ValueError: they were made for other robots or with other row options
+    ///         (the message names both and the difference).
+    fn merge(&self, py: Python<'_>, other: &Bound<'_, PyPartial>) -> PyResult<PyPartial> {
+        let other = &other.get().inner;
+        let inner = py.detach(|| merge("Partial.merge", &[&self.inner, other]))?;
+        Ok(PyPartial { inner })
+    }
+
+    /// Identifies the robot at `robot_path` (the one the partial was made for)
+    /// from the merged rows, as `identify` does on all the samples.
+    ///
+    /// Args:
+    ///     robot_path: the URDF (or MJCF) the partials were made with.
+    ///     method: `"ols"` (default), `"wls"`, `"tls"`, `"tls-unscaled"`, `"ridge"`
+    ///         (with `ridge_lambda`) or `"consistent"`.
+    ///     ridge_lambda: the scale-free weight of `"ridge"`.
+    ///
+    /// Returns:
+    ///     The dict of `identify`.
+    ///
+    /// Raises:
+    ///     LoadError: the robot does not load.
+    ///     ValueError: an unknown method, another robot than the partial's, a
+    ///         failing estimate.
+    #[pyo3(signature = (robot_path, *, method = "ols", ridge_lambda = 1e-6))]
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        robot_path: PathBuf,
+        method: &str,
+        ridge_lambda: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let given = Choices {
+            function: "Partial.solve",
+            mode: "standard",
+            method,
+            friction: "none",
+            epsilon: 0.01,
+            ridge_lambda,
+            cutoff: 10.0,
+            raw_states: false,
+        }
+        .options()?;
+        let model = load_robot(&robot_path)?;
+        let identified = py.detach(|| {
+            self.inner
+                .identify(&Reference::new(&model), &given)
+                .map_err(|e| match e {
+                    PartialError::Mismatch { what, ours, theirs } => PyValueError::new_err(format!(
+                        "Partial.solve: {}: not the robot the partial was made for: different {what}: the partial's \
+                         {ours} against this {theirs}",
+                        robot_path.display()
+                    )),
+                    e => partial_error("Partial.solve", e),
+                })
+        })?;
+        to_dict(py, &identified)
+    }
+
+    /// The recordings whose rows the partial holds (file names, in merge order).
+    #[getter]
+    fn recordings(&self) -> Vec<String> {
+        self.inner.recordings.iter().map(|r| r.file.clone()).collect()
+    }
+
+    /// Samples of all its recordings.
+    #[getter]
+    fn samples(&self) -> usize {
+        self.inner.recordings.iter().map(|r| r.samples).sum()
+    }
+
+    /// The robot's name.
+    #[getter]
+    fn robot(&self) -> String {
+        self.inner.robot.name.clone()
+    }
+
+    /// The parameter names, in the order of the regressor's columns.
+    #[getter]
+    fn parameters(&self) -> Vec<String> {
+        self.inner.robot.parameters.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Partial({}: {} recordings, {} samples, {} parameters)",
+            self.inner.robot.name,
+            self.inner.recordings.len(),
+            self.samples(),
+            self.inner.robot.parameters.len()
+        )
+    }
+}
+
+/// The partial factor of one recording: what `identify` reads and accumulates,
+/// without the estimate (`dyngen identify ROBOT DATA --partial OUT`).
+///
+/// Args: those of `identify` that shape the rows (`robot_path`, `data_path`,
+/// `mode`, `friction`, `epsilon`, `cutoff`, `raw_states`, `recipe`). The estimator
+/// is chosen by `Partial.solve`.
+///
+/// Returns:
+///     A `Partial`.
+///
+/// Raises:
+///     LoadError: the robot does not load.
+///     ValueError: an unknown option; `mode="mim"`, `friction="auto"`, `"stribeck"`
+///         or `"stribeck-smooth"` (they need the rows themselves, which a partial
+///         does not keep: the message says what works); a recording that does not
+///         read or does not fit the robot.
+#[pyfunction]
+#[pyo3(signature = (
+    robot_path,
+    data_path,
+    *,
+    mode = "standard",
+    friction = "none",
+    epsilon = 0.01,
+    cutoff = 10.0,
+    raw_states = false,
+    recipe = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn identify_partial(
+    py: Python<'_>,
+    robot_path: PathBuf,
+    data_path: PathBuf,
+    mode: &str,
+    friction: &str,
+    epsilon: f64,
+    cutoff: f64,
+    raw_states: bool,
+    recipe: Option<PathBuf>,
+) -> PyResult<PyPartial> {
+    let options = Choices {
+        function: "identify_partial",
+        mode,
+        method: "ols",
+        friction,
+        epsilon,
+        ridge_lambda: 1e-6,
+        cutoff,
+        raw_states,
+    }
+    .options()?;
+    let failed =
+        |e: pipeline::PipelineError| PyValueError::new_err(format!("identify_partial: {}: {e}", data_path.display()));
+    partial::check_options(&options).map_err(|e| PyValueError::new_err(format!("identify_partial: {e}")))?;
+    let recipe = read_recipe("identify_partial", recipe.as_deref())?;
+    let model = load_robot(&robot_path)?;
+    let inner = py.detach(|| {
+        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(failed)?;
+        let span = DataSpan::of(&data_path, &loaded.trajectory);
+        Partial::from_trajectory(&Reference::new(&model), &loaded.trajectory, &options, &recipe, span).map_err(failed)
+    })?;
+    Ok(PyPartial { inner })
+}
+
+/// `partials` merged in order (a left fold; any grouping gives the same estimate
+/// up to rounding).
+///
+/// Raises:
+///     ValueError: an empty list, or two partials made for other robots or with
+///         other row options (the message names both and the difference).
+#[pyfunction]
+pub fn merge_partials(py: Python<'_>, partials: Vec<Bound<'_, PyPartial>>) -> PyResult<PyPartial> {
+    let inner: Vec<&Partial> = partials.iter().map(|p| &p.get().inner).collect();
+    let inner = py.detach(|| merge("merge_partials", &inner))?;
+    Ok(PyPartial { inner })
+}
+
+/// The partial factor file at `path` (`dyngen identify ... --partial OUT`, or
+/// `Partial.save`).
+///
+/// Raises:
+///     OSError: the file does not read.
+///     ValueError: not a partial, another schema version, inconsistent factors.
+#[pyfunction]
+pub fn load_partial(path: PathBuf) -> PyResult<PyPartial> {
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("load_partial: {}: {e}", path.display())))?;
+    Partial::from_json(&text)
+        .map(|inner| PyPartial { inner })
+        .map_err(|e| PyValueError::new_err(format!("load_partial: {}: {e}", path.display())))
+}
+
+/// Registers the partial factors' class and functions in the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPartial>()?;
+    m.add_function(wrap_pyfunction!(identify_partial, m)?)?;
+    m.add_function(wrap_pyfunction!(merge_partials, m)?)?;
+    m.add_function(wrap_pyfunction!(load_partial, m)?)?;
+    Ok(())
 }

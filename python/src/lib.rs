@@ -1491,6 +1491,7 @@ impl PyModel {
 fn _dyngen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
+    identify::register(m)?;
     m.add_class::<PyModel>()?;
     m.add("LoadError", m.py().get_type::<LoadError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -479,6 +479,16 @@ impl Recipe {
         Ok(recipe)
     }
 
+    /// The recipe without its time and row windows: how to read any recording
+    /// of the same logger, not which part of one.
+    pub fn without_window(&self) -> Recipe {
+        Recipe {
+            window: None,
+            rows: None,
+            ..self.clone()
+        }
+    }
+
     /// The recipe as `key = value` lines that [`Recipe::parse`] reads back to the
     /// same recipe; only the keys that differ from [`Recipe::default`] are written
     /// (the default recipe is the empty text). Header names holding `,` or `#`

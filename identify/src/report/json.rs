@@ -140,6 +140,10 @@ pub struct Preprocessing {
     /// Whether the rotor inertias `Ia` were fitted (`false`: left out, 0), when
     /// joint terms were.
     pub rotor_inertia: Option<bool>,
+    /// Identified from merged partial factors ([`crate::partial`]): every
+    /// recording and the part of it used (`data` and `window` are then absent).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub recordings: Vec<DataSpan>,
 }
 
 /// Which samples of which file an identification used.
@@ -154,6 +158,21 @@ pub struct DataSpan {
     /// Their time stamps (s).
     pub t_first: Option<f64>,
     pub t_last: Option<f64>,
+}
+
+impl DataSpan {
+    /// Which samples of the file `path` `traj` holds.
+    pub fn of(path: &Path, traj: &crate::data::Trajectory) -> DataSpan {
+        let last = traj.len().saturating_sub(1);
+        DataSpan {
+            file: path.display().to_string(),
+            samples: traj.len(),
+            first: traj.location(0).to_string(),
+            last: traj.location(last).to_string(),
+            t_first: traj.t().first().copied(),
+            t_last: traj.t().last().copied(),
+        }
+    }
 }
 
 /// A joint parameter reported with a value that is not physical.

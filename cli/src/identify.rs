@@ -440,18 +440,6 @@ pub fn load_recording(
     Ok(loaded.trajectory)
 }
 
-/// Only the time and row windows of `recipe`, as recipe lines (`window = 5:65`);
-/// `None` when it has neither.
-pub fn window_lines(recipe: &Recipe) -> Option<String> {
-    let windows = Recipe {
-        window: recipe.window,
-        rows: recipe.rows,
-        ..Recipe::default()
-    };
-    let text = windows.to_text();
-    (!text.is_empty()).then(|| text.trim_end().replace('\n', "; "))
-}
-
 /// `1000 samples of run.csv, line 2 to line 1001 (t = 0 … 9.99 s)`.
 pub fn describe_span(span: &DataSpan) -> String {
     let times = match (span.t_first, span.t_last) {
@@ -590,7 +578,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if let Some(prediction) = identified.report.prediction.as_mut() {
         if let Some(pre) = prediction.preprocessing.as_mut() {
             pre.recipe = Some(recipe.without_window().to_text());
-            pre.window = window_lines(&recipe);
+            pre.window = recipe.window_text();
             pre.data = Some(training.clone());
             pre.gravity = args.recording.gravity.get()?;
         }
@@ -630,7 +618,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             (Some(r), _) => format!("read through --validate-recipe {}", r.display()),
             (None, _) => "read through the training recipe".to_string(),
         };
-        let window = match (&args.validate_window, window_lines(&recipe)) {
+        let window = match (&args.validate_window, recipe.window_text()) {
             (Some(w), _) => format!("--validate-window {w}"),
             (None, Some(training)) => format!("all of it: the training window ({training}) is not applied to it"),
             (None, None) => "all of it".to_string(),

@@ -35,6 +35,8 @@ def identify(
     cutoff: float = 10.0,
     raw_states: bool = False,
     recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+    validate: Optional[Union[str, "os.PathLike[str]"]] = None,
+    validate_recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> Dict[str, Any]:
     """Identifies the robot's inertial parameters from a recording, as ``dyngen
     identify`` does: ``mode`` ``"standard"``, ``"principal"`` or ``"mim"``; ``method``

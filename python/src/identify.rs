@@ -6,6 +6,7 @@ use dyngen_identify::data::Recipe;
 use dyngen_identify::partial::{self, Partial, PartialError};
 use dyngen_identify::pipeline::{self, Estimator, Identification, IdentifyOptions, JointTerms, Mode};
 use dyngen_identify::report::DataSpan;
+use dyngen_identify::validate::Validation;
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::{LoadOptions, Model};
 use dyngen_reference::Reference;
@@ -115,6 +116,9 @@ impl Choices<'_> {
 ///         from positions, and of the measured states.
 ///     raw_states: use the measured positions and velocities as read, not low-passed.
 ///     recipe: the path of a recipe file saying how to read a log of another layout.
+///     validate: a second recording to predict with the result (held-out data).
+///     validate_recipe: the recipe of the validation recording; by default the
+///         training recipe without its time and row windows.
 ///
 /// Returns:
 ///     A dict: `names` (list of str), `values`, `sigma`, `sigma_percent` (numpy
@@ -123,7 +127,12 @@ impl Choices<'_> {
 ///     channel), `channels` (list of str), `combinations` (the identifiable
 ///     combinations as text), `combination_matrix` (their coefficients, one row
 ///     per combination, one column per name), `combination_values`,
-///     `combination_sigma` (numpy arrays), `warnings` (list of str).
+///     `combination_sigma` (numpy arrays), `warnings` (list of str),
+///     `parameters_json` (the text `dyngen identify --params-json` writes, with the
+///     preprocessing, for `dyngen validate`; None for `mode="mim"`), and with
+///     `validate` a dict `validation`: `samples`, `joint_names`, per joint `rms`
+///     (of the prediction error), `measured_rms`, `relative` (‖τ̂ − τ‖ / ‖τ‖), and
+///     `overall` (over every joint and sample).
 ///
 /// Raises:
 ///     LoadError: the robot does not load.
@@ -142,6 +151,8 @@ impl Choices<'_> {
     cutoff = 10.0,
     raw_states = false,
     recipe = None,
+    validate = None,
+    validate_recipe = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
@@ -156,7 +167,14 @@ pub fn identify<'py>(
     cutoff: f64,
     raw_states: bool,
     recipe: Option<PathBuf>,
+    validate: Option<PathBuf>,
+    validate_recipe: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if validate_recipe.is_some() && validate.is_none() {
+        return Err(PyValueError::new_err(
+            "identify: `validate_recipe` is the recipe of the `validate` recording; give `validate` too",
+        ));
+    }
     let options = Choices {
         function: "identify",
         mode,
@@ -169,14 +187,68 @@ pub fn identify<'py>(
     }
     .options()?;
     let recipe = read_recipe("identify", recipe.as_deref())?;
+    let validation_recipe = match &validate_recipe {
+        Some(_) => read_recipe("identify", validate_recipe.as_deref())?,
+        None => recipe.without_window(),
+    };
     let model = load_robot(&robot_path)?;
-    let failed = |e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", data_path.display()));
-    let identified = py.detach(|| {
-        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(failed)?;
-        let robot = Reference::new(&model);
-        pipeline::identify(&robot, &loaded.trajectory, &options).map_err(failed)
+    let failed =
+        |path: &Path, e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", path.display()));
+    let robot = Reference::new(&model);
+    let (identified, validation) = py.detach(|| {
+        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(|e| failed(&data_path, e))?;
+        let mut identified =
+            pipeline::identify(&robot, &loaded.trajectory, &options).map_err(|e| failed(&data_path, e))?;
+        // What `--params-json` records of the preprocessing, for `dyngen validate`.
+        if let Some(pre) = identified
+            .report
+            .prediction
+            .as_mut()
+            .and_then(|p| p.preprocessing.as_mut())
+        {
+            pre.recipe = Some(recipe.without_window().to_text());
+            pre.window = recipe.window_text();
+            pre.data = Some(DataSpan::of(&data_path, &loaded.trajectory));
+        }
+        let validation = match &validate {
+            None => None,
+            Some(path) => {
+                let other =
+                    pipeline::load(path, &validation_recipe, model.dof(), &options).map_err(|e| failed(path, e))?;
+                let predicted = identified
+                    .predict(&robot, &other.trajectory)
+                    .map_err(|e| failed(path, e))?;
+                let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+                let t = &other.trajectory;
+                let v = Validation::new(&names, (0..t.len()).map(|k| t.tau(k)), predicted.iter().map(|p| &p[..]))
+                    .map_err(|e| PyValueError::new_err(format!("identify: validation {}: {e}", path.display())))?;
+                Some(v)
+            }
+        };
+        Ok::<_, PyErr>((identified, validation))
     })?;
-    to_dict(py, &identified)
+    let out = to_dict(py, &identified)?;
+    let json = match identified.mim {
+        Some(_) => None,
+        None => Some(
+            identified
+                .report
+                .to_json()
+                .map_err(|e| PyValueError::new_err(format!("identify: {e}")))?,
+        ),
+    };
+    out.set_item("parameters_json", json)?;
+    if let Some(v) = validation {
+        let d = PyDict::new(py);
+        d.set_item("samples", v.samples)?;
+        d.set_item("joint_names", v.joint_names.clone())?;
+        d.set_item("rms", PyArray1::from_slice(py, &v.rms))?;
+        d.set_item("measured_rms", PyArray1::from_slice(py, &v.measured_rms))?;
+        d.set_item("relative", PyArray1::from_slice(py, &v.relative))?;
+        d.set_item("overall", v.overall)?;
+        out.set_item("validation", d)?;
+    }
+    Ok(out)
 }
 
 /// The recipe at `path`, or the default.

@@ -2,12 +2,13 @@
 exact torques, so the identifiable parameters come back exactly."""
 
 import re
+import subprocess
 
 import numpy as np
 import pytest
 
 import dyngen
-from conftest import ROBOTS
+from conftest import ROBOTS, ROOT
 
 
 @pytest.fixture(scope="module")
@@ -70,3 +71,35 @@ def test_recording_of_another_robot(recording):
     with pytest.raises(ValueError, match="identify: ") as info:
         dyngen.identify(ROBOTS[1][1], path)  # the Panda has 7 joints, the recording 6
     assert "7" in str(info.value)
+
+
+def test_validation_and_parameters_json(recording, tmp_path):
+    """`validate=` predicts a second recording (here the first with a quarter of its
+    rows through a recipe window, and all of it): exact data, so every joint's
+    relative error is at rounding level; `parameters_json` is what `dyngen validate`
+    reads, and gives the same overall error there."""
+    robot, truth, path = recording
+    window = tmp_path / "window.recipe"
+    window.write_text("window = 0:5\n")
+    result = dyngen.identify(ROBOTS[0][1], path, raw_states=True, recipe=window, validate=path)
+    v = result["validation"]
+    assert v["samples"] == 2000  # the training window is not applied to the validation recording
+    assert v["joint_names"] == robot.joint_names
+    assert v["rms"].shape == v["relative"].shape == v["measured_rms"].shape == (robot.nv,)
+    assert np.max(v["relative"]) < 1e-8 and v["overall"] < 1e-8
+    assert dyngen.identify(ROBOTS[0][1], path, raw_states=True, validate=path,
+                           validate_recipe=window)["validation"]["samples"] == 501
+    params = tmp_path / "params.json"
+    params.write_text(result["parameters_json"])
+    assert '"window": "window = 0:5"' in result["parameters_json"]
+    out = subprocess.run(["cargo", "run", "--quiet", "-p", "dyngen-cli", "--", "validate", str(ROBOTS[0][1]),
+                          str(params), str(path)], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    overall = float(re.search(r"full precision: ([0-9.e+-]+)", out).group(1))
+    assert abs(overall - v["overall"]) <= 1e-12, out
+    assert "validation" not in dyngen.identify(ROBOTS[0][1], path, raw_states=True)
+
+
+def test_validate_recipe_needs_validate(recording):
+    _, _, path = recording
+    with pytest.raises(ValueError, match=re.escape("`validate_recipe` is the recipe of the `validate` recording")):
+        dyngen.identify(ROBOTS[0][1], path, validate_recipe=path)

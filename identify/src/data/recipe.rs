@@ -489,6 +489,19 @@ impl Recipe {
         }
     }
 
+    /// Its time and row windows alone as recipe lines joined by `; ` (`window = 5:65;
+    /// rows = 1:900`), `None` when it has neither: the part of one recording it
+    /// reads, as the parameters JSON records it.
+    pub fn window_text(&self) -> Option<String> {
+        let windows = Recipe {
+            window: self.window,
+            rows: self.rows,
+            ..Recipe::default()
+        };
+        let text = windows.to_text();
+        (!text.is_empty()).then(|| text.trim_end().replace('\n', "; "))
+    }
+
     /// The recipe as `key = value` lines that [`Recipe::parse`] reads back to the
     /// same recipe; only the keys that differ from [`Recipe::default`] are written
     /// (the default recipe is the empty text). Header names holding `,` or `#`

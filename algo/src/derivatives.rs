@@ -1,6 +1,6 @@
 //! The derivatives of inverse and forward dynamics (Pinocchio's
-//! `computeRNEADerivatives` and `computeABADerivatives`), by running [`crate::rnea`]
-//! and [`crate::aba`] themselves on [`Dual`] numbers, `N` directions per pass.
+//! `computeRNEADerivatives` and `computeABADerivatives`): [`crate::rnea`] itself run
+//! on [`Dual`] numbers, `N` directions per pass, and forward dynamics' through `M⁻¹`.
 //!
 //! Derivatives with respect to `q` are taken in the tangent space, as Pinocchio's:
 //! column `d` of `∂τ/∂q` is `d/dε τ(q ⊕ ε e_d)` at `ε = 0`, so that a free flyer's or a
@@ -9,7 +9,7 @@
 
 use crate::dual::{Dual, DualWorkspace};
 use crate::kinematics::check_len;
-use crate::multibody::{Multibody, Workspace, PARAMS_PER_BODY};
+use crate::multibody::{Multibody, Workspace, NO_PARENT, PARAMS_PER_BODY};
 use crate::Real;
 
 /// Which input a direction of [`sweep`] moves, and along which coordinate.
@@ -17,10 +17,8 @@ use crate::Real;
 enum Direction {
     /// Velocity coordinate `d` of the configuration (the tangent space).
     Q(usize),
-    /// Entry `d` of the second input (`v`).
+    /// Entry `d` of the velocity `v`.
     V(usize),
-    /// Entry `d` of the third input (`a` or `τ`).
-    A(usize),
 }
 
 /// Runs `pass` over every direction of `directions` (`N` per pass) with `q`, `v`, `a`
@@ -58,10 +56,10 @@ fn sweep<S: Real, const N: usize>(
             *dv = Dual::constant_of(v[i], z);
             *da = Dual::constant_of(a[i], z);
             for k in 0..width {
-                match dir(k) {
-                    Some(Direction::V(d)) if d == i => dv.tangent[k] = one,
-                    Some(Direction::A(d)) if d == i => da.tangent[k] = one,
-                    _ => {}
+                if let Some(Direction::V(d)) = dir(k) {
+                    if d == i {
+                        dv.tangent[k] = one;
+                    }
                 }
             }
         }
@@ -119,13 +117,14 @@ pub fn rnea_derivatives<S: Real, const N: usize>(
                 a,
                 params,
                 out,
+                ..
             } = d;
             crate::rnea(multibody, workspace, q, v, a, params, &mut out[..nv]);
         },
         |direction, tau, k| {
             let (m, d) = match direction {
                 Direction::Q(d) => (&mut *dtau_dq, d),
-                Direction::V(d) | Direction::A(d) => (&mut *dtau_dv, d),
+                Direction::V(d) => (&mut *dtau_dv, d),
             };
             for (i, t) in tau.iter().enumerate() {
                 m[i * nv + d] = t.tangent[k];
@@ -138,8 +137,12 @@ pub fn rnea_derivatives<S: Real, const N: usize>(
 /// `q̈ = aba(q, v, τ)` and its derivatives `∂q̈/∂q`, `∂q̈/∂v` (in the tangent space)
 /// and `∂q̈/∂τ = M(q)⁻¹`, each `nv × nv` row-major: Pinocchio's
 /// `computeABADerivatives`, with the rotor inertias `armature` (one per velocity
-/// coordinate, or empty) as [`crate::aba`]. Runs aba on [`Dual`] numbers
-/// `⌈3 nv / N⌉` times. Where `M(q)` is singular the results are not finite.
+/// coordinate, or empty) as [`crate::aba`]. As Pinocchio: `q̈` by [`crate::aba`],
+/// then `∂q̈/∂x = −M⁻¹ ∂τ/∂x` at `a = q̈` ([`rnea_derivatives`]; the rotor inertia's
+/// `Ia q̈` depends on neither `q` nor `v`), with `M + diag(Ia)` factored as `Lᵀ D L`
+/// along the tree (Featherstone, *Rigid Body Dynamics Algorithms*, §6.3: no fill-in
+/// outside each coordinate's path to the base). Where `M` is singular the results are
+/// not finite.
 ///
 /// # Panics
 /// If a slice's length does not match the multibody.
@@ -147,6 +150,7 @@ pub fn rnea_derivatives<S: Real, const N: usize>(
 pub fn aba_derivatives<S: Real, const N: usize>(
     multibody: &Multibody,
     dual: &mut DualWorkspace<S, N>,
+    workspace: &mut Workspace<S>,
     q: &[S],
     v: &[S],
     tau: &[S],
@@ -158,66 +162,70 @@ pub fn aba_derivatives<S: Real, const N: usize>(
     minv: &mut [S],
 ) {
     let nv = multibody.nv();
-    check_len("q", q, multibody.nq());
-    check_len("v", v, nv);
-    check_len("tau", tau, nv);
     check_len("ddq", ddq, nv);
-    check_len("params", params, PARAMS_PER_BODY * multibody.bodies());
-    for (name, m) in [("ddq_dq", &*ddq_dq), ("ddq_dv", &*ddq_dv), ("minv", &*minv)] {
-        check_len(name, m, nv * nv);
+    check_len("minv", minv, nv * nv);
+    crate::aba(multibody, workspace, q, v, tau, params, armature, ddq);
+    rnea_derivatives(multibody, dual, workspace, q, v, ddq, params, ddq_dq, ddq_dv, minv);
+    let factor = &mut dual.matrix;
+    factor.copy_from_slice(minv);
+    for (d, &ia) in armature.iter().enumerate() {
+        factor[d * nv + d] = factor[d * nv + d] + ia;
     }
-    if !armature.is_empty() {
-        check_len("armature", armature, nv);
+    ltdl(multibody, factor);
+    let (z, one) = (S::constant(workspace.context, 0.0), S::constant(workspace.context, 1.0));
+    for c in 0..nv {
+        for r in 0..nv {
+            minv[r * nv + c] = if r == c { one } else { z };
+        }
+        ltdl_solve(multibody, factor, minv, c);
+        ltdl_solve(multibody, factor, ddq_dq, c);
+        ltdl_solve(multibody, factor, ddq_dv, c);
     }
-    dual.set_params(params);
-    let z = dual.zero();
-    // The armature as constants, in the output's room (6 nv) after the accelerations.
-    let with_armature = !armature.is_empty();
-    sweep(
-        multibody,
-        dual,
-        q,
-        v,
-        tau,
-        |k| match k / nv {
-            0 => Direction::Q(k),
-            1 => Direction::V(k - nv),
-            _ => Direction::A(k - 2 * nv),
-        },
-        3 * nv,
-        nv,
-        |d| {
-            let DualWorkspace {
-                workspace,
-                q,
-                v,
-                a,
-                params,
-                out,
-            } = d;
-            let (acc, rest) = out.split_at_mut(nv);
-            let arm = if with_armature {
-                for (r, &x) in rest[..nv].iter_mut().zip(armature) {
-                    *r = Dual::constant_of(x, z);
-                }
-                &rest[..nv]
-            } else {
-                &rest[..0]
-            };
-            crate::aba(multibody, workspace, q, v, a, params, arm, acc);
-        },
-        |direction, acc, k| {
-            let (m, d) = match direction {
-                Direction::Q(d) => (&mut *ddq_dq, d),
-                Direction::V(d) => (&mut *ddq_dv, d),
-                Direction::A(d) => (&mut *minv, d),
-            };
-            for (i, x) in acc.iter().enumerate() {
-                m[i * nv + d] = x.tangent[k];
+    for x in ddq_dq.iter_mut().chain(ddq_dv.iter_mut()) {
+        *x = -*x;
+    }
+}
+
+/// `M` (nv × nv row-major, symmetric) factored in place as `M = Lᵀ D L`, `L` unit lower
+/// triangular with the sparsity of the tree: afterwards the diagonal holds `D` and
+/// entry `(k, i)`, `i` on `k`'s path to the base, holds `L_ki` (the rest is left as
+/// it was). Featherstone's LTDL (RBDA Table 6.3).
+fn ltdl<S: Real>(multibody: &Multibody, m: &mut [S]) {
+    let (nv, parent) = (multibody.nv(), &multibody.dof_parent);
+    for k in (0..nv).rev() {
+        let mut i = parent[k];
+        while i != NO_PARENT {
+            let a = m[k * nv + i] / m[k * nv + k];
+            let mut j = i;
+            while j != NO_PARENT {
+                m[i * nv + j] = m[i * nv + j] - a * m[k * nv + j];
+                j = parent[j];
             }
-        },
-    );
-    for (x, d) in ddq.iter_mut().zip(&dual.out[..nv]) {
-        *x = d.value;
+            m[k * nv + i] = a;
+            i = parent[i];
+        }
+    }
+}
+
+/// Column `c` of the row-major `nv × nv` matrix `x` replaced by `M⁻¹` times it, `M`
+/// factored by [`ltdl`]: `Lᵀ y = x`, `D z = y`, `L w = z` along the tree (RBDA Table 6.5).
+fn ltdl_solve<S: Real>(multibody: &Multibody, factor: &[S], x: &mut [S], c: usize) {
+    let (nv, parent) = (multibody.nv(), &multibody.dof_parent);
+    for i in (0..nv).rev() {
+        let mut j = parent[i];
+        while j != NO_PARENT {
+            x[j * nv + c] = x[j * nv + c] - factor[i * nv + j] * x[i * nv + c];
+            j = parent[j];
+        }
+    }
+    for i in 0..nv {
+        x[i * nv + c] = x[i * nv + c] / factor[i * nv + i];
+    }
+    for i in 0..nv {
+        let mut j = parent[i];
+        while j != NO_PARENT {
+            x[i * nv + c] = x[i * nv + c] - factor[i * nv + j] * x[j * nv + c];
+            j = parent[j];
+        }
     }
 }

@@ -145,6 +145,8 @@ pub struct DualWorkspace<S: Real, const N: usize> {
     pub(crate) params: Vec<Dual<S, N>>,
     /// Room for a 6 × nv result.
     pub(crate) out: Vec<Dual<S, N>>,
+    /// Room for an nv × nv matrix of `S` (the factor of `M` in the derivatives of aba).
+    pub(crate) matrix: Vec<S>,
 }
 
 impl<S: Real, const N: usize> DualWorkspace<S, N> {
@@ -158,6 +160,7 @@ impl<S: Real, const N: usize> DualWorkspace<S, N> {
             a: alloc::vec![zero; nv],
             params: alloc::vec![zero; PARAMS_PER_BODY * multibody.bodies()],
             out: alloc::vec![zero; 6 * nv],
+            matrix: alloc::vec![S::constant(context, 0.0); nv * nv],
         }
     }
 

@@ -25,7 +25,14 @@ pub struct Multibody {
     /// `supports[support_offsets[i]..support_offsets[i + 1]]` (body 0 has none).
     pub(crate) supports: Vec<usize>,
     pub(crate) support_offsets: Vec<usize>,
+    /// Per velocity coordinate, the one before it on the path to the base (the
+    /// previous coordinate of its joint, or the last of the parent's joint), or
+    /// [`NO_PARENT`]: the tree of `M`'s sparsity.
+    pub(crate) dof_parent: Vec<usize>,
 }
+
+/// No velocity coordinate ([`Multibody`]'s `dof_parent` of a root coordinate).
+pub(crate) const NO_PARENT: usize = usize::MAX;
 
 /// One joint of [`Multibody::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,6 +115,17 @@ impl Multibody {
             supports.extend(j.v_offset..j.v_offset + j.nv());
             support_offsets.push(supports.len());
         }
+        let mut dof_parent = Vec::with_capacity(nv);
+        for j in &joints {
+            let mut before = match j.parent {
+                0 => NO_PARENT,
+                p => joints[p - 1].v_offset + joints[p - 1].nv() - 1,
+            };
+            for d in j.v_offset..j.v_offset + j.nv() {
+                dof_parent.push(before);
+                before = d;
+            }
+        }
         Ok(Multibody {
             joints,
             gravity,
@@ -116,6 +134,7 @@ impl Multibody {
             nv,
             supports,
             support_offsets,
+            dof_parent,
         })
     }
 

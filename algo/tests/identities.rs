@@ -259,7 +259,7 @@ fn derivatives_are_the_differences_of_the_algorithms() {
         rnea(&body, &mut ws, &q, &v, &a, &params, &mut tau);
         let (mut ddq, mut minv) = (vec![0.0; nv], vec![0.0; nv * nv]);
         aba_derivatives(
-            &body, &mut dual8, &q, &v, &tau, &params, &armature, &mut ddq, &mut dq, &mut dv, &mut minv,
+            &body, &mut dual8, &mut ws, &q, &v, &tau, &params, &armature, &mut ddq, &mut dq, &mut dv, &mut minv,
         );
         let mut plain = vec![0.0; nv];
         aba(&body, &mut ws, &q, &v, &tau, &params, &armature, &mut plain);

@@ -86,7 +86,7 @@ fn no_algorithm_allocates_per_call() {
                 &body, &mut dual8, &mut ws, &q, &v, &a, &params, &mut d1, &mut d2, &mut d3,
             );
             aba_derivatives(
-                &body, &mut dual8, &q, &v, &tau, &params, &armature, &mut qdd, &mut d1, &mut d2, &mut d3,
+                &body, &mut dual8, &mut ws, &q, &v, &tau, &params, &armature, &mut qdd, &mut d1, &mut d2, &mut d3,
             );
             body_motions(&body, &mut ws, &q, &v, &a);
             frame_velocity(&body, &ws, body.bodies(), &frame, ReferenceFrame::Local);

@@ -230,6 +230,7 @@ fn derivatives_and_centroidal(body: &Multibody, s: &Value, worst: &mut Worst) {
     aba_derivatives(
         body,
         &mut dual8,
+        &mut ws,
         &q,
         &v,
         &tau,
@@ -294,6 +295,7 @@ fn forward_derivatives_against_extended_precision() {
         .unwrap();
         let nv = body.nv();
         let mut dual = DualWorkspace::<f64, 8>::new(&body, ());
+        let mut ws = Workspace::new(&body, ());
         let mut worst = Worst::default();
         for (s, e) in fixture["samples"]
             .as_array()
@@ -307,6 +309,7 @@ fn forward_derivatives_against_extended_precision() {
             aba_derivatives(
                 &body,
                 &mut dual,
+                &mut ws,
                 &q,
                 &v,
                 &tau,

@@ -45,16 +45,27 @@ def best(f, repeat):
 
 
 def states(robot, model, n, rng):
-    """`n` random states for dyngen and the same for Pinocchio (the shipped robots have
-    no continuous joint, so the coordinates are the same)."""
+    """`n` random states for dyngen, and the same configurations for Pinocchio (whose
+    continuous joints have two coordinates, cos θ and sin θ, where dyngen has θ; both
+    number the joints alike on the shipped robots)."""
     q = rng.uniform(-np.pi, np.pi, (n, robot.nq))
     if robot.joint_names[0] == "root_joint":
         q[:, :3] = rng.uniform(-1, 1, (n, 3))
         quat = rng.normal(size=(n, 4))
         q[:, 3:7] = quat / np.linalg.norm(quat, axis=1, keepdims=True)
-    assert robot.nq == model.nq
     v, a = rng.uniform(-2, 2, (2, n, robot.nv))
-    return q, v, a
+    assert list(model.names)[1:] == robot.joint_names
+    pin_q = np.empty((n, model.nq))
+    offset = 0
+    for joint in list(model.joints)[1:]:
+        if joint.nq == 2 and joint.nv == 1:  # continuous
+            pin_q[:, joint.idx_q] = np.cos(q[:, offset])
+            pin_q[:, joint.idx_q + 1] = np.sin(q[:, offset])
+            offset += 1
+        else:
+            pin_q[:, joint.idx_q : joint.idx_q + joint.nq] = q[:, offset : offset + joint.nq]
+            offset += joint.nq
+    return q, pin_q, v, a
 
 
 def cases(robot, model, data, frame, fid):
@@ -110,17 +121,18 @@ def main():
         data = model.createData()
         frame = robot.frame_names[-1]
         fid = model.getFrameId(frame)
-        q, v, a = states(robot, model, N, rng)
+        q, pin_q, v, a = states(robot, model, N, rng)
         cpp = cpp_times(args.pinocchio_bench, urdf, free_flyer) if args.pinocchio_bench else {}
         loop = 1000
         for algorithm, ours, theirs, cpp_name in cases(robot, model, data, frame, fid):
             rows = list(zip(q[:loop], v[:loop], a[:loop]))
+            pin_rows = list(zip(pin_q[:loop], v[:loop], a[:loop]))
             per_call = best(lambda: [ours(*s) for s in rows], args.repeat) / loop
             robot.max_threads = 1
             batch_one = best(lambda: ours(q, v, a), args.repeat) / N
             robot.max_threads = None
             batch_all = best(lambda: ours(q, v, a), args.repeat) / N
-            pin_py = best(lambda: [theirs(*s) for s in rows], args.repeat) / loop
+            pin_py = best(lambda: [theirs(*s) for s in pin_rows], args.repeat) / loop
             c = cpp.get(cpp_name)
             print(f"{name:11s} {algorithm:17s} {1e9 * per_call:9.0f} {1e9 * batch_one:9.0f} "
                   f"{1e9 * batch_all:9.0f} {1e9 * pin_py:9.0f} {'' if c is None else f'{c:9.0f}':>9s}")

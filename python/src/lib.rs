@@ -949,8 +949,23 @@ impl PyModel {
             [arg("q", q, nq), arg("v", v, nv), arg("tau", tau, nv)],
             [&[nv], &[nv, nv], &[nv, nv], &[nv, nv]],
             |st, [q, v, tau], [ddq, dq, dv, minv]| {
-                let State { params, dual8, .. } = st;
-                dyngen_algo::aba_derivatives(body, dual(dual8, body), q, v, tau, params, &[], ddq, dq, dv, minv)
+                let State {
+                    plain, params, dual8, ..
+                } = st;
+                dyngen_algo::aba_derivatives(
+                    body,
+                    dual(dual8, body),
+                    plain,
+                    q,
+                    v,
+                    tau,
+                    params,
+                    &[],
+                    ddq,
+                    dq,
+                    dv,
+                    minv,
+                )
             }
         )?;
         Ok((ddq, dq, dv, minv))

@@ -91,7 +91,7 @@ ALGORITHMS = [
 
 @pytest.mark.parametrize(
     "algorithm, threads",
-    [(a, t) for a in ALGORITHMS for t in (1, 2, 4) if t == 1 or "derivatives" not in a],
+    [(a, t) for a in ALGORITHMS for t in (1, 2) if t == 1 or "derivatives" not in a],
 )
 def test_batch_equals_loop(robot, algorithm, threads):
     f, arity = algorithms(robot)[algorithm]

@@ -1,6 +1,9 @@
 """Shared fixtures: the shipped robots loaded by dyngen and by Pinocchio, the mapping
 between their coordinates, and random states."""
 
+import json
+import os
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -26,12 +29,43 @@ def record(robot, algorithm, error):
     WORST[key] = max(WORST.get(key, 0.0), float(error))
 
 
+# Under pytest-xdist (`-n`), each worker hands its worst errors to the controller in
+# a file of this folder.
+WORST_FILES = ROOT / "target" / "pytest-worst"
+
+
+def pytest_sessionfinish(session):
+    worker = os.environ.get("PYTEST_XDIST_WORKER")
+    if worker and WORST:
+        WORST_FILES.mkdir(parents=True, exist_ok=True)
+        rows = [[robot, algorithm, error] for (robot, algorithm), error in WORST.items()]
+        (WORST_FILES / f"{worker}.json").write_text(json.dumps(rows))
+
+
 def pytest_terminal_summary(terminalreporter):
-    if not WORST:
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        return  # the controller prints every worker's
+    worst = dict(WORST)
+    for f in sorted(WORST_FILES.glob("*.json")) if WORST_FILES.exists() else []:
+        for robot, algorithm, error in json.loads(f.read_text()):
+            worst[robot, algorithm] = max(worst.get((robot, algorithm), 0.0), error)
+        f.unlink()
+    if not worst:
         return
     terminalreporter.section("worst error against Pinocchio (relative to max(1, |value|))")
-    for (robot, algorithm), error in sorted(WORST.items()):
+    for (robot, algorithm), error in sorted(worst.items()):
         terminalreporter.write_line(f"{robot:12s} {algorithm:28s} {error:.2e}")
+
+
+def dyngen_command(*args):
+    """Runs the `dyngen` command (`target/debug/dyngen`, as `cargo test --workspace`
+    leaves it; built with `cargo build -p dyngen-cli` when missing) and returns its
+    standard output; a failure raises."""
+    binary = ROOT / "target" / "debug" / "dyngen"
+    if not binary.exists():
+        subprocess.run(["cargo", "build", "--quiet", "-p", "dyngen-cli"], cwd=ROOT, check=True)
+    return subprocess.run([str(binary), *map(str, args)], cwd=ROOT, capture_output=True, text=True,
+                          check=True).stdout
 
 
 def load(path, free_flyer):

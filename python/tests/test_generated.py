@@ -12,7 +12,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import ROBOTS, ROOT, random_states
+from conftest import ROBOTS, ROOT, dyngen_command, random_states
 
 URDF = ROBOTS[0][1]
 
@@ -20,13 +20,9 @@ URDF = ROBOTS[0][1]
 @pytest.fixture(scope="module")
 def ur5_module(tmp_path_factory):
     package = tmp_path_factory.mktemp("generated") / "ur5-python"
-    subprocess.run(
-        ["cargo", "run", "--quiet", "-p", "dyngen-cli", "--", "generate", str(URDF), "--name", "Ur5",
-         "--python", str(package)],
-        cwd=ROOT, check=True,
-    )
+    dyngen_command("generate", URDF, "--name", "Ur5", "--python", package)
     # Built in the dev profile against the workspace's target folder, so that what
-    # `cargo test` built (dyngen, pyo3, numpy) is reused.
+    # the package's own build left (pyo3, numpy) is reused.
     env = dict(os.environ, CARGO_TARGET_DIR=str(ROOT / "target"), MATURIN_PEP517_ARGS="--profile dev")
     subprocess.run(
         [sys.executable, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", "--force-reinstall",

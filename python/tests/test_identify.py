@@ -2,13 +2,12 @@
 exact torques, so the identifiable parameters come back exactly."""
 
 import re
-import subprocess
 
 import numpy as np
 import pytest
 
 import dyngen
-from conftest import ROBOTS, ROOT
+from conftest import ROBOTS, dyngen_command
 
 
 @pytest.fixture(scope="module")
@@ -92,8 +91,7 @@ def test_validation_and_parameters_json(recording, tmp_path):
     params = tmp_path / "params.json"
     params.write_text(result["parameters_json"])
     assert '"window": "window = 0:5"' in result["parameters_json"]
-    out = subprocess.run(["cargo", "run", "--quiet", "-p", "dyngen-cli", "--", "validate", str(ROBOTS[0][1]),
-                          str(params), str(path)], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    out = dyngen_command("validate", ROBOTS[0][1], params, path)
     overall = float(re.search(r"full precision: ([0-9.e+-]+)", out).group(1))
     assert abs(overall - v["overall"]) <= 1e-12, out
     assert "validation" not in dyngen.identify(ROBOTS[0][1], path, raw_states=True)

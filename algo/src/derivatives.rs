@@ -12,65 +12,6 @@ use crate::kinematics::check_len;
 use crate::multibody::{Multibody, Workspace, NO_PARENT, PARAMS_PER_BODY};
 use crate::Real;
 
-/// Which input a direction of [`sweep`] moves, and along which coordinate.
-#[derive(Clone, Copy)]
-enum Direction {
-    /// Velocity coordinate `d` of the configuration (the tangent space).
-    Q(usize),
-    /// Entry `d` of the velocity `v`.
-    V(usize),
-}
-
-/// Runs `pass` over every direction of `directions` (`N` per pass) with `q`, `v`, `a`
-/// seeded accordingly in `dual`, then hands each direction's derivatives of the
-/// pass's output (`dual.out[..len]`) to `store`.
-#[allow(clippy::too_many_arguments)]
-fn sweep<S: Real, const N: usize>(
-    multibody: &Multibody,
-    dual: &mut DualWorkspace<S, N>,
-    q: &[S],
-    v: &[S],
-    a: &[S],
-    directions: impl Fn(usize) -> Direction,
-    count: usize,
-    len: usize,
-    pass: impl Fn(&mut DualWorkspace<S, N>),
-    mut store: impl FnMut(Direction, &[Dual<S, N>], usize),
-) {
-    let z = dual.zero();
-    let one = S::constant(dual.workspace.context, 1.0);
-    let mut start = 0;
-    while start < count {
-        let width = N.min(count - start);
-        let dir = |k: usize| (k < width).then(|| directions(start + k));
-        dual.seed_configuration(
-            multibody,
-            q,
-            |k, d| match dir(k) {
-                Some(Direction::Q(e)) if e == d => one,
-                _ => z,
-            },
-            |k| matches!(dir(k), Some(Direction::Q(_))),
-        );
-        for (i, (dv, da)) in dual.v.iter_mut().zip(dual.a.iter_mut()).enumerate() {
-            *dv = Dual::constant_of(v[i], z);
-            *da = Dual::constant_of(a[i], z);
-            for k in 0..width {
-                if let Some(Direction::V(d)) = dir(k) {
-                    if d == i {
-                        dv.tangent[k] = one;
-                    }
-                }
-            }
-        }
-        pass(dual);
-        for k in 0..width {
-            store(directions(start + k), &dual.out[..len], k);
-        }
-        start += width;
-    }
-}
-
 /// `∂τ/∂q`, `∂τ/∂v` (in the tangent space) and `∂τ/∂a = M(q)` of [`crate::rnea`] at
 /// `(q, v, a)`, each `nv × nv` row-major (row `i` the derivatives of `τ_i`):
 /// Pinocchio's `computeRNEADerivatives`. Runs rnea on [`Dual`] numbers `⌈2 nv / N⌉`
@@ -100,37 +41,48 @@ pub fn rnea_derivatives<S: Real, const N: usize>(
         check_len(name, m, nv * nv);
     }
     dual.set_params(params);
-    sweep(
-        multibody,
-        dual,
-        q,
-        v,
-        a,
-        |k| if k < nv { Direction::Q(k) } else { Direction::V(k - nv) },
-        2 * nv,
-        nv,
-        |d| {
-            let DualWorkspace {
-                workspace,
-                q,
-                v,
-                a,
-                params,
-                out,
-                ..
-            } = d;
-            crate::rnea(multibody, workspace, q, v, a, params, &mut out[..nv]);
-        },
-        |direction, tau, k| {
-            let (m, d) = match direction {
-                Direction::Q(d) => (&mut *dtau_dq, d),
-                Direction::V(d) => (&mut *dtau_dv, d),
+    let (z, one) = (dual.zero(), S::constant(dual.workspace.context, 1.0));
+    // Direction d of the 2 nv: q's tangent e_d for d < nv, then v's e_(d − nv).
+    let mut start = 0;
+    while start < 2 * nv {
+        let width = N.min(2 * nv - start);
+        dual.seed_configuration(
+            multibody,
+            q,
+            |k, d| if start + k == d { one } else { z },
+            |k| k < width && start + k < nv,
+        );
+        for i in 0..nv {
+            dual.v[i] = Dual::constant_of(v[i], z);
+            dual.a[i] = Dual::constant_of(a[i], z);
+        }
+        for k in (0..width).filter(|k| start + k >= nv) {
+            dual.v[start + k - nv].tangent[k] = one;
+        }
+        let DualWorkspace {
+            workspace,
+            q: dq,
+            v: dv,
+            a: da,
+            params: dp,
+            out,
+            ..
+        } = dual;
+        let tau = &mut out[..nv];
+        crate::rnea(multibody, workspace, dq, dv, da, dp, tau);
+        for k in 0..width {
+            let d = start + k;
+            let (m, column) = if d < nv {
+                (&mut *dtau_dq, d)
+            } else {
+                (&mut *dtau_dv, d - nv)
             };
             for (i, t) in tau.iter().enumerate() {
-                m[i * nv + d] = t.tangent[k];
+                m[i * nv + column] = t.tangent[k];
             }
-        },
-    );
+        }
+        start += width;
+    }
     crate::crba(multibody, workspace, q, params, dtau_da);
 }
 

@@ -199,8 +199,9 @@ pub struct Joint {
     pub v_offset: usize,
 }
 
+/// The placement `x` in the numbers `S` (made in context `c`).
 #[inline(always)]
-pub(crate) fn constant_se3<S: Real>(c: S::Context, x: &Se3<f64>) -> Se3<S> {
+pub fn constant_se3<S: Real>(c: S::Context, x: &Se3<f64>) -> Se3<S> {
     let r = &x.rotation;
     Se3 {
         rotation: [constant_vec(c, r[0]), constant_vec(c, r[1]), constant_vec(c, r[2])],

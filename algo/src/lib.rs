@@ -74,7 +74,7 @@ pub use jacobian::{
     compute_frame_jacobian, frame_classical_acceleration, frame_jacobian, frame_jacobian_time_variation,
     frame_velocity, ReferenceFrame,
 };
-pub use joint::{quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
+pub use joint::{constant_se3, quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
 pub use kinematics::{body_motions, forward_kinematics};
 pub use multibody::{JointSpec, Multibody, TreeError, Workspace, PARAMS_PER_BODY};
 pub use real::{polynomial_sin_cos, Precision, Real};

@@ -318,14 +318,6 @@ fn dual<'a, S: Real<Context = ()>, const N: usize>(
     slot.get_or_insert_with(|| DualWorkspace::new(body, ()))
 }
 
-/// `x` in the numbers `S`.
-fn lift<S: Real<Context = ()>>(x: &Se3<f64>) -> Se3<S> {
-    Se3 {
-        rotation: x.rotation.map(|row| row.map(|e| S::constant((), e))),
-        translation: x.translation.map(|e| S::constant((), e)),
-    }
-}
-
 /// The first row (then argument, then entry) of the inputs that is not finite.
 fn first_non_finite(inputs: &[Rows<'_>], rows: usize) -> Option<RowFailure> {
     (0..rows).find_map(|row| {
@@ -1023,7 +1015,11 @@ impl PyModel {
             [&[3, 3], &[3]],
             |st, [q], [r, t]| {
                 dyngen_algo::forward_kinematics(body, &mut st.plain, q);
-                write_se3(&st.plain.world[index].compose(&lift(&offset)), r, t);
+                write_se3(
+                    &st.plain.world[index].compose(&dyngen_algo::constant_se3((), &offset)),
+                    r,
+                    t,
+                );
             }
         )?;
         Ok((r, t))

@@ -78,6 +78,9 @@ pub fn aba<S: Real>(
     armature: &[S],
     qdd: &mut [S],
 ) {
+    if multibody.reduction.is_some() {
+        return aba_with_mimics(multibody, workspace, q, v, tau, params, armature, qdd);
+    }
     let nv = multibody.nv();
     check_len("v", v, nv);
     check_len("tau", tau, nv);
@@ -172,4 +175,40 @@ pub fn aba<S: Real>(
         }
         workspace.acceleration[i] = a_prime.add(j.motion(c, &qdd[off..off + n]));
     }
+}
+
+/// [`aba`] for a multibody with [`crate::Mimic`] joints, where the articulated-body
+/// recursion does not apply: `M + diag(Ia)` by [`crate::crba`] factored densely
+/// (`Lᵀ D L`), `τ − h` by [`crate::rnea`] at `q̈ = 0`.
+#[allow(clippy::too_many_arguments)]
+fn aba_with_mimics<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    v: &[S],
+    tau: &[S],
+    params: &[S],
+    armature: &[S],
+    qdd: &mut [S],
+) {
+    let nv = multibody.nv();
+    check_len("tau", tau, nv);
+    check_len("qdd", qdd, nv);
+    if !armature.is_empty() {
+        check_len("armature", armature, nv);
+    }
+    let mut matrix = core::mem::take(&mut workspace.mimic.matrix);
+    let zero = core::mem::take(&mut workspace.mimic.zero);
+    crate::crba(multibody, workspace, q, params, &mut matrix);
+    for (d, &ia) in armature.iter().enumerate() {
+        matrix[d * nv + d] = matrix[d * nv + d] + ia;
+    }
+    crate::rnea(multibody, workspace, q, v, &zero, params, qdd);
+    for (x, &t) in qdd.iter_mut().zip(tau) {
+        *x = t - *x;
+    }
+    crate::derivatives::ltdl(multibody, &mut matrix);
+    crate::derivatives::ltdl_solve(multibody, &matrix, qdd, 1, 0);
+    workspace.mimic.matrix = matrix;
+    workspace.mimic.zero = zero;
 }

@@ -5,6 +5,7 @@
 
 use crate::dual::DualWorkspace;
 use crate::kinematics::check_len;
+use crate::mimic::{on_tree, Reduce};
 use crate::multibody::{Multibody, Workspace, PARAMS_PER_BODY};
 use crate::spatial::{cross, scale, sub, Force, Inertia, Vec3};
 use crate::Real;
@@ -33,6 +34,11 @@ fn subtree_inertias<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>
 /// If a slice's length does not match the multibody.
 pub fn center_of_mass<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], params: &[S]) -> Vec3<S> {
     crate::forward_kinematics(multibody, workspace, q);
+    total_com(multibody, workspace, params)
+}
+
+/// After [`crate::forward_kinematics`]: the centre of mass ([`subtree_inertias`] on the way).
+fn total_com<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, params: &[S]) -> Vec3<S> {
     subtree_inertias(multibody, workspace, params);
     let total = workspace.inertia[0];
     scale(S::constant(workspace.context, 1.0) / total.mass, total.first_moment)
@@ -65,16 +71,37 @@ pub fn com_jacobian<S: Real>(
     params: &[S],
     jacobian: &mut [S],
 ) -> Vec3<S> {
-    let nv = multibody.nv();
-    check_len("jacobian", jacobian, 3 * nv);
-    let com = center_of_mass(multibody, workspace, q, params);
+    check_len("jacobian", jacobian, 3 * multibody.nv());
+    crate::forward_kinematics(multibody, workspace, q);
+    let com = total_com(multibody, workspace, params);
+    let nv = multibody.tree_nv();
+    let tree = |w: &mut Workspace<S>, _: &[S], _: &[S], _: &[S], out: &mut [S]| com_jacobian_tree(multibody, w, out);
+    match multibody.reduction {
+        Some(_) => on_tree(
+            multibody,
+            workspace,
+            None,
+            None,
+            None,
+            3 * nv,
+            Reduce::Cols(3),
+            jacobian,
+            tree,
+        ),
+        None => com_jacobian_tree(multibody, workspace, jacobian),
+    }
+    com
+}
+
+/// After [`total_com`]: [`com_jacobian`] along the tree's coordinates.
+fn com_jacobian_tree<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, jacobian: &mut [S]) {
+    let nv = multibody.tree_nv();
     let inverse_mass = S::constant(workspace.context, 1.0) / workspace.inertia[0].mass;
     for_each_column(multibody, workspace, |d, momentum| {
         for r in 0..3 {
             jacobian[r * nv + d] = momentum.linear[r] * inverse_mass;
         }
     });
-    com
 }
 
 /// The centroidal momentum matrix `A_g` (6 × nv row-major, rows `[linear; angular]`,
@@ -91,9 +118,32 @@ pub fn centroidal_map<S: Real>(
     params: &[S],
     a_g: &mut [S],
 ) -> Vec3<S> {
-    let nv = multibody.nv();
-    check_len("a_g", a_g, 6 * nv);
-    let com = center_of_mass(multibody, workspace, q, params);
+    check_len("a_g", a_g, 6 * multibody.nv());
+    crate::forward_kinematics(multibody, workspace, q);
+    let com = total_com(multibody, workspace, params);
+    let nv = multibody.tree_nv();
+    let tree =
+        |w: &mut Workspace<S>, _: &[S], _: &[S], _: &[S], out: &mut [S]| centroidal_map_tree(multibody, w, com, out);
+    match multibody.reduction {
+        Some(_) => on_tree(
+            multibody,
+            workspace,
+            None,
+            None,
+            None,
+            6 * nv,
+            Reduce::Cols(6),
+            a_g,
+            tree,
+        ),
+        None => centroidal_map_tree(multibody, workspace, com, a_g),
+    }
+    com
+}
+
+/// After [`total_com`]: [`centroidal_map`] along the tree's coordinates.
+fn centroidal_map_tree<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, com: Vec3<S>, a_g: &mut [S]) {
+    let nv = multibody.tree_nv();
     for_each_column(multibody, workspace, |d, f| {
         // The moment about the centre of mass: n − c × f.
         let n = sub(f.angular, cross(com, f.linear));
@@ -102,7 +152,6 @@ pub fn centroidal_map<S: Real>(
             a_g[(r + 3) * nv + d] = n[r];
         }
     });
-    com
 }
 
 /// `A_g(q)` and its time variation `Ȧ_g(q, v) = d/dt A_g(q(t))` along `q̇ = v` (each

@@ -2,6 +2,7 @@
 //! (Featherstone, *Rigid Body Dynamics Algorithms*, Table 6.2).
 
 use crate::kinematics::{check_len, placements};
+use crate::mimic::{on_tree, Reduce};
 use crate::multibody::{Multibody, Workspace, PARAMS_PER_BODY};
 use crate::spatial::Inertia;
 use crate::Real;
@@ -14,7 +15,28 @@ use crate::Real;
 /// # Panics
 /// If a slice's length does not match the multibody.
 pub fn crba<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], params: &[S], m: &mut [S]) {
-    let nv = multibody.nv();
+    if multibody.reduction.is_some() {
+        check_len("m", m, multibody.nv() * multibody.nv());
+        let tree =
+            |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], out: &mut [S]| crba_tree(multibody, w, q, params, out);
+        let nv = multibody.tree_nv();
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            None,
+            None,
+            nv * nv,
+            Reduce::Both,
+            m,
+            tree,
+        );
+    }
+    crba_tree(multibody, workspace, q, params, m);
+}
+
+fn crba_tree<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], params: &[S], m: &mut [S]) {
+    let nv = multibody.tree_nv();
     check_len("params", params, PARAMS_PER_BODY * multibody.bodies());
     check_len("m", m, nv * nv);
     placements(multibody, workspace, q);

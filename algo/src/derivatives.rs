@@ -129,9 +129,9 @@ pub fn aba_derivatives<S: Real, const N: usize>(
         for r in 0..nv {
             minv[r * nv + c] = if r == c { one } else { z };
         }
-        ltdl_solve(multibody, factor, minv, c);
-        ltdl_solve(multibody, factor, ddq_dq, c);
-        ltdl_solve(multibody, factor, ddq_dv, c);
+        ltdl_solve(multibody, factor, minv, nv, c);
+        ltdl_solve(multibody, factor, ddq_dq, nv, c);
+        ltdl_solve(multibody, factor, ddq_dv, nv, c);
     }
     for x in ddq_dq.iter_mut().chain(ddq_dv.iter_mut()) {
         *x = -*x;
@@ -142,7 +142,7 @@ pub fn aba_derivatives<S: Real, const N: usize>(
 /// triangular with the sparsity of the tree: afterwards the diagonal holds `D` and
 /// entry `(k, i)`, `i` on `k`'s path to the base, holds `L_ki` (the rest is left as
 /// it was). Featherstone's LTDL (RBDA Table 6.3).
-fn ltdl<S: Real>(multibody: &Multibody, m: &mut [S]) {
+pub(crate) fn ltdl<S: Real>(multibody: &Multibody, m: &mut [S]) {
     let (nv, parent) = (multibody.nv(), &multibody.dof_parent);
     for k in (0..nv).rev() {
         let mut i = parent[k];
@@ -159,24 +159,25 @@ fn ltdl<S: Real>(multibody: &Multibody, m: &mut [S]) {
     }
 }
 
-/// Column `c` of the row-major `nv × nv` matrix `x` replaced by `M⁻¹` times it, `M`
-/// factored by [`ltdl`]: `Lᵀ y = x`, `D z = y`, `L w = z` along the tree (RBDA Table 6.5).
-fn ltdl_solve<S: Real>(multibody: &Multibody, factor: &[S], x: &mut [S], c: usize) {
+/// Column `c` of the row-major matrix `x` (`nv` rows of `width`) replaced by `M⁻¹`
+/// times it, `M` factored by [`ltdl`]: `Lᵀ y = x`, `D z = y`, `L w = z` along the
+/// tree (RBDA Table 6.5).
+pub(crate) fn ltdl_solve<S: Real>(multibody: &Multibody, factor: &[S], x: &mut [S], width: usize, c: usize) {
     let (nv, parent) = (multibody.nv(), &multibody.dof_parent);
     for i in (0..nv).rev() {
         let mut j = parent[i];
         while j != NO_PARENT {
-            x[j * nv + c] = x[j * nv + c] - factor[i * nv + j] * x[i * nv + c];
+            x[j * width + c] = x[j * width + c] - factor[i * nv + j] * x[i * width + c];
             j = parent[j];
         }
     }
     for i in 0..nv {
-        x[i * nv + c] = x[i * nv + c] / factor[i * nv + i];
+        x[i * width + c] = x[i * width + c] / factor[i * nv + i];
     }
     for i in 0..nv {
         let mut j = parent[i];
         while j != NO_PARENT {
-            x[i * nv + c] = x[i * nv + c] - factor[i * nv + j] * x[j * nv + c];
+            x[i * width + c] = x[i * width + c] - factor[i * nv + j] * x[j * width + c];
             j = parent[j];
         }
     }

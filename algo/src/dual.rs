@@ -196,8 +196,12 @@ impl<S: Real, const N: usize> DualWorkspace<S, N> {
         let mut dv = [z; 6];
         let mut dq = [z; 7];
         for k in (0..N).filter(|&k| moves(k)) {
-            for j in &multibody.joints {
-                let (qs, vs) = (j.q_offset..j.q_offset + j.nq(), j.v_offset..j.v_offset + j.nv());
+            for (n, j) in multibody.joints.iter().enumerate() {
+                // A joint following another moves with its leader's coordinate.
+                let Some((qo, vo)) = multibody.coordinates_of(n) else {
+                    continue;
+                };
+                let (qs, vs) = (qo..qo + j.nq(), vo..vo + j.nv());
                 for (e, d) in vs.clone().enumerate() {
                     dv[e] = direction(k, d);
                 }

@@ -3,6 +3,7 @@
 
 use crate::dual::{Dual, DualWorkspace};
 use crate::kinematics::check_len;
+use crate::mimic::{on_tree, times, Reduce};
 use crate::multibody::{Multibody, Workspace};
 use crate::spatial::{add, cross, mat_tr_vec, mat_vec, neg, Motion, Se3, Vec3};
 use crate::Real;
@@ -56,8 +57,19 @@ pub fn frame_jacobian<S: Real>(
                 ReferenceFrame::Local => placement.inv_act_motion(world),
             };
             let d = j.v_offset + e;
-            for (r, x) in column.to_array().into_iter().enumerate() {
-                jacobian[r * nv + d] = x;
+            match multibody.reduction.as_deref() {
+                None => {
+                    for (r, x) in column.to_array().into_iter().enumerate() {
+                        jacobian[r * nv + d] = x;
+                    }
+                }
+                // A follower's column adds to its leader's, scaled (`J_tree E`).
+                Some(reduction) => {
+                    let (k, a) = reduction.v[d];
+                    for (r, x) in column.to_array().into_iter().enumerate() {
+                        jacobian[r * nv + k] = jacobian[r * nv + k] + times(c, x, a);
+                    }
+                }
             }
         }
         i = j.parent;
@@ -79,7 +91,35 @@ pub fn compute_frame_jacobian<S: Real>(
     reference: ReferenceFrame,
     jacobian: &mut [S],
 ) {
-    check_len("q", q, multibody.nq());
+    if multibody.reduction.is_some() {
+        let tree = |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], _: &mut [S]| {
+            compute_frame_jacobian_tree(multibody, w, q, body, frame, reference, jacobian)
+        };
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            None,
+            None,
+            0,
+            Reduce::None,
+            &mut [],
+            tree,
+        );
+    }
+    compute_frame_jacobian_tree(multibody, workspace, q, body, frame, reference, jacobian);
+}
+
+fn compute_frame_jacobian_tree<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    body: usize,
+    frame: &Se3<f64>,
+    reference: ReferenceFrame,
+    jacobian: &mut [S],
+) {
+    check_len("q", q, multibody.tree_nq());
     assert!(body <= multibody.bodies(), "body {body} is not a body of the multibody");
     let c = workspace.context;
     let (z, o) = (workspace.zero(), S::constant(c, 1.0));

@@ -1,5 +1,6 @@
 //! Forward kinematics: every body's placement, in its parent and in the base frame.
 
+use crate::mimic::{on_tree, Reduce};
 use crate::multibody::{Multibody, Workspace};
 use crate::spatial::{add, cross, Motion};
 use crate::Real;
@@ -16,7 +17,7 @@ pub(crate) fn check_len<S>(what: &str, x: &[S], expected: usize) {
 
 /// `λ(i)M_i(q)` of every body into `workspace.placement`.
 pub(crate) fn placements<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
-    check_len("q", q, multibody.nq());
+    check_len("q", q, multibody.tree_nq());
     let c = workspace.context;
     for (i, j) in multibody.joints.iter().enumerate() {
         workspace.placement[i + 1] = j.placement(c, &q[j.q_offset..j.q_offset + j.nq()]);
@@ -27,6 +28,25 @@ pub(crate) fn placements<S: Real>(multibody: &Multibody, workspace: &mut Workspa
 /// frame (`workspace.world`, `⁰M_i = ⁰M_λ(i) · λ(i)M_i(q)`): Pinocchio's
 /// `forwardKinematics(model, data, q)` (`data.liMi`, `data.oMi`).
 pub fn forward_kinematics<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
+    if multibody.reduction.is_some() {
+        let tree =
+            |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], _: &mut [S]| forward_kinematics_tree(multibody, w, q);
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            None,
+            None,
+            0,
+            Reduce::None,
+            &mut [],
+            tree,
+        );
+    }
+    forward_kinematics_tree(multibody, workspace, q);
+}
+
+fn forward_kinematics_tree<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
     placements(multibody, workspace, q);
     let (z, o) = (workspace.zero(), S::constant(workspace.context, 1.0));
     for (i, j) in multibody.joints.iter().enumerate() {
@@ -51,9 +71,28 @@ pub fn forward_kinematics<S: Real>(multibody: &Multibody, workspace: &mut Worksp
 /// # Panics
 /// If a slice's length does not match the multibody.
 pub fn body_motions<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], v: &[S], a: &[S]) {
-    check_len("v", v, multibody.nv());
-    check_len("a", a, multibody.nv());
-    forward_kinematics(multibody, workspace, q);
+    if multibody.reduction.is_some() {
+        let tree =
+            |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], _: &mut [S]| body_motions_tree(multibody, w, q, v, a);
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            Some(v),
+            Some(a),
+            0,
+            Reduce::None,
+            &mut [],
+            tree,
+        );
+    }
+    body_motions_tree(multibody, workspace, q, v, a);
+}
+
+fn body_motions_tree<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], v: &[S], a: &[S]) {
+    check_len("v", v, multibody.tree_nv());
+    check_len("a", a, multibody.tree_nv());
+    forward_kinematics_tree(multibody, workspace, q);
     let c = workspace.context;
     let z = workspace.zero();
     workspace.velocity[0] = Motion::zero(z);

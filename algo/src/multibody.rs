@@ -29,6 +29,42 @@ pub struct Multibody {
     /// previous coordinate of its joint, or the last of the parent's joint), or
     /// [`NO_PARENT`]: the tree of `M`'s sparsity.
     pub(crate) dof_parent: Vec<usize>,
+    /// The joints that follow others ([`Multibody::with_mimics`]), and how the
+    /// coordinates of the tree follow those of the multibody; `None` without any.
+    pub(crate) reduction: Option<alloc::boxed::Box<Reduction>>,
+}
+
+/// A joint that moves with another (URDF's `<mimic>`, Pinocchio's mimic joint): its
+/// coordinate is `multiplier · q_leader + offset`, its velocity and acceleration
+/// `multiplier` times the leader's, and it has no coordinate of its own. Both joints
+/// have one coordinate (revolute, continuous or prismatic). Joints are 0-based, as
+/// in [`Multibody::joints`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mimic {
+    pub joint: usize,
+    pub leader: usize,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+/// How the coordinates of the tree (every joint its own, as [`Joint::q_offset`] and
+/// [`Joint::v_offset`] lay them out) follow the multibody's: `q_tree = E q + b`,
+/// `v_tree = E v`. The algorithms run on the tree, and reduce what they return with
+/// `Eᵀ` (the virtual work of a follower's effort goes to its leader).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Reduction {
+    pub(crate) mimics: Vec<Mimic>,
+    /// The multibody's coordinates.
+    pub(crate) nq: usize,
+    pub(crate) nv: usize,
+    /// Per tree position coordinate: the multibody coordinate it follows, the
+    /// multiplier and the offset.
+    pub(crate) q: Vec<(usize, f64, f64)>,
+    /// Per tree velocity coordinate: the multibody coordinate it follows, the multiplier.
+    pub(crate) v: Vec<(usize, f64)>,
+    /// Per joint, its first position and velocity coordinate in the multibody's
+    /// coordinates; `None` for a follower.
+    pub(crate) offsets: Vec<Option<(usize, usize)>>,
 }
 
 /// No velocity coordinate ([`Multibody`]'s `dof_parent` of a root coordinate).
@@ -57,6 +93,9 @@ pub enum TreeError {
     ParentNotBefore { joint: usize, parent: usize },
     /// A free flyer anywhere but as the first joint, on the base.
     FreeFlyerNotAtRoot { joint: usize },
+    /// A [`Mimic`] that cannot be: a joint or a leader out of range or without
+    /// exactly one coordinate, a joint following itself, following twice, or a cycle.
+    BadMimic { joint: usize, reason: &'static str },
 }
 
 impl core::fmt::Display for TreeError {
@@ -73,6 +112,7 @@ impl core::fmt::Display for TreeError {
                     "joint {joint} is a free flyer; only the first joint, on the base, may be one"
                 )
             }
+            TreeError::BadMimic { joint, reason } => write!(f, "mimic joint {joint}: {reason}"),
         }
     }
 }
@@ -135,7 +175,135 @@ impl Multibody {
             supports,
             support_offsets,
             dof_parent,
+            reduction: None,
         })
+    }
+
+    /// The same tree with some joints following others ([`Mimic`]): the multibody
+    /// then has the leaders' coordinates only (`nq`, `nv` count them), every
+    /// algorithm takes and returns those, and its results are Pinocchio's for a model
+    /// with mimic joints: `τ = Eᵀ τ_tree`, `M = Eᵀ M_tree E`, Jacobians `J_tree E`,
+    /// regressors `Eᵀ Y_tree`. A follower of a follower follows the first leader
+    /// (multipliers and offsets composed). Forward dynamics then solves with `M`
+    /// (dense, `O(n³)`): the articulated-body recursion does not apply.
+    ///
+    /// # Errors
+    /// [`TreeError::BadMimic`] for a joint or leader out of range or with more than
+    /// one coordinate, a joint following itself or twice, or a cycle.
+    pub fn with_mimics(mut self, mimics: &[Mimic]) -> Result<Multibody, TreeError> {
+        if mimics.is_empty() {
+            return Ok(self);
+        }
+        let n = self.joints.len();
+        let bad = |joint, reason| Err(TreeError::BadMimic { joint, reason });
+        let mut follows: Vec<Option<Mimic>> = alloc::vec![None; n];
+        for m in mimics {
+            if m.joint >= n || m.leader >= n {
+                return bad(m.joint, "the joint or its leader is not a joint of the tree");
+            }
+            if self.joints[m.joint].nv() != 1 || self.joints[m.joint].nq() != 1 {
+                return bad(
+                    m.joint,
+                    "only a joint with one coordinate (revolute, continuous, prismatic) can follow",
+                );
+            }
+            if self.joints[m.leader].nv() != 1 || self.joints[m.leader].nq() != 1 {
+                return bad(
+                    m.joint,
+                    "its leader does not have one coordinate (revolute, continuous, prismatic)",
+                );
+            }
+            if m.joint == m.leader {
+                return bad(m.joint, "a joint cannot follow itself");
+            }
+            if !(m.multiplier.is_finite() && m.offset.is_finite()) {
+                return bad(m.joint, "its multiplier and offset must be finite");
+            }
+            if follows[m.joint].replace(*m).is_some() {
+                return bad(m.joint, "it follows two leaders");
+            }
+        }
+        // Each follower resolved to an independent leader: q = a q_leader + b.
+        let mut resolved: Vec<Mimic> = Vec::with_capacity(mimics.len());
+        for m in mimics {
+            let (mut r, mut steps) = (*m, 0);
+            while let Some(next) = follows[r.leader] {
+                steps += 1;
+                if steps > n {
+                    return bad(m.joint, "its leaders form a cycle");
+                }
+                r = Mimic {
+                    joint: r.joint,
+                    leader: next.leader,
+                    multiplier: r.multiplier * next.multiplier,
+                    offset: r.multiplier * next.offset + r.offset,
+                };
+            }
+            resolved.push(r);
+        }
+        let (mut nq, mut nv) = (0, 0);
+        let mut offsets = Vec::with_capacity(n);
+        for (k, j) in self.joints.iter().enumerate() {
+            if follows[k].is_some() {
+                offsets.push(None);
+            } else {
+                offsets.push(Some((nq, nv)));
+                nq += j.nq();
+                nv += j.nv();
+            }
+        }
+        let (mut q, mut v) = (Vec::with_capacity(self.nq), Vec::with_capacity(self.nv));
+        for (k, j) in self.joints.iter().enumerate() {
+            match offsets[k] {
+                Some((qo, vo)) => {
+                    q.extend((0..j.nq()).map(|e| (qo + e, 1.0, 0.0)));
+                    v.extend((0..j.nv()).map(|e| (vo + e, 1.0)));
+                }
+                None => {
+                    let r = resolved.iter().find(|r| r.joint == k).copied();
+                    let r = r.expect("every follower is resolved");
+                    let (lq, lv) = offsets[r.leader].expect("a resolved leader follows nobody");
+                    q.push((lq, r.multiplier, r.offset));
+                    v.push((lv, r.multiplier));
+                }
+            }
+        }
+        // M couples a leader with its followers' paths: no longer the tree's
+        // sparsity, so its factor is dense (each coordinate under the one before).
+        self.dof_parent = (0..nv).map(|d| if d == 0 { NO_PARENT } else { d - 1 }).collect();
+        self.reduction = Some(alloc::boxed::Box::new(Reduction {
+            mimics: resolved,
+            nq,
+            nv,
+            q,
+            v,
+            offsets,
+        }));
+        Ok(self)
+    }
+
+    /// The joints that follow others, each resolved to an independent leader.
+    pub fn mimics(&self) -> &[Mimic] {
+        self.reduction.as_ref().map_or(&[], |r| &r.mimics)
+    }
+
+    /// Joint `k`'s first position and velocity coordinate in the multibody's `q` and
+    /// `v`; `None` for a joint that follows another ([`Mimic`]).
+    pub fn coordinates_of(&self, k: usize) -> Option<(usize, usize)> {
+        match &self.reduction {
+            None => Some((self.joints[k].q_offset, self.joints[k].v_offset)),
+            Some(r) => r.offsets[k],
+        }
+    }
+
+    /// Position and velocity coordinates of the tree, every joint counted (the
+    /// algorithms' inner sizes).
+    pub(crate) fn tree_nq(&self) -> usize {
+        self.nq
+    }
+
+    pub(crate) fn tree_nv(&self) -> usize {
+        self.nv
     }
 
     /// Number of moving bodies (= joints).
@@ -143,12 +311,14 @@ impl Multibody {
         self.joints.len()
     }
 
+    /// Number of position coordinates (a follower's not counted: [`Mimic`]).
     pub fn nq(&self) -> usize {
-        self.nq
+        self.reduction.as_ref().map_or(self.nq, |r| r.nq)
     }
 
+    /// Number of velocity coordinates (a follower's not counted: [`Mimic`]).
     pub fn nv(&self) -> usize {
-        self.nv
+        self.reduction.as_ref().map_or(self.nv, |r| r.nv)
     }
 
     /// Scales every quaternion of the configuration `q` to unit length (Pinocchio's
@@ -157,11 +327,14 @@ impl Multibody {
     /// # Panics
     /// If `q` is not `nq` long.
     pub fn normalize(&self, q: &mut [f64]) {
-        crate::kinematics::check_len("q", q, self.nq);
-        for j in &self.joints {
+        crate::kinematics::check_len("q", q, self.nq());
+        for (k, j) in self.joints.iter().enumerate() {
+            let Some((offset, _)) = self.coordinates_of(k) else {
+                continue;
+            };
             let k = match j.kind {
-                JointType::Spherical => j.q_offset,
-                JointType::FreeFlyer => j.q_offset + 3,
+                JointType::Spherical => offset,
+                JointType::FreeFlyer => offset + 3,
                 _ => continue,
             };
             let n = sqrt(q[k..k + 4].iter().map(|x| x * x).sum::<f64>());
@@ -173,11 +346,14 @@ impl Multibody {
 
     /// The neutral configuration: zero coordinates, identity quaternions.
     pub fn neutral(&self) -> Vec<f64> {
-        let mut q = alloc::vec![0.0; self.nq];
-        for j in &self.joints {
+        let mut q = alloc::vec![0.0; self.nq()];
+        for (k, j) in self.joints.iter().enumerate() {
+            let Some((offset, _)) = self.coordinates_of(k) else {
+                continue;
+            };
             match j.kind {
-                JointType::Spherical => q[j.q_offset + 3] = 1.0,
-                JointType::FreeFlyer => q[j.q_offset + 6] = 1.0,
+                JointType::Spherical => q[offset + 3] = 1.0,
+                JointType::FreeFlyer => q[offset + 6] = 1.0,
                 _ => {}
             }
         }
@@ -225,6 +401,8 @@ pub struct Workspace<S: Real> {
     pub(crate) axes: Vec<Motion<S>>,
     /// A body's path to the base (frame Jacobians).
     pub(crate) path: Vec<usize>,
+    /// The tree's coordinates and results when some joints follow others ([`Mimic`]).
+    pub(crate) mimic: crate::mimic::MimicBuffers<S>,
 }
 
 impl<S: Real> Workspace<S> {
@@ -253,11 +431,12 @@ impl<S: Real> Workspace<S> {
             articulated: alloc::vec![Inertia::zero(z).to_matrix(z); n],
             bias_force: alloc::vec![Force::zero(z); n],
             bias_acceleration: alloc::vec![Motion::zero(z); n],
-            u: alloc::vec![Force::zero(z); multibody.nv()],
-            u_torque: alloc::vec![z; multibody.nv()],
+            u: alloc::vec![Force::zero(z); multibody.tree_nv()],
+            u_torque: alloc::vec![z; multibody.tree_nv()],
             d_inv: alloc::vec![[z; 36]; n],
             axes: alloc::vec![Motion::zero(z); multibody.supports.len()],
             path: alloc::vec![0; multibody.bodies()],
+            mimic: crate::mimic::MimicBuffers::new(multibody, z),
         }
     }
 

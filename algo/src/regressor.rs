@@ -2,6 +2,7 @@
 //! `τ = Y(q, q̇, q̈) π`, linear in the standard parameters of every body.
 
 use crate::kinematics::{check_len, newton_euler_pass, placements};
+use crate::mimic::{on_tree, Reduce};
 use crate::multibody::{Multibody, Workspace, PARAMS_PER_BODY};
 use crate::spatial::{add, cross, Force, Vec3};
 use crate::Real;
@@ -68,7 +69,36 @@ pub fn joint_torque_regressor<S: Real>(
     a: &[S],
     y: &mut [S],
 ) {
-    let (nv, nb) = (multibody.nv(), multibody.bodies());
+    if multibody.reduction.is_some() {
+        let (nv, cols) = (multibody.tree_nv(), PARAMS_PER_BODY * multibody.bodies());
+        check_len("y", y, multibody.nv() * cols);
+        let tree = |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], out: &mut [S]| {
+            joint_torque_regressor_tree(multibody, w, q, v, a, out)
+        };
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            Some(v),
+            Some(a),
+            nv * cols,
+            Reduce::Rows(cols),
+            y,
+            tree,
+        );
+    }
+    joint_torque_regressor_tree(multibody, workspace, q, v, a, y);
+}
+
+fn joint_torque_regressor_tree<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    y: &mut [S],
+) {
+    let (nv, nb) = (multibody.tree_nv(), multibody.bodies());
     check_len("v", v, nv);
     check_len("a", a, nv);
     check_len("y", y, nv * PARAMS_PER_BODY * nb);
@@ -120,7 +150,34 @@ pub fn joint_wrench_regressor<S: Real>(
     a: &[S],
     w: &mut [S],
 ) {
-    let (nv, nb) = (multibody.nv(), multibody.bodies());
+    if multibody.reduction.is_some() {
+        let tree = |ws: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], _: &mut [S]| {
+            joint_wrench_regressor_tree(multibody, ws, q, v, a, w)
+        };
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            Some(v),
+            Some(a),
+            0,
+            Reduce::None,
+            &mut [],
+            tree,
+        );
+    }
+    joint_wrench_regressor_tree(multibody, workspace, q, v, a, w);
+}
+
+fn joint_wrench_regressor_tree<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    w: &mut [S],
+) {
+    let (nv, nb) = (multibody.tree_nv(), multibody.bodies());
     check_len("v", v, nv);
     check_len("a", a, nv);
     check_len("w", w, 6 * nb * PARAMS_PER_BODY * nb);

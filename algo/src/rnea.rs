@@ -2,6 +2,7 @@
 //! Featherstone, *Rigid Body Dynamics Algorithms*, Table 5.1), in body frames.
 
 use crate::kinematics::{check_len, newton_euler_pass, placements};
+use crate::mimic::{on_tree, Reduce};
 use crate::multibody::{Multibody, Workspace, PARAMS_PER_BODY};
 use crate::spatial::Inertia;
 use crate::Real;
@@ -31,7 +32,36 @@ pub fn rnea<S: Real>(
     params: &[S],
     tau: &mut [S],
 ) {
-    let nv = multibody.nv();
+    if multibody.reduction.is_some() {
+        let tree = |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], out: &mut [S]| {
+            rnea_tree(multibody, w, q, v, a, params, out)
+        };
+        let nv = multibody.tree_nv();
+        return on_tree(
+            multibody,
+            workspace,
+            Some(q),
+            Some(v),
+            Some(a),
+            nv,
+            Reduce::Rows(1),
+            tau,
+            tree,
+        );
+    }
+    rnea_tree(multibody, workspace, q, v, a, params, tau);
+}
+
+fn rnea_tree<S: Real>(
+    multibody: &Multibody,
+    workspace: &mut Workspace<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    params: &[S],
+    tau: &mut [S],
+) {
+    let nv = multibody.tree_nv();
     check_len("v", v, nv);
     check_len("a", a, nv);
     check_len("tau", tau, nv);

@@ -77,12 +77,24 @@ pub fn load_model(path: &Path, args: &ModelArgs) -> Result<Model> {
 
 /// Like [`load_model`], for the commands that run the dynamics at run time
 /// (identification, simulation, validation, NIM): refuses a model without moving
-/// joints, and one with a free flyer, a ball or a planar joint, which only the
-/// generated code handles so far.
+/// joints, one with a joint that follows another (`<mimic>`), and one with a free
+/// flyer, a ball or a planar joint, which only the generated code handles so far.
 pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
     let model = load_model(path, args)?;
     if model.dof() == 0 {
         return Err(CliError::input(path, "the robot has no moving joints"));
+    }
+    if let Some(j) = model.mimic_joint() {
+        return Err(CliError::input(
+            path,
+            format!(
+                "joint `{}` follows another (<mimic>); this command runs on robots whose joints each have a \
+                 coordinate of their own. The run-time algorithms take mimic joints (`dyngen.load` in Python, \
+                 `dyngen_model::Model::multibody` in Rust); or remove the <mimic> element to identify the joint \
+                 as an independent one",
+                j.name
+            ),
+        ));
     }
     if let Some(j) = model.multi_dof_joint() {
         return Err(CliError::input(

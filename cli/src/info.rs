@@ -83,6 +83,12 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         out!("{out}");
         return Ok(());
     }
+    if let Some(why) = dyngen_codegen::unsupported(&model) {
+        writeln!(out).ok();
+        writeln!(out, "Generated functions: none ({why})").ok();
+        out!("{out}");
+        return Ok(());
+    }
     let generated = with_spinner(progress, "generating code for the op counts", || {
         generate(&model, "Robot", &bases, &Options::default())
     });
@@ -119,6 +125,20 @@ fn topology(model: &Model, path: &std::path::Path) -> String {
             }
         )
         .ok();
+    }
+    if model.mimic_joint().is_some() {
+        writeln!(
+            out,
+            "  {} velocity coordinates; joints that follow another (<mimic>), q = multiplier · q_leader + offset:",
+            model.nv()
+        )
+        .ok();
+        for j in &model.joints {
+            if let Some(m) = j.mimic {
+                let leader = &model.joints[m.leader - 1].name;
+                writeln!(out, "    {} = {} · {leader} + {}", j.name, m.multiplier, m.offset).ok();
+            }
+        }
     }
     writeln!(out).ok();
     writeln!(out, "Joints (joint j carries body j; parent 0 is the base)").ok();

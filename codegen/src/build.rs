@@ -14,6 +14,8 @@ pub enum Error {
     TypeName(String),
     /// Neither an output directory was set nor `OUT_DIR` (not running in `build.rs`).
     NoOutDir,
+    /// The model holds what generated code does not support ([`crate::unsupported`]).
+    Unsupported(String),
     Io {
         path: PathBuf,
         error: std::io::Error,
@@ -29,6 +31,7 @@ impl fmt::Display for Error {
                 "`{n}` is not a valid Rust type name; use an identifier such as `Ur5`"
             ),
             Error::NoOutDir => write!(f, "OUT_DIR is not set: call this from build.rs, or set Config::out_dir"),
+            Error::Unsupported(why) => write!(f, "{why}"),
             Error::Io { path, error } => write!(f, "{}: {error}", path.display()),
         }
     }
@@ -183,6 +186,9 @@ impl Config {
     pub fn generate_file(&self, model: &Model, type_name: &str, source: &str) -> Result<String, Error> {
         if !generate::is_type_name(type_name) {
             return Err(Error::TypeName(type_name.to_string()));
+        }
+        if let Some(why) = crate::unsupported(model) {
+            return Err(Error::Unsupported(why));
         }
         let mut model = model.clone();
         if let Some(g) = self.gravity {

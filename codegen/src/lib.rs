@@ -29,6 +29,7 @@ pub use build::{compile_urdf, write_if_changed, Config, Error};
 pub use capability::{Capability, Selection, UnknownCapability};
 pub use generate::{generate, is_type_name, GeneratedCode, Options, DEFAULT_COMPOSE_ABOVE_NV};
 
+use dyngen_model::Model;
 use proc_macro2::TokenStream;
 use quote::quote;
 
@@ -49,6 +50,19 @@ pub enum RobotSource {
     Urdf(syn::LitStr),
 }
 
+/// Why generated code cannot be made for `model`, if it cannot: a joint that follows
+/// another (`<mimic>`), which only the run-time algorithms take so far.
+pub fn unsupported(model: &Model) -> Option<String> {
+    let j = model.mimic_joint()?;
+    let leader = j.mimic.map_or("", |m| model.joints[m.leader - 1].name.as_str());
+    Some(format!(
+        "joint `{}` follows joint `{leader}` (<mimic>), which generated code does not support yet; load the robot \
+         at run time instead (`dyngen_model::load_robot`, then `Model::multibody` and `dyngen_algo`'s algorithms, or \
+         `dyngen.load` in Python), or remove the <mimic> element to make the joint independent",
+        j.name
+    ))
+}
+
 /// The whole `robot!` macro: parse, build the checked model, generate.
 pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
     let input = dsl::parse(input)?;
@@ -67,6 +81,13 @@ pub fn expand_robot_macro(input: TokenStream) -> syn::Result<TokenStream> {
             (model, Some(path))
         }
     };
+    if let Some(why) = unsupported(&model) {
+        let span = match &input.source {
+            RobotSource::Urdf(lit) => lit.span(),
+            RobotSource::Dsl(_) => input.name.span(),
+        };
+        return Err(syn::Error::new(span, why));
+    }
     let bases = base::analyse_model(&model);
     let options = Options {
         functions: input.functions,

@@ -4,7 +4,7 @@
 //! declaration order, or by joint name as Pinocchio and urdfdom number them).
 
 use crate::error::{Element, ErrorKind, ModelError};
-use crate::ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+use crate::ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Mimic, Model, Placement};
 use crate::math;
 use std::collections::HashMap;
 
@@ -36,6 +36,17 @@ pub struct JointDesc {
     pub line: Option<usize>,
 }
 
+/// A joint that follows another (URDF `<mimic>`): `q = multiplier · q_leader + offset`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MimicDesc {
+    /// The following joint and its leader, by name.
+    pub joint: String,
+    pub leader: String,
+    pub multiplier: f64,
+    pub offset: f64,
+    pub line: Option<usize>,
+}
+
 /// A robot as a front end read it: links and joints by name, in declaration order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Description {
@@ -43,6 +54,8 @@ pub struct Description {
     pub gravity: [f64; 3],
     pub links: Vec<LinkDesc>,
     pub joints: Vec<JointDesc>,
+    /// The moving joints that follow others.
+    pub mimics: Vec<MimicDesc>,
 }
 
 /// The order in which the depth-first numbering visits a link's child joints.
@@ -455,6 +468,7 @@ impl Description {
                         },
                         limits: if keeps_limits { j.limits } else { None },
                         dynamics: j.dynamics,
+                        mimic: None,
                     });
                     model.bodies.push(Body {
                         name: self.links[link].name.clone(),
@@ -505,6 +519,9 @@ impl Description {
         if model.joints.is_empty() && errors.is_empty() {
             errors.push(err(Element::Robot, None, ErrorKind::NoMovingJoint));
         }
+        if errors.is_empty() {
+            errors.extend(self.followers(&mut model));
+        }
         // Only a tree without errors so far has a mass matrix worth factoring below.
         let factor = errors.is_empty();
         for (b, inertial) in body_inertial.into_iter().enumerate() {
@@ -548,6 +565,92 @@ impl Description {
         }
         model.warnings = warnings;
         Ok(model)
+    }
+
+    /// Sets [`Joint::mimic`] of every follower in [`Description::mimics`], resolved to
+    /// a leader that follows no other; returns what cannot be followed.
+    fn followers(&self, model: &mut Model) -> Vec<ModelError> {
+        let mut errors = Vec::new();
+        let one = |k: JointKind| k.nq() == 1 && k.nv() == 1;
+        for m in &self.mimics {
+            let mut bad = |why: String| {
+                errors.push(ModelError {
+                    element: Element::Joint(m.joint.clone()),
+                    line: m.line,
+                    kind: ErrorKind::BadMimic(why),
+                })
+            };
+            let Some(f) = model.joints.iter().position(|j| j.name == m.joint) else {
+                bad("only a moving joint can follow another".into());
+                continue;
+            };
+            let Some(l) = model.joints.iter().position(|j| j.name == m.leader) else {
+                bad(if self.joints.iter().any(|j| j.name == m.leader) {
+                    format!(
+                        "its leader `{}` is a fixed joint, which has no coordinate to follow; follow a moving joint, \
+                         or make this joint fixed too",
+                        m.leader
+                    )
+                } else {
+                    format!(
+                        "joint=\"{}\" names no joint of this robot; name the revolute, continuous or prismatic joint \
+                         this one follows",
+                        m.leader
+                    )
+                });
+                continue;
+            };
+            let (kind, leader_kind) = (model.joints[f].kind, model.joints[l].kind);
+            if f == l {
+                bad("a joint cannot follow itself; name another joint".into());
+            } else if !one(kind) || !one(leader_kind) {
+                bad(format!(
+                    "a {} joint follows a {} joint; only revolute, continuous and prismatic joints can follow or be \
+                     followed",
+                    kind.urdf_name(),
+                    leader_kind.urdf_name()
+                ));
+            } else if !(m.multiplier.is_finite() && m.offset.is_finite()) {
+                bad(format!(
+                    "multiplier {} and offset {} must be finite numbers",
+                    m.multiplier, m.offset
+                ));
+            } else {
+                model.joints[f].mimic = Some(Mimic {
+                    leader: l + 1,
+                    multiplier: m.multiplier,
+                    offset: m.offset,
+                });
+            }
+        }
+        // A follower of a follower follows the first leader: q = a (a' q + b') + b.
+        let given: Vec<Option<Mimic>> = model.joints.iter().map(|j| j.mimic).collect();
+        let n = given.len();
+        for (f, first) in given.iter().enumerate() {
+            let Some(mut m) = *first else { continue };
+            let mut steps = 0;
+            while let Some(next) = given[m.leader - 1] {
+                steps += 1;
+                if steps > n {
+                    let name = model.joints[f].name.clone();
+                    errors.push(ModelError {
+                        line: self.mimics.iter().find(|d| d.joint == name).and_then(|d| d.line),
+                        element: Element::Joint(name),
+                        kind: ErrorKind::BadMimic(
+                            "its leaders, followed in turn, run in a cycle; one joint of the cycle must lead".into(),
+                        ),
+                    });
+                    break;
+                }
+                m = Mimic {
+                    leader: next.leader,
+                    multiplier: m.multiplier * next.multiplier,
+                    offset: m.multiplier * next.offset + m.offset,
+                };
+            }
+            model.joints[f].mimic = Some(m);
+        }
+        errors
     }
 
     /// Follows parent joints up from the first link until a link repeats; returns the

@@ -57,9 +57,8 @@ pub enum ErrorKind {
         /// How many numbers the attribute holds (1 or 3).
         expected: usize,
     },
-    /// A `<mimic>` joint: it follows another joint (named here), which a tree of
-    /// independent joints cannot express.
-    MimicJoint(String),
+    /// A `<mimic>` that cannot be followed: the reason, and what would be valid.
+    BadMimic(String),
     UnknownParentLink(String),
     UnknownChildLink(String),
     DuplicateLink,
@@ -158,11 +157,7 @@ impl fmt::Display for ErrorKind {
                     ),
                 }
             }
-            ErrorKind::MimicJoint(leader) => write!(
-                f,
-                "mimics joint `{leader}` (<mimic>), which is not supported: the dynamics would treat it as an \
-                 independent joint; remove the <mimic> element to model it as one, or lock it with type=\"fixed\""
-            ),
+            ErrorKind::BadMimic(why) => write!(f, "<mimic>: {why}"),
             ErrorKind::UnknownParentLink(p) => {
                 write!(f, "parent link `{p}` does not exist; a joint's parent must name a <link> of this robot")
             }

@@ -205,6 +205,20 @@ pub struct Joint {
     pub axis: Vec3,
     pub limits: Option<Limits>,
     pub dynamics: JointDynamics,
+    /// The joint this one follows (URDF `<mimic>`): then it has no coordinate of its
+    /// own, its coordinate being `multiplier · q_leader + offset`.
+    pub mimic: Option<Mimic>,
+}
+
+/// How a joint follows another (URDF `<mimic>`, Pinocchio's mimic joint): its
+/// coordinate is `multiplier · q_leader + offset`, its velocity and acceleration
+/// `multiplier` times the leader's. The leader (1-based) follows no other joint: a
+/// chain of followers is resolved to its first leader when the model is built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mimic {
+    pub leader: usize,
+    pub multiplier: f64,
+    pub offset: f64,
 }
 
 /// A moving body of the checked model; its frame is its joint's frame.
@@ -276,29 +290,46 @@ impl Model {
     }
 
     /// Number of joints, which is the number of moving bodies; also the number of
-    /// degrees of freedom when every joint has one ([`Model::multi_dof_joint`]).
+    /// degrees of freedom when every joint has one ([`Model::multi_dof_joint`]) and
+    /// none follows another ([`Model::mimic_joint`]).
     pub fn dof(&self) -> usize {
         self.joints.len()
     }
 
-    /// Number of position coordinates, `Σ nq` over the joints.
+    /// Number of position coordinates, `Σ nq` over the joints that follow no other.
     pub fn nq(&self) -> usize {
-        self.joints.iter().map(|j| j.kind.nq()).sum()
+        self.own(&self.joints).map(|j| j.kind.nq()).sum()
     }
 
-    /// Number of velocity coordinates (degrees of freedom), `Σ nv` over the joints.
+    /// Number of velocity coordinates (degrees of freedom), `Σ nv` over the joints that
+    /// follow no other.
     pub fn nv(&self) -> usize {
-        self.joints.iter().map(|j| j.kind.nv()).sum()
+        self.own(&self.joints).map(|j| j.kind.nv()).sum()
     }
 
-    /// Index in `q` of joint `j`'s first position (1-based joint).
+    /// Index in `q` of joint `j`'s first position (1-based joint); a follower's is its
+    /// leader's.
     pub fn q_offset(&self, j: usize) -> usize {
-        self.joints[..j - 1].iter().map(|j| j.kind.nq()).sum()
+        let j = self.joints[j - 1].mimic.map_or(j, |m| m.leader);
+        self.own(&self.joints[..j - 1]).map(|j| j.kind.nq()).sum()
     }
 
-    /// Index in `v` of joint `j`'s first velocity (1-based joint).
+    /// Index in `v` of joint `j`'s first velocity (1-based joint); a follower's is its
+    /// leader's.
     pub fn v_offset(&self, j: usize) -> usize {
-        self.joints[..j - 1].iter().map(|j| j.kind.nv()).sum()
+        let j = self.joints[j - 1].mimic.map_or(j, |m| m.leader);
+        self.own(&self.joints[..j - 1]).map(|j| j.kind.nv()).sum()
+    }
+
+    /// The joints among `joints` with coordinates of their own (following no other).
+    fn own<'a>(&self, joints: &'a [Joint]) -> impl Iterator<Item = &'a Joint> {
+        joints.iter().filter(|j| j.mimic.is_none())
+    }
+
+    /// The first joint that follows another (`<mimic>`), if any: what the layers that
+    /// take one coordinate per joint refuse by name.
+    pub fn mimic_joint(&self) -> Option<&Joint> {
+        self.joints.iter().find(|j| j.mimic.is_some())
     }
 
     /// The joint (1-based) that owns velocity coordinate `d`.
@@ -338,13 +369,14 @@ impl Model {
         self.joint_owning(i, JointKind::nq)
     }
 
-    /// The joint whose coordinates, `width` of them per joint, include `index`.
+    /// The joint whose coordinates, `width` of them per joint, include `index` (a
+    /// leader, never one that follows it).
     fn joint_owning(&self, index: usize, width: fn(JointKind) -> usize) -> Option<usize> {
         let mut end = 0;
         self.joints
             .iter()
             .position(|j| {
-                end += width(j.kind);
+                end += if j.mimic.is_some() { 0 } else { width(j.kind) };
                 index < end
             })
             .map(|k| k + 1)

@@ -41,10 +41,11 @@ pub mod xml;
 pub use base::{BaseParams, Parameterisation};
 pub use desc::{
     check_inertial, check_physical, inertia_violation, nearest_physical_moments, DeclaredJointType, Description,
-    JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY, FREE_FLYER_JOINT, INERTIA_TOLERANCE, WORLD_LINK,
+    JointDesc, LinkDesc, LoadOptions, MimicDesc, SiblingOrder, DEFAULT_GRAVITY, FREE_FLYER_JOINT, INERTIA_TOLERANCE,
+    WORLD_LINK,
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
-pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Model, Placement};
+pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Mimic, Model, Placement};
 pub use mjcf::{
     load_mjcf, load_mjcf_options, load_mjcf_with, load_robot, load_robot_options, load_robot_with, parse_mjcf,
     parse_mjcf_options, parse_mjcf_with,

@@ -492,6 +492,7 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
             gravity: reader.gravity,
             links: reader.links,
             joints: reader.joints,
+            mimics: Vec::new(),
         },
         root_line: Some(tags[root].line),
         errors: reader.errors,

@@ -7,7 +7,8 @@ use dyngen_algo::{JointSpec, Multibody, Se3, TreeError};
 
 impl Model {
     /// This model as the algorithms' [`Multibody`]: the same numbering, placements,
-    /// axes, gravity and nominal standard parameters ([`Model::standard_params`]).
+    /// axes, gravity and nominal standard parameters ([`Model::standard_params`]), and
+    /// the joints that follow others ([`crate::Mimic`]) as [`dyngen_algo::Mimic`]s.
     ///
     /// ```
     /// let model = dyngen_model::parse_urdf(r#"<robot name="r"><link name="base"/>
@@ -48,6 +49,19 @@ impl Model {
                 }
             })
             .collect();
-        Multibody::new(self.gravity, &specs)
+        let mimics: Vec<dyngen_algo::Mimic> = self
+            .joints
+            .iter()
+            .enumerate()
+            .filter_map(|(k, j)| {
+                j.mimic.map(|m| dyngen_algo::Mimic {
+                    joint: k,
+                    leader: m.leader - 1,
+                    multiplier: m.multiplier,
+                    offset: m.offset,
+                })
+            })
+            .collect();
+        Multibody::new(self.gravity, &specs)?.with_mimics(&mimics)
     }
 }

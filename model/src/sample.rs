@@ -83,7 +83,8 @@ fn draw(model: &Model, count: usize, seed: u64, within_limits: bool) -> Vec<Stat
     (0..count)
         .map(|_| {
             let mut q = Vec::with_capacity(model.nq());
-            for j in &model.joints {
+            // A follower (`<mimic>`) moves with its leader's coordinate.
+            for j in model.joints.iter().filter(|j| j.mimic.is_none()) {
                 match j.kind {
                     JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => {
                         // One turn, or ±0.5 m, within the limits when asked and there

@@ -3,7 +3,9 @@
 //! text supplies line numbers, spots unexpanded xacro, and tells which optional
 //! elements (`<inertial>`, `<limit>`) were actually written.
 
-use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY};
+use crate::desc::{
+    DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, MimicDesc, SiblingOrder, DEFAULT_GRAVITY,
+};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math;
@@ -80,22 +82,19 @@ pub fn load_urdf_options(path: &Path, options: LoadOptions) -> Result<Model, Mod
 /// callers that want to adjust it (gravity, say) before checking.
 pub fn urdf_description(text: &str) -> Result<Description, ModelErrors> {
     let fail = |errors| ModelErrors { file: None, errors };
-    let (desc, _, unsupported, _) = read(text).map_err(fail)?;
-    if !unsupported.is_empty() {
-        return Err(fail(unsupported));
-    }
+    let (desc, _, _) = read(text).map_err(fail)?;
     Ok(desc)
 }
 
 fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
     let strict = options.strict;
-    let (mut desc, robot_line, unsupported, notes) = read(text)?;
+    let (mut desc, robot_line, notes) = read(text)?;
     if options.free_flyer {
         desc = desc.with_free_flyer();
     }
     // Siblings by joint name, as urdfdom and so Pinocchio number them.
     let mut errors = match desc.build_checked(SiblingOrder::Name, options) {
-        Ok(mut model) if unsupported.is_empty() && (!strict || notes.is_empty()) => {
+        Ok(mut model) if !strict || notes.is_empty() => {
             model.warnings.extend(notes);
             return Ok(model);
         }
@@ -115,7 +114,6 @@ fn build(text: &str, options: LoadOptions) -> Result<Model, Vec<ModelError>> {
             e.line = robot_line;
         }
     }
-    errors.extend(unsupported);
     // In file order, as a compiler lists them; the sort is stable for ties.
     errors.sort_by_key(|e| e.line.unwrap_or(usize::MAX));
     Err(errors)
@@ -129,11 +127,9 @@ fn robot_error(line: Option<usize>, kind: ErrorKind) -> ModelError {
     }
 }
 
-/// What [`read`] gives: the description, the line of `<robot>`, what the file asks
-/// for that the description cannot hold (mimic joints), reported with the checks of
-/// the description, and what it is read with a warning for (a planar joint without
-/// `<axis>`).
-type ReadOutcome = (Description, Option<usize>, Vec<ModelError>, Vec<ModelError>);
+/// What [`read`] gives: the description, the line of `<robot>`, and what it is read
+/// with a warning for (a planar joint without `<axis>`).
+type ReadOutcome = (Description, Option<usize>, Vec<ModelError>);
 
 /// Reads URDF text into a description and the line of its `<robot>` element.
 fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
@@ -169,7 +165,6 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
     if !numbers.is_empty() {
         return Err(numbers);
     }
-    let unsupported = mimic_errors(&tags);
     let robot = match urdf_rs::read_from_string(&without_geometry(text, &tags)) {
         Ok(robot) => robot,
         Err(e) => return Err(parse_errors(&tags, &e.to_string())),
@@ -255,13 +250,30 @@ fn read(text: &str) -> Result<ReadOutcome, Vec<ModelError>> {
             })
         })
         .collect();
+    // A <mimic> on a fixed joint has nothing to follow with: ignored, as urdfdom does.
+    let mimics = robot
+        .joints
+        .iter()
+        .filter(|j| !matches!(j.joint_type, urdf_rs::JointType::Fixed))
+        .filter_map(|j| {
+            let m = j.mimic.as_ref()?;
+            Some(MimicDesc {
+                joint: j.name.clone(),
+                leader: m.joint.clone(),
+                multiplier: m.multiplier.unwrap_or(1.0),
+                offset: m.offset.unwrap_or(0.0),
+                line: mimic_line(&tags, &j.name),
+            })
+        })
+        .collect();
     let desc = Description {
         name: robot.name.clone(),
         gravity: DEFAULT_GRAVITY,
         links,
         joints,
+        mimics,
     };
-    Ok((desc, outline.robot_line, unsupported, notes))
+    Ok((desc, outline.robot_line, notes))
 }
 
 /// The numeric attributes of the elements dyngen reads, with how many numbers each
@@ -272,6 +284,7 @@ fn numeric_attributes(owner: &str, element: &str) -> &'static [(&'static str, us
         ("link", "mass") => &[("value", 1)],
         ("link", "inertia") => &[("ixx", 1), ("ixy", 1), ("ixz", 1), ("iyy", 1), ("iyz", 1), ("izz", 1)],
         ("joint", "axis") => &[("xyz", 3)],
+        ("joint", "mimic") => &[("multiplier", 1), ("offset", 1)],
         ("joint", "limit") => &[("lower", 1), ("upper", 1), ("effort", 1), ("velocity", 1)],
         ("joint", "dynamics") => &[("damping", 1), ("friction", 1)],
         ("joint", "calibration") => &[("rising", 1), ("falling", 1)],
@@ -457,20 +470,12 @@ fn quaternion_problem(quat: &str) -> Option<String> {
     })
 }
 
-/// A `<mimic>` in a moving joint: reported rather than read as an independent joint.
-/// On a fixed joint it has nothing to follow with and is ignored, as urdfdom does.
-fn mimic_errors(tags: &[Tag]) -> Vec<ModelError> {
+/// The line of the `<mimic>` of the joint named `joint`.
+fn mimic_line(tags: &[Tag], joint: &str) -> Option<usize> {
     tags.iter()
         .filter(|t| t.name == "mimic")
-        .filter_map(|t| {
-            let owner = owner_of(tags, t).filter(|o| o.name == "joint" && o.attr("type") != Some("fixed"))?;
-            Some(ModelError {
-                element: element_of(owner),
-                line: Some(t.line),
-                kind: ErrorKind::MimicJoint(t.attr("joint").unwrap_or_default().to_string()),
-            })
-        })
-        .collect()
+        .find(|t| owner_of(tags, t).is_some_and(|o| o.name == "joint" && o.attr("name") == Some(joint)))
+        .map(|t| t.line)
 }
 
 /// Turns a failure of urdf-rs into errors. urdf-rs stops at the first problem and

@@ -5,7 +5,8 @@
 use dyngen_model::math;
 use dyngen_model::urdf::urdf_description;
 use dyngen_model::{
-    load_urdf, parse_urdf, parse_urdf_with, to_urdf, Element, ErrorKind, JointKind, Model, ModelError, ModelErrors,
+    load_urdf, parse_urdf, parse_urdf_with, to_urdf, Element, ErrorKind, JointKind, Mimic, Model, ModelError,
+    ModelErrors,
 };
 use std::path::PathBuf;
 
@@ -665,45 +666,125 @@ fn wrong_count_or_unreadable_vectors_name_the_element_and_line() {
 }
 
 #[test]
-fn mimic_joint_is_reported() {
+fn mimic_joints_follow_their_leader() {
     let text = robot(&[
         r#"<link name="base"/>"#,
         &link("a"),
         &link("b"),
-        &joint("ja", "continuous", "base", "a", ""),
+        &link("c"),
+        &link("d"),
+        &joint("ja", "revolute", "base", "a", ""),
         &joint(
             "jb",
-            "continuous",
-            "base",
+            "prismatic",
+            "a",
             "b",
-            r#"<mimic joint="ja" multiplier="-1"/>"#,
+            r#"<mimic joint="ja" multiplier="-0.5" offset="0.2"/>"#,
         ),
+        &joint(
+            "jc",
+            "continuous",
+            "b",
+            "c",
+            r#"<mimic joint="jb" multiplier="3" offset="1"/>"#,
+        ),
+        &joint("jd", "revolute", "a", "d", r#"<mimic joint="ja"/>"#),
+    ]);
+    let (model, warned) = load_warned(&text);
+    assert!(warned.is_empty(), "{warned:?}");
+    assert_eq!((model.dof(), model.nq(), model.nv()), (4, 1, 1));
+    let mimic = |name: &str| model.joints.iter().find(|j| j.name == name).unwrap().mimic;
+    assert_eq!(mimic("ja"), None);
+    assert_eq!(
+        mimic("jb"),
+        Some(Mimic {
+            leader: 1,
+            multiplier: -0.5,
+            offset: 0.2
+        })
+    );
+    // A follower of a follower follows the first leader: 3 (−0.5 q + 0.2) + 1.
+    let jc = mimic("jc").unwrap();
+    assert_eq!((jc.leader, jc.multiplier), (1, -1.5));
+    assert!((jc.offset - 1.6).abs() < 1e-15);
+    // URDF's defaults: multiplier 1, offset 0.
+    assert_eq!(
+        mimic("jd"),
+        Some(Mimic {
+            leader: 1,
+            multiplier: 1.0,
+            offset: 0.0
+        })
+    );
+    assert!((1..=4).all(|j| model.v_offset(j) == 0 && model.q_offset(j) == 0));
+    assert_eq!(model.mimic_joint().map(|j| j.name.as_str()), Some("jb"));
+    let body = model.multibody().unwrap();
+    assert_eq!((body.nq(), body.nv(), body.mimics().len()), (1, 1, 3));
+}
+
+#[test]
+fn a_mimic_that_cannot_be_followed_is_named_with_its_line() {
+    let cases = [
+        (
+            r#"<mimic joint="nobody"/>"#,
+            "revolute",
+            "joint=\"nobody\" names no joint of this robot",
+        ),
+        (r#"<mimic joint="jf"/>"#, "revolute", "its leader `jf` is a fixed joint"),
+        (r#"<mimic joint="jb"/>"#, "revolute", "a joint cannot follow itself"),
+        (
+            r#"<mimic joint="ja"/>"#,
+            "planar",
+            "a planar joint follows a revolute joint; only revolute",
+        ),
+        (r#"<mimic joint="ja" multiplier="nan"/>"#, "revolute", "must be finite"),
+    ];
+    for (mimic, kind, message) in cases {
+        let text = robot(&[
+            r#"<link name="base"/>"#,
+            &link("a"),
+            &link("b"),
+            &link("f"),
+            &joint("ja", "revolute", "base", "a", ""),
+            &joint("jf", "fixed", "base", "f", ""),
+            &joint("jb", kind, "a", "b", mimic),
+        ]);
+        let e = single(&text, Element::Joint("jb".into()), 8);
+        assert!(matches!(e.kind, ErrorKind::BadMimic(_)), "{e}");
+        assert!(e.to_string().contains(message), "{e}");
+    }
+    // A cycle of followers: each named.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "revolute", "base", "a", r#"<mimic joint="jb"/>"#),
+        &joint("jb", "revolute", "a", "b", r#"<mimic joint="ja"/>"#),
+    ]);
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert!(
+        errs.iter().all(|e| e.to_string().contains("run in a cycle")),
+        "{errs:#?}"
+    );
+    // A multiplier that is not a number, at its line.
+    let text = robot(&[
+        r#"<link name="base"/>"#,
+        &link("a"),
+        &link("b"),
+        &joint("ja", "revolute", "base", "a", ""),
+        &joint("jb", "revolute", "a", "b", r#"<mimic joint="ja" multiplier="twice"/>"#),
     ]);
     let e = single(&text, Element::Joint("jb".into()), 6);
-    assert_eq!(e.kind, ErrorKind::MimicJoint("ja".into()));
     assert!(
-        e.to_string()
-            .contains("mimics joint `ja` (<mimic>), which is not supported"),
+        e.to_string().contains("<mimic multiplier=\"twice\"> is not a number"),
         "{e}"
-    );
-    // Also when the description alone is asked for, and beside other errors.
-    assert!(urdf_description(&text).is_err());
-    let text = text.replace(r#"<link name="b">"#, r#"<link name="b_">"#);
-    let errs = errors(&text);
-    assert!(
-        errs.iter().any(|e| e.kind == ErrorKind::MimicJoint("ja".into())),
-        "{errs:#?}"
-    );
-    assert!(
-        errs.iter().any(|e| e.kind == ErrorKind::UnknownChildLink("b".into())),
-        "{errs:#?}"
     );
 }
 
 #[test]
 fn mimic_on_a_fixed_joint_is_ignored() {
-    // What the mimic error tells the user to do, done: the joint is locked, and its
-    // <mimic> has nothing to follow with.
+    // The joint is locked: its <mimic> has nothing to follow with.
     let text = robot(&[
         r#"<link name="base"/>"#,
         &link("a"),

@@ -270,6 +270,14 @@ fn load_robot(robot_path: &Path) -> PyResult<Model> {
             robot_path.display()
         )));
     }
+    if let Some(j) = model.mimic_joint() {
+        return Err(LoadError::new_err(format!(
+            "{}: joint `{}` follows another (<mimic>); identification runs on robots whose joints each have a \
+             coordinate of their own",
+            robot_path.display(),
+            j.name
+        )));
+    }
     if let Some(j) = model.multi_dof_joint() {
         return Err(LoadError::new_err(format!(
             "{}: joint `{}` is a {} joint; identification runs on robots whose joints each have one degree of freedom",

@@ -35,6 +35,8 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     damping: j.damping,
                     friction: j.friction,
                 },
+                // Generated code is made for models without followers only.
+                mimic: None,
             })
             .collect(),
         bodies: m

@@ -64,6 +64,7 @@ fn build(name: &str, gravity: [f64; 3], links: Vec<LinkDesc>, joints: Vec<JointD
         gravity,
         links,
         joints,
+        mimics: Vec::new(),
     }
     .build()
     .expect("test model is valid")

@@ -126,3 +126,273 @@ fn census_generated_algorithms_match_pinocchio() {
         println!("{name}: worst relative error against Pinocchio {worst:.1e}");
     }
 }
+
+/// Mimic joints (`tests/fixtures/mimic/`, `scripts/make_mimic_fixtures.py`): fixture name,
+/// URDF, on a free flyer.
+const MIMIC: [(&str, &str, bool); 3] = [
+    ("arm_linkage_gripper", "arm_linkage_gripper", false),
+    ("mimic_probe", "mimic_probe", false),
+    ("mimic_probe_free_flyer", "mimic_probe", true),
+];
+
+/// The run-time algorithms on a model with mimic joints against Pinocchio 4.1's mimic
+/// support (rnea, nonlinear effects, gravity, crba, frames and their Jacobians, centre
+/// of mass, its Jacobian, `A_g`), and against Pinocchio's tree without followers
+/// reduced with `E` for what Pinocchio does not run on mimic joints (regressor, rnea
+/// derivatives); forward dynamics and its derivatives by their identities with those.
+#[test]
+fn mimic_joints_match_pinocchio() {
+    use dyngen_algo::{ReferenceFrame, Workspace};
+    let mut worst = dyngen_tests::Worst::new(|_| 1e-12);
+    for (fixture, urdf, free_flyer) in MIMIC {
+        let json = load_json(&format!("mimic/{fixture}.json"));
+        let path = workspace_root().join(format!("tests/fixtures/mimic/{urdf}.urdf"));
+        let options = LoadOptions {
+            free_flyer,
+            ..LoadOptions::default()
+        };
+        let model = load_urdf_options(&path, options).unwrap_or_else(|e| panic!("{e}"));
+        assert!(model.warnings.is_empty(), "{fixture}: {:#?}", model.warnings);
+        let (nq, nv) = (model.nq(), model.nv());
+        assert_eq!(
+            (nq, nv),
+            (
+                json["nq"].as_u64().unwrap() as usize,
+                json["nv"].as_u64().unwrap() as usize
+            )
+        );
+        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let tree: Vec<&str> = json["tree_joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|n| n.as_str().unwrap())
+            .collect();
+        assert_eq!(
+            names[usize::from(free_flyer)..],
+            tree[usize::from(free_flyer)..],
+            "{fixture}"
+        );
+        let followers: Vec<&str> = model
+            .joints
+            .iter()
+            .filter(|j| j.mimic.is_some())
+            .map(|j| j.name.as_str())
+            .collect();
+        let mimic: Vec<&str> = json["mimic_joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|n| n.as_str().unwrap())
+            .collect();
+        let mut sorted = mimic.clone();
+        sorted.sort();
+        let mut ours = followers.clone();
+        ours.sort();
+        assert_eq!(ours, sorted, "{fixture}");
+        let params = model.standard_params();
+        worst.add("params", fixture, 0, &params, &json_numbers(&json["params"]), 1.0);
+        let body = model.multibody().unwrap();
+        let mut ws = Workspace::new(&body, ());
+        let mut dual = dyngen_algo::DualWorkspace::<f64, 8>::new(&body, ());
+        for (s, sample) in json["samples"].as_array().unwrap().iter().enumerate() {
+            let [q, v, a] = ["q", "v", "a"].map(|k| json_numbers(&sample[k]));
+            let zero = vec![0.0; nv];
+            let mut out = vec![0.0; nv];
+            let check = |what, got: &[f64], key: &str, w: &mut dyngen_tests::Worst| {
+                w.add(what, fixture, s, got, &json_numbers(&sample[key]), 1.0)
+            };
+            dyngen_algo::rnea(&body, &mut ws, &q, &v, &a, &params, &mut out);
+            check("rnea", &out, "tau", &mut worst);
+            dyngen_algo::rnea(&body, &mut ws, &q, &v, &zero, &params, &mut out);
+            check("nle", &out, "nle", &mut worst);
+            dyngen_algo::rnea(&body, &mut ws, &q, &zero, &zero, &params, &mut out);
+            check("gravity", &out, "gravity", &mut worst);
+            let mut m = vec![0.0; nv * nv];
+            dyngen_algo::crba(&body, &mut ws, &q, &params, &mut m);
+            check("crba", &m, "M", &mut worst);
+            let com = dyngen_algo::center_of_mass(&body, &mut ws, &q, &params);
+            check("com", &com, "com", &mut worst);
+            let mut jcom = vec![0.0; 3 * nv];
+            dyngen_algo::com_jacobian(&body, &mut ws, &q, &params, &mut jcom);
+            check("com_jacobian", &jcom, "com_jacobian", &mut worst);
+            let mut ag = vec![0.0; 6 * nv];
+            dyngen_algo::centroidal_map(&body, &mut ws, &q, &params, &mut ag);
+            check("centroidal_map", &ag, "centroidal_map", &mut worst);
+            for (name, want) in sample["frames"].as_object().unwrap() {
+                let frame = &model.frames[model.frame_index(name).unwrap()];
+                let offset = dyngen_algo::Se3 {
+                    rotation: frame.placement.rotation,
+                    translation: frame.placement.translation,
+                };
+                dyngen_algo::forward_kinematics(&body, &mut ws, &q);
+                let placed = ws.world[frame.body].compose(&offset);
+                let got: Vec<f64> = placed
+                    .rotation
+                    .iter()
+                    .flatten()
+                    .chain(&placed.translation)
+                    .copied()
+                    .collect();
+                worst.add("frame placement", fixture, s, &got, &json_numbers(want), 1.0);
+                let mut j = vec![0.0; 6 * nv];
+                let lwa = ReferenceFrame::LocalWorldAligned;
+                dyngen_algo::compute_frame_jacobian(&body, &mut ws, &q, frame.body, &offset, lwa, &mut j);
+                worst.add("frame jacobian", fixture, s, &j, &json_numbers(&want["jacobian"]), 1.0);
+            }
+            let mut y = vec![0.0; nv * params.len()];
+            dyngen_algo::joint_torque_regressor(&body, &mut ws, &q, &v, &a, &mut y);
+            check("regressor", &y, "regressor", &mut worst);
+            let (mut dq, mut dv, mut da) = (vec![0.0; nv * nv], vec![0.0; nv * nv], vec![0.0; nv * nv]);
+            dyngen_algo::rnea_derivatives(
+                &body, &mut dual, &mut ws, &q, &v, &a, &params, &mut dq, &mut dv, &mut da,
+            );
+            check("dtau_dq", &dq, "dtau_dq", &mut worst);
+            check("dtau_dv", &dv, "dtau_dv", &mut worst);
+            check("dtau_da", &da, "M", &mut worst);
+            // Forward dynamics: aba(q, v, rnea(q, v, a)) = a; its derivatives by
+            // M ∂q̈/∂x = −∂τ/∂x and M M⁻¹ = E, with Pinocchio's M and ∂τ/∂x.
+            let tau = json_numbers(&sample["tau"]);
+            dyngen_algo::aba(&body, &mut ws, &q, &v, &tau, &params, &[], &mut out);
+            worst.add("aba", fixture, s, &out, &a, 1.0);
+            let (mut ddq_dq, mut ddq_dv, mut minv) = (vec![0.0; nv * nv], vec![0.0; nv * nv], vec![0.0; nv * nv]);
+            let mut ddq = vec![0.0; nv];
+            dyngen_algo::aba_derivatives(
+                &body,
+                &mut dual,
+                &mut ws,
+                &q,
+                &v,
+                &tau,
+                &params,
+                &[],
+                &mut ddq,
+                &mut ddq_dq,
+                &mut ddq_dv,
+                &mut minv,
+            );
+            let mj = json_numbers(&sample["M"]);
+            let times = |x: &[f64]| -> Vec<f64> {
+                (0..nv * nv)
+                    .map(|rc| (0..nv).map(|k| mj[rc / nv * nv + k] * x[k * nv + rc % nv]).sum())
+                    .collect()
+            };
+            let identity: Vec<f64> = (0..nv * nv).map(|rc| f64::from(u8::from(rc / nv == rc % nv))).collect();
+            worst.add("M minv", fixture, s, &times(&minv), &identity, 1.0);
+            let neg = |k: &str| json_numbers(&sample[k]).iter().map(|x| -x).collect::<Vec<_>>();
+            worst.add("M ddq_dq", fixture, s, &times(&ddq_dq), &neg("dtau_dq"), 1.0);
+            worst.add("M ddq_dv", fixture, s, &times(&ddq_dv), &neg("dtau_dv"), 1.0);
+        }
+    }
+    println!(
+        "mimic joints against Pinocchio, worst relative errors: {:#?}",
+        worst.items
+    );
+}
+
+/// What Pinocchio does not take and dyngen does (a follower numbered before its
+/// leader and upstream of it, a follower of a follower, a continuous follower): the
+/// algorithms with followers equal the tree without them at `q_tree = E q + b`, reduced
+/// (`τ = Eᵀ τ_tree`, `M = Eᵀ M_tree E`, `Y = Eᵀ Y_tree`, `J = J_tree E`).
+#[test]
+fn mimic_joints_reduce_the_tree() {
+    use dyngen_algo::Workspace;
+    let text = std::fs::read_to_string(workspace_root().join("tests/fixtures/mimic/mimic_probe.urdf")).unwrap();
+    // a_joint follows c_joint, below it; e_joint follows d_joint, itself a follower;
+    // f_joint, continuous, follows b_joint.
+    let text = text
+        .replace(
+            r#"<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="100" velocity="5"/></joint>"#,
+            r#"<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="100" velocity="5"/><mimic joint="c_joint" multiplier="0.5" offset="0.1"/></joint>"#,
+        )
+        .replacen(r#"<mimic joint="b_joint" multiplier="-0.2" offset="-0.22"/>"#, r#"<mimic joint="d_joint" multiplier="4" offset="-0.3"/>"#, 1)
+        .replacen(r#"type="revolute"><parent link="c"/>"#, r#"type="continuous"><parent link="c"/>"#, 1);
+    let model = dyngen_model::parse_urdf(&text).unwrap();
+    let follower = |n: &str| model.joints.iter().find(|j| j.name == n).unwrap().mimic.unwrap();
+    assert_eq!(follower("a_joint").leader, 3, "{:?}", model.joints);
+    assert_eq!(model.joints[follower("e_joint").leader - 1].name, "b_joint");
+    let f = model.joints.iter().find(|j| j.name == "f_joint").unwrap();
+    assert_eq!(f.kind, dyngen_model::JointKind::Continuous);
+    let mut tree = model.clone();
+    tree.joints.iter_mut().for_each(|j| j.mimic = None);
+    let (n, nv, nt) = (model.dof(), model.nv(), tree.nv());
+    // E and b from the model's followers.
+    let mut e = vec![vec![0.0; nv]; nt];
+    let mut b = vec![0.0; nt];
+    for (k, j) in model.joints.iter().enumerate() {
+        match j.mimic {
+            None => e[k][model.v_offset(k + 1)] = 1.0,
+            Some(m) => {
+                e[k][model.v_offset(m.leader)] = m.multiplier;
+                b[k] = m.offset;
+            }
+        }
+    }
+    assert_eq!((n, nv), (7, 2));
+    let (body, whole) = (model.multibody().unwrap(), tree.multibody().unwrap());
+    let (mut ws, mut wt) = (Workspace::new(&body, ()), Workspace::new(&whole, ()));
+    let params = model.standard_params();
+    let np = params.len();
+    for s in 0..4 {
+        let x = |k: usize| ((s * 7 + k * 3) as f64 * 0.37).sin();
+        let (q, v, a): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            (0..nv).map(x).collect(),
+            (0..nv).map(|k| x(k + 5)).collect(),
+            (0..nv).map(|k| x(k + 9)).collect(),
+        );
+        let expand = |y: &[f64], offset: bool| -> Vec<f64> {
+            (0..nt)
+                .map(|d| (0..nv).map(|k| e[d][k] * y[k]).sum::<f64>() + if offset { b[d] } else { 0.0 })
+                .collect()
+        };
+        let (qt, vt, at) = (expand(&q, true), expand(&v, false), expand(&a, false));
+        // Eᵀ x for x of nt rows and `cols` columns.
+        let reduce = |x: &[f64], cols: usize| -> Vec<f64> {
+            (0..nv * cols)
+                .map(|rc| (0..nt).map(|d| e[d][rc / cols] * x[d * cols + rc % cols]).sum())
+                .collect()
+        };
+        let (mut tau, mut tau_t) = (vec![0.0; nv], vec![0.0; nt]);
+        dyngen_algo::rnea(&body, &mut ws, &q, &v, &a, &params, &mut tau);
+        dyngen_algo::rnea(&whole, &mut wt, &qt, &vt, &at, &params, &mut tau_t);
+        assert!(rel_err(&tau, &reduce(&tau_t, 1), 1.0) < 1e-14, "sample {s}");
+        let (mut m, mut m_t) = (vec![0.0; nv * nv], vec![0.0; nt * nt]);
+        dyngen_algo::crba(&body, &mut ws, &q, &params, &mut m);
+        dyngen_algo::crba(&whole, &mut wt, &qt, &params, &mut m_t);
+        // Eᵀ M_tree E: rows reduced, then columns (M_tree symmetric).
+        let half = reduce(&m_t, nt);
+        let mt_e: Vec<f64> = (0..nv * nv)
+            .map(|rc| (0..nt).map(|d| half[rc / nv * nt + d] * e[d][rc % nv]).sum())
+            .collect();
+        assert!(rel_err(&m, &mt_e, 1.0) < 1e-14, "sample {s}");
+        let (mut y, mut y_t) = (vec![0.0; nv * np], vec![0.0; nt * np]);
+        dyngen_algo::joint_torque_regressor(&body, &mut ws, &q, &v, &a, &mut y);
+        dyngen_algo::joint_torque_regressor(&whole, &mut wt, &qt, &vt, &at, &mut y_t);
+        assert!(rel_err(&y, &reduce(&y_t, np), 1.0) < 1e-14, "sample {s}");
+        let frame = dyngen_algo::Se3::identity(0.0, 1.0);
+        let (mut j, mut j_t) = (vec![0.0; 6 * nv], vec![0.0; 6 * nt]);
+        let world = dyngen_algo::ReferenceFrame::World;
+        dyngen_algo::compute_frame_jacobian(&body, &mut ws, &q, n, &frame, world, &mut j);
+        dyngen_algo::compute_frame_jacobian(&whole, &mut wt, &qt, n, &frame, world, &mut j_t);
+        let j_e: Vec<f64> = (0..6 * nv)
+            .map(|rc| (0..nt).map(|d| j_t[rc / nv * nt + d] * e[d][rc % nv]).sum())
+            .collect();
+        assert!(rel_err(&j, &j_e, 1.0) < 1e-14, "sample {s}");
+        // J̇ = J̇_tree E, along v_tree = E v.
+        let (mut ds, mut dt) = (
+            dyngen_algo::DualWorkspace::<f64, 1>::new(&body, ()),
+            dyngen_algo::DualWorkspace::<f64, 1>::new(&whole, ()),
+        );
+        let (mut jd, mut jd_t) = (vec![0.0; 6 * nv], vec![0.0; 6 * nt]);
+        dyngen_algo::frame_jacobian_time_variation(&body, &mut ds, &q, &v, n, &frame, world, &mut j, &mut jd);
+        dyngen_algo::frame_jacobian_time_variation(&whole, &mut dt, &qt, &vt, n, &frame, world, &mut j_t, &mut jd_t);
+        let jd_e: Vec<f64> = (0..6 * nv)
+            .map(|rc| (0..nt).map(|d| jd_t[rc / nv * nt + d] * e[d][rc % nv]).sum())
+            .collect();
+        assert!(rel_err(&jd, &jd_e, 1.0) < 1e-14, "sample {s}");
+        // Forward dynamics undoes inverse dynamics.
+        let mut ddq = vec![0.0; nv];
+        dyngen_algo::aba(&body, &mut ws, &q, &v, &tau, &params, &[], &mut ddq);
+        assert!(rel_err(&ddq, &a, 1.0) < 1e-12, "sample {s}: {ddq:?} {a:?}");
+    }
+}

@@ -135,6 +135,7 @@ impl RandomTree {
                 })
                 .collect(),
             joints,
+            mimics: Vec::new(),
         };
         RandomTree {
             seed,

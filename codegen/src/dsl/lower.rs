@@ -128,5 +128,6 @@ pub fn lower(robot: &Robot, tree: &IncidenceTree) -> Option<Description> {
         gravity,
         links,
         joints: descs,
+        mimics: Vec::new(),
     })
 }

@@ -82,11 +82,13 @@ pub fn joint_torque(p: &[f64; PER_JOINT], v: f64, a: f64, coulomb: Coulomb) -> f
 /// inertia from [`JointDynamics::armature`](crate::ir::JointDynamics) (MJCF
 /// `armature`; 0 from a URDF), viscous and Coulomb friction from `<dynamics damping
 /// friction>` (MJCF `damping frictionloss`), offset 0, the same on each coordinate of
-/// a joint.
+/// a joint. A joint that follows another (`<mimic>`, multiplier `k`) adds its own to
+/// its leader's as their virtual work does: `k² Ia`, `k² Fv`, `|k| Fc`.
 pub fn nominal_joint_params(model: &Model) -> Vec<f64> {
-    model
+    let mut p: Vec<f64> = model
         .joints
         .iter()
+        .filter(|j| j.mimic.is_none())
         .flat_map(|j| {
             std::iter::repeat_n(
                 [j.dynamics.armature, j.dynamics.damping, j.dynamics.friction, 0.0],
@@ -94,7 +96,17 @@ pub fn nominal_joint_params(model: &Model) -> Vec<f64> {
             )
         })
         .flatten()
-        .collect()
+        .collect();
+    for j in &model.joints {
+        if let Some(m) = j.mimic {
+            let (d, k) = (model.v_offset(m.leader), m.multiplier);
+            let leader = &mut p[PER_JOINT * d..PER_JOINT * (d + 1)];
+            leader[0] += k * k * j.dynamics.armature;
+            leader[1] += k * k * j.dynamics.damping;
+            leader[2] += k.abs() * j.dynamics.friction;
+        }
+    }
+    p
 }
 
 /// Appends the joint-parameter columns to a torque regressor given as rows (`n` rows

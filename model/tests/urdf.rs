@@ -679,7 +679,7 @@ fn mimic_joints_follow_their_leader() {
             "prismatic",
             "a",
             "b",
-            r#"<mimic joint="ja" multiplier="-0.5" offset="0.2"/>"#,
+            r#"<mimic joint="ja" multiplier="-0.5" offset="0.2"/><dynamics damping="0.2" friction="0.3"/>"#,
         ),
         &joint(
             "jc",
@@ -720,6 +720,12 @@ fn mimic_joints_follow_their_leader() {
     assert_eq!(model.mimic_joint().map(|j| j.name.as_str()), Some("jb"));
     let body = model.multibody().unwrap();
     assert_eq!((body.nq(), body.nv(), body.mimics().len()), (1, 1, 3));
+    // The follower's friction acts on the leader's coordinate through k = −0.5:
+    // k² Fv and |k| Fc.
+    assert_eq!(
+        dyngen_model::joint_params::nominal_joint_params(&model),
+        [0.0, 0.25 * 0.2, 0.5 * 0.3, 0.0]
+    );
 }
 
 #[test]

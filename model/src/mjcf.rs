@@ -5,7 +5,7 @@
 //!
 //! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree
 //! inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia
-//! settotalmass meshdir assetdir strippath>` (MuJoCo's default angle unit is the
+//! settotalmass meshdir assetdir strippath fitaabb>` (MuJoCo's default angle unit is the
 //! degree), `<option gravity>` and its `<flag gravity="disable">` (no gravity),
 //! `<default>` classes (nested, `class` on joints, geoms, sites and meshes,
 //! `childclass` on bodies) for joint, geom, site and mesh attributes, `<asset><mesh>`
@@ -53,10 +53,9 @@
 //! (half sizes; with `fromto`, `size[0]` for x and y and half the length for z) or
 //! ellipsoid (semi-axes, `fromto` as the box), at its `pos` and orientation (or
 //! `fromto`'s middle, `z` along it), combined about their common centre of mass; or
-//! a mesh (below). Sdf, plane and hfield geoms that would give a body its inertia, a
-//! primitive geom naming a `mesh` (MuJoCo fits it to the mesh) and
-//! `shellinertia="true"` (which MuJoCo refuses on a mesh geom) are refused naming
-//! the geom and line. Then each body's
+//! a mesh (below), or a primitive fitted to a mesh (below). Sdf, plane and hfield
+//! geoms that would give a body its inertia and `shellinertia="true"` (which MuJoCo
+//! refuses on a mesh geom) are refused naming the geom and line. Then each body's
 //! mass is raised to `boundmass` and its principal moments to `boundinertia`
 //! (MuJoCo leaves a body without mass of its own with its inertial frame at the
 //! numbers of its `pos`, so the mass `boundmass` gives it sits there too); with
@@ -90,6 +89,22 @@
 //! - mass: the geom's `mass`, else `density` times the volume (area for a shell);
 //!   the inertia about the centre of mass through MuJoCo's eigen decomposition and
 //!   box of equal inertia; the geom's `pos` and orientation place the mesh frame.
+//!
+//! A box, sphere, capsule, cylinder or ellipsoid geom naming a `mesh` is fitted to
+//! it, as MuJoCo 4's compiler fits it (`mjCMesh::FitGeom`), its `size` ignored: from
+//! half sides `h` along the mesh's principal axes, those of its box of equal inertia
+//! (the default), or with `<compiler fitaabb="true">` those of its vertices'
+//! bounding box in that frame, a box or ellipsoid takes `h`; by default a sphere
+//! their mean, a cylinder the radius `r = (h0 + h1) / 2` and half length `h2`, a
+//! capsule that `r` and `max(0, h2 - r / 2)`; with `fitaabb` a sphere the largest,
+//! a cylinder `r = max(h0, h1)` and `h2`, a capsule that `r` and `h2 - r`; every size
+//! then times the geom's `fitscale` (default 1). The primitive sits in the mesh's
+//! principal frame (its origin at the bounding box's centre with `fitaabb`) placed
+//! by the geom's `pos` and orientation, and weighs its `mass` or `density` times its
+//! own volume. Refused naming the geom and line: another type naming a mesh, a
+//! `fromto` with a mesh, a `fitscale` that is not a positive number, and a fitted
+//! size that is not positive (MuJoCo refuses it too: a capsule fitted to a round
+//! mesh's bounding box has no length).
 //!
 //! Refused, each naming the `<mesh>`, its line and the file as written: a file that
 //! is missing, unreadable, of another format (`.msh` included), an OBJ without faces
@@ -478,6 +493,7 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
         meshdir: None,
         assetdir: None,
         strippath: false,
+        fit_aabb: false,
         meshes: HashMap::new(),
         mesh_masses: HashMap::new(),
     };
@@ -886,6 +902,10 @@ struct Reader<'t> {
     assetdir: Option<String>,
     /// `<compiler strippath>`: mesh files named without their folders.
     strippath: bool,
+    /// `<compiler fitaabb>`: a primitive geom naming a mesh is fitted to the mesh's
+    /// axis-aligned bounding box (in its principal frame) instead of its box of
+    /// equal inertia.
+    fit_aabb: bool,
     /// `<asset><mesh>` elements by name (their tags).
     meshes: HashMap<String, usize>,
     /// The mass properties of the meshes computed so far, or why they are refused.
@@ -1032,6 +1052,7 @@ impl<'t> Reader<'t> {
             ("alignfree", &mut self.alignfree),
             ("balanceinertia", &mut balance),
             ("strippath", &mut self.strippath),
+            ("fitaabb", &mut self.fit_aabb),
         ] {
             match t.attr(attr) {
                 None => {}
@@ -1120,17 +1141,17 @@ impl<'t> Reader<'t> {
             );
         }
         // Attributes known not to change the dynamics of what is read here.
-        const HARMLESS: [&str; 7] = [
+        const HARMLESS: [&str; 6] = [
             "texturedir",
             "discardvisual",
             "usethread",
             "fusestatic",
             "saveinertial",
-            "fitaabb",
             "coordinate",
         ];
-        const READ: [&str; 14] = [
+        const READ: [&str; 15] = [
             "strippath",
+            "fitaabb",
             "meshdir",
             "assetdir",
             "exactmeshinertia",
@@ -1937,14 +1958,16 @@ impl<'t> Reader<'t> {
                 );
                 continue;
             }
-            if kind != "mesh" && kind != "sdf" && attr(self, "mesh").is_some() {
+            // A primitive naming a mesh is fitted to it (its size and frame from the mesh's).
+            let fitted = kind != "mesh" && kind != "sdf" && attr(self, "mesh").is_some();
+            if fitted && !matches!(kind.as_str(), "box" | "sphere" | "capsule" | "cylinder" | "ellipsoid") {
                 self.error(
                     el.clone(),
                     t.line,
-                    ErrorKind::NotSupported(format!(
-                        "{geom} of type `{kind}` names a mesh, which MuJoCo fits the {kind} to (its size and \
-                         placement from the mesh's inertia); that fitting is not done here: give the geom \
-                         type=\"mesh\", or its own size and no mesh"
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} of type `{kind}` names a mesh, but MuJoCo fits only a box, sphere, capsule, \
+                         cylinder or ellipsoid to a mesh (and refuses the model otherwise): give it one of those \
+                         types, or type=\"mesh\", or no mesh"
                     )),
                 );
                 continue;
@@ -1984,7 +2007,7 @@ impl<'t> Reader<'t> {
                 }
                 None => [0.0; 3],
             };
-            let (pos, rotation) = self.geom_frame(t, &class, "geom", el);
+            let (mut pos, mut rotation) = self.geom_frame(t, &class, "geom", el);
             if fromto && !matches!(kind.as_str(), "capsule" | "cylinder" | "box" | "ellipsoid") {
                 self.error(
                     el.clone(),
@@ -1994,6 +2017,42 @@ impl<'t> Reader<'t> {
                     )),
                 );
                 continue;
+            }
+            let mut sizes = sizes;
+            if fitted {
+                if fromto {
+                    self.error(
+                        el.clone(),
+                        t.line,
+                        ErrorKind::InvalidMjcf(format!(
+                            "{geom} names a mesh and has a `fromto`, which MuJoCo refuses (\"fromto cannot be used \
+                             with mesh geom\"): place it with `pos` and an orientation"
+                        )),
+                    );
+                    continue;
+                }
+                let fitscale = match attr(self, "fitscale") {
+                    None => 1.0,
+                    Some(v) => match v.trim().parse::<f64>() {
+                        Ok(x) if x.is_finite() && x > 0.0 => x,
+                        _ => {
+                            self.error(
+                                el.clone(),
+                                t.line,
+                                ErrorKind::InvalidMjcf(format!(
+                                    "{geom} has fitscale=\"{v}\", which is not a positive number (it scales the \
+                                     size fitted to the mesh, and MuJoCo refuses a size that is not positive)"
+                                )),
+                            );
+                            continue;
+                        }
+                    },
+                };
+                let Some((s, placed)) = self.fitted_geom(t, &class, el, &geom, &kind, fitscale, (pos, rotation)) else {
+                    continue;
+                };
+                sizes = s;
+                (pos, rotation) = placed;
             }
             if kind == "mesh" {
                 if let Some(part) = self.mesh_geom(t, &class, el, &geom, mass, density, (pos, rotation)) {
@@ -2074,6 +2133,24 @@ impl<'t> Reader<'t> {
                     continue;
                 }
             };
+            if fitted && needed.iter().any(|&x| x.is_nan() || x <= 0.0) {
+                let mesh = attr(self, "mesh").unwrap_or_default();
+                let how = if self.fit_aabb {
+                    "its bounding box (<compiler fitaabb=\"true\">)"
+                } else {
+                    "its box of equal inertia"
+                };
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} fitted to mesh `{mesh}` from {how} gets size=\"{}\", which MuJoCo refuses (a \
+                         {kind}'s sizes must be positive); give it another type, or type=\"mesh\"",
+                        needed.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+                    )),
+                );
+                continue;
+            }
             if needed.iter().any(|&x| x.is_nan() || x <= 0.0) {
                 self.error(
                     el.clone(),
@@ -2122,12 +2199,29 @@ impl<'t> Reader<'t> {
         density: f64,
         (pos, rotation): (Vec3, Mat3),
     ) -> Option<Inertial> {
+        let (_, props) = self.geom_mesh(t, class, el, geom, "mesh")?;
+        let m = mass.unwrap_or(density * props.measure);
+        let local = Inertial {
+            mass: m,
+            com: props.com,
+            inertia: from_principal(props.moments.map(|x| m * x), &props.axes),
+        };
+        Some(local.transformed(&Placement {
+            rotation,
+            translation: pos,
+        }))
+    }
+
+    /// The name and mass properties of the mesh a geom of type `kind` names, or
+    /// `None` with the error (on the geom's line when it names no mesh or an
+    /// unknown one, on the `<mesh>`'s when the mesh cannot be had).
+    fn geom_mesh(&mut self, t: &Tag, class: &str, el: &Element, geom: &str, kind: &str) -> Option<(String, MeshMass)> {
         let Some(name) = self.class_attr(t, class, "geom", "mesh") else {
             self.error(
                 el.clone(),
                 t.line,
                 ErrorKind::InvalidMjcf(format!(
-                    "{geom} of type `mesh` names no mesh; give it mesh=\"NAME\" of a <mesh> in <asset>"
+                    "{geom} of type `{kind}` names no mesh; give it mesh=\"NAME\" of a <mesh> in <asset>"
                 )),
             );
             return None;
@@ -2151,26 +2245,75 @@ impl<'t> Reader<'t> {
                 r
             }
         };
-        let props = match props {
-            Ok(p) => p,
+        match props {
+            Ok(p) => Some((name, p)),
             Err(e) => {
                 // Once, however many geoms use the mesh.
                 if !self.errors.contains(&e) {
                     self.errors.push(e);
                 }
-                return None;
+                None
             }
+        }
+    }
+
+    /// A primitive geom naming a mesh, fitted to it as MuJoCo 4's compiler fits it
+    /// (`mjCMesh::FitGeom`, called from `mjCGeom::Compile`), from half sides `h` in
+    /// the mesh's principal frame: its box of equal inertia, or with `<compiler
+    /// fitaabb="true">` its vertices' bounding box. By default a box or ellipsoid
+    /// takes `h`, a sphere their mean, a cylinder `(h0 + h1) / 2` and `h2`, a capsule
+    /// that radius `r` and `max(0, h2 - r / 2)`; with `fitaabb` a sphere takes the
+    /// largest, a cylinder `max(h0, h1)` and `h2`, a capsule that radius and
+    /// `h2 - r`. All times `fitscale`. Its frame is the mesh's principal frame (its
+    /// origin moved to the bounding box's centre with `fitaabb`) placed by the
+    /// geom's `pos` and orientation. The sizes and the placement in the body frame,
+    /// or `None` with the error.
+    #[allow(clippy::too_many_arguments)]
+    fn fitted_geom(
+        &mut self,
+        t: &Tag,
+        class: &str,
+        el: &Element,
+        geom: &str,
+        kind: &str,
+        fitscale: f64,
+        (pos, rotation): (Vec3, Mat3),
+    ) -> Option<([f64; 3], (Vec3, Mat3))> {
+        let (_, props) = self.geom_mesh(t, class, el, geom, kind)?;
+        let b = props.box_half;
+        let a = &props.aabb;
+        let (sizes, center) = if self.fit_aabb {
+            let h = a.half;
+            let s = match kind {
+                "sphere" => [h[0].max(h[1]).max(h[2]), 0.0, 0.0],
+                "capsule" => {
+                    let r = h[0].max(h[1]);
+                    [r, h[2] - r, 0.0]
+                }
+                "cylinder" => [h[0].max(h[1]), h[2], 0.0],
+                _ => h,
+            };
+            (s, a.center)
+        } else {
+            let s = match kind {
+                "sphere" => [(b[0] + b[1] + b[2]) / 3.0, 0.0, 0.0],
+                "capsule" => {
+                    let r = (b[0] + b[1]) / 2.0;
+                    [r, (b[2] - r / 2.0).max(0.0), 0.0]
+                }
+                "cylinder" => [(b[0] + b[1]) / 2.0, b[2], 0.0],
+                _ => b,
+            };
+            (s, [0.0; 3])
         };
-        let m = mass.unwrap_or(density * props.measure);
-        let local = Inertial {
-            mass: m,
-            com: props.com,
-            inertia: from_principal(props.moments.map(|x| m * x), &props.axes),
-        };
-        Some(local.transformed(&Placement {
-            rotation,
-            translation: pos,
-        }))
+        // The mesh frame in the geom frame: MuJoCo's mjuu_frameaccum of the geom's
+        // frame with the mesh's (its position moved to the box's centre).
+        let offset = math::add(&props.com, &math::mat_vec(&props.axes, &center));
+        let placed = (
+            math::add(&pos, &math::mat_vec(&rotation, &offset)),
+            math::mat_mul(&rotation, &props.axes),
+        );
+        Some((sizes.map(|x| x * fitscale), placed))
     }
 
     /// Notes a `<mesh>` of `<asset>` under its name (its file's name without folder

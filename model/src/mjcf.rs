@@ -82,10 +82,17 @@
 //!   triangles);
 //! - `inertia="legacy"` (MuJoCo's default): tetrahedra from the triangles'
 //!   area-weighted centroid, their volumes taken positive (too much volume for a
-//!   non-convex mesh); `"convex"`: the same over the convex hull (`maxhullvert`,
-//!   which stops MuJoCo's hull early, is refused); `"exact"`: signed tetrahedra, for
-//!   a closed mesh with outward triangles; `"shell"`: unit surface density on the
-//!   triangles;
+//!   non-convex mesh); `"convex"`: the same over the convex hull; `"exact"`: signed
+//!   tetrahedra, for a closed mesh with outward triangles; `"shell"`: unit surface
+//!   density on the triangles;
+//! - `maxhullvert` (-1, no limit, or above 3, as MuJoCo requires it): MuJoCo stops
+//!   its hull (qhull's `TA` option) once it has that many vertices, at points
+//!   chosen by qhull's order of additions, which is not reproduced here. So where
+//!   the hull gives the inertia (`"convex"`, or a mesh of vertices alone, whose
+//!   faces are the hull's) and the mesh has more distinct vertices than the limit,
+//!   the mesh is refused; a limit at least that count stops nothing and is read;
+//!   elsewhere the hull is MuJoCo's collision shape only and the limit changes no
+//!   inertia;
 //! - mass: the geom's `mass`, else `density` times the volume (area for a shell);
 //!   the inertia about the centre of mass through MuJoCo's eigen decomposition and
 //!   box of equal inertia; the geom's `pos` and orientation place the mesh frame.
@@ -2412,25 +2419,47 @@ impl<'t> Reader<'t> {
             (Some(f), None) => self.mesh_file(f, flip).map_err(invalid)?,
             (None, Some(v)) => inline_mesh(v, t.attr("face")).map_err(invalid)?,
         };
-        if mode == MeshInertia::Convex {
-            if let Some(v) = self
-                .class_attr(t, &class, "mesh", "maxhullvert")
-                .filter(|v| v.trim() != "-1")
-            {
-                return Err(mesh_error(
-                    t.line,
-                    ErrorKind::NotSupported(format!(
-                        "{what}: maxhullvert=\"{v}\" stops MuJoCo's hull (qhull) early, which changes the inertia \
-                         of inertia=\"convex\" in a way not reproduced here; remove maxhullvert, or choose another \
-                         inertia"
-                    )),
-                ));
-            }
-        }
         // No faces (vertices alone), or the convex mode: the convex hull, built on
         // the vertices as read (as MuJoCo builds it) and turned outwards after the
         // transformation (a mirroring scale turns it inside out).
         let needs_hull = mode == MeshInertia::Convex || mesh.faces.is_empty();
+        if let Some(v) = self.class_attr(t, &class, "mesh", "maxhullvert") {
+            let limit = match v.trim().parse::<i64>() {
+                Ok(n) if n == -1 || n > 3 => n,
+                _ => {
+                    return Err(invalid(format!(
+                        "maxhullvert=\"{v}\" is neither -1 (no limit, the default) nor an integer above 3 \
+                         (MuJoCo refuses it)"
+                    )))
+                }
+            };
+            // MuJoCo passes the limit to qhull as `TA(maxhullvert - 4)`: qhull stops
+            // adding points once the hull has `maxhullvert` vertices, which it can
+            // only reach, with a point still outside, when the mesh has more
+            // distinct vertices than that.
+            let distinct = mjcf_mesh::distinct_points(&mesh.vertices);
+            if needs_hull && limit != -1 && (limit as u64) < distinct as u64 {
+                let role = if mode == MeshInertia::Convex {
+                    "the hull gives its inertia (inertia=\"convex\")"
+                } else {
+                    "the hull's triangles are its faces (it has no `face`)"
+                };
+                return Err(mesh_error(
+                    t.line,
+                    ErrorKind::NotSupported(format!(
+                        "{what}: maxhullvert=\"{v}\" stops MuJoCo's convex hull (qhull, option TA{}) at {limit} of \
+                         its {distinct} distinct vertices, at the points qhull's own order of additions picks, which \
+                         is not reproduced here, and {role}; remove maxhullvert or make it at least {distinct}{}",
+                        limit - 4,
+                        if mesh.faces.is_empty() {
+                            ""
+                        } else {
+                            ", or choose another inertia"
+                        }
+                    )),
+                ));
+            }
+        }
         let mut hull = if needs_hull {
             Some(mjcf_mesh::convex_hull(&mesh.vertices).map_err(invalid)?)
         } else {

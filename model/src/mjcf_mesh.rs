@@ -399,6 +399,15 @@ pub(crate) fn convex_hull(vertices: &[Vec3]) -> Result<Vec<[usize; 3]>, String> 
     Ok(faces.into_iter().filter(|f| f.alive).map(|f| f.v).collect())
 }
 
+/// How many distinct points `vertices` holds (`-0` and `0` the same coordinate).
+pub(crate) fn distinct_points(vertices: &[Vec3]) -> usize {
+    vertices
+        .iter()
+        .map(|v| v.map(|x| (x + 0.0).to_bits()))
+        .collect::<std::collections::HashSet<_>>()
+        .len()
+}
+
 /// The mesh moved by `refpos`, turned by `refquat` (`w x y z`, normalised) and scaled
 /// by `scale`, in MuJoCo's order (`mjCMesh::ApplyTransformations`).
 pub(crate) fn transform(mesh: &mut TriMesh, refpos: Vec3, refquat: [f64; 4], scale: Vec3) {

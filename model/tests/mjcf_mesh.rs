@@ -353,6 +353,70 @@ fn mesh_attributes_and_geoms_are_checked() {
 }
 
 #[test]
+fn maxhullvert_is_refused_only_where_it_stops_the_hull_that_gives_the_inertia() {
+    // A wedge with its faces (6 distinct vertices) and the same vertices alone.
+    let vertex = "0 0 0  0.2 0 0  0 0.3 0  0 0 0.1  0.2 0 0.1  0 0.3 0.1";
+    let face = "0 2 1  3 4 5  0 1 4  0 4 3  1 2 5  1 5 4  2 0 3  2 3 5";
+    let mass = |mesh: &str| parse_mjcf(&model_with(mesh)).map(|m| m.bodies[0].inertial.mass);
+    let full = mass(&format!("<mesh name=\"m\" vertex=\"{vertex}\"/>")).unwrap();
+    // 0.2 x 0.3 / 2 x 0.1 at 1000 kg/m³, in single precision.
+    assert!((full - 3.0).abs() < 1e-6, "{full}");
+    // The convex mode stopped early.
+    let e = mass(&format!(
+        "<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" inertia=\"convex\" maxhullvert=\"5\"/>"
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains(
+            "line 3: robot: <mesh name=\"m\">: maxhullvert=\"5\" stops MuJoCo's convex hull (qhull, option TA1) at 5 \
+             of its 6 distinct vertices, at the points qhull's own order of additions picks, which is not reproduced \
+             here, and the hull gives its inertia (inertia=\"convex\"); remove maxhullvert or make it at least 6, \
+             or choose another inertia"
+        ),
+        "{e}"
+    );
+    // Vertices alone: the hull's triangles are the faces, in every mode (MuJoCo's
+    // default, legacy, here).
+    let e = mass(&format!("<mesh name=\"m\" vertex=\"{vertex}\" maxhullvert=\"4\"/>"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(
+            "line 3: robot: <mesh name=\"m\">: maxhullvert=\"4\" stops MuJoCo's convex hull (qhull, option TA0) at 4 \
+             of its 6 distinct vertices, at the points qhull's own order of additions picks, which is not reproduced \
+             here, and the hull's triangles are its faces (it has no `face`); remove maxhullvert or make it at least 6"
+        ),
+        "{e}"
+    );
+    // A limit qhull cannot reach, and a hull that gives no inertia (legacy with
+    // faces: MuJoCo's hull is then for collisions only), change nothing.
+    for mesh in [
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" maxhullvert=\"6\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" inertia=\"convex\" maxhullvert=\"40\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" maxhullvert=\"4\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" inertia=\"convex\" maxhullvert=\"-1\"/>"),
+    ] {
+        assert!((mass(&mesh).unwrap() - full).abs() < 1e-9, "{mesh}");
+    }
+    // MuJoCo's own bounds.
+    for v in ["3", "0", "-2", "8.5", "many", ""] {
+        let e = mass(&format!(
+            "<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" maxhullvert=\"{v}\"/>"
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains(&format!(
+                "line 3: robot: <mesh name=\"m\">: maxhullvert=\"{v}\" is neither -1 (no limit, the default) nor an \
+                 integer above 3 (MuJoCo refuses it)"
+            )),
+            "{e}"
+        );
+    }
+}
+
+#[test]
 fn a_mesh_in_an_included_file_is_read_from_the_models_folder() {
     let dir = TempDir::new("mesh-include");
     dir.write("meshes/box.stl", box_stl());

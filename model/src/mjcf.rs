@@ -5,7 +5,7 @@
 //!
 //! Read: `<mujoco model>`, `<compiler angle eulerseq autolimits alignfree
 //! inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia
-//! settotalmass meshdir assetdir strippath>` (MuJoCo's default angle unit is the
+//! settotalmass meshdir assetdir strippath fitaabb>` (MuJoCo's default angle unit is the
 //! degree), `<option gravity>` and its `<flag gravity="disable">` (no gravity),
 //! `<default>` classes (nested, `class` on joints, geoms, sites and meshes,
 //! `childclass` on bodies) for joint, geom, site and mesh attributes, `<asset><mesh>`
@@ -53,10 +53,9 @@
 //! (half sizes; with `fromto`, `size[0]` for x and y and half the length for z) or
 //! ellipsoid (semi-axes, `fromto` as the box), at its `pos` and orientation (or
 //! `fromto`'s middle, `z` along it), combined about their common centre of mass; or
-//! a mesh (below). Sdf, plane and hfield geoms that would give a body its inertia, a
-//! primitive geom naming a `mesh` (MuJoCo fits it to the mesh) and
-//! `shellinertia="true"` (which MuJoCo refuses on a mesh geom) are refused naming
-//! the geom and line. Then each body's
+//! a mesh (below), or a primitive fitted to a mesh (below). Sdf, plane and hfield
+//! geoms that would give a body its inertia and `shellinertia="true"` (which MuJoCo
+//! refuses on a mesh geom) are refused naming the geom and line. Then each body's
 //! mass is raised to `boundmass` and its principal moments to `boundinertia`
 //! (MuJoCo leaves a body without mass of its own with its inertial frame at the
 //! numbers of its `pos`, so the mass `boundmass` gives it sits there too); with
@@ -83,13 +82,36 @@
 //!   triangles);
 //! - `inertia="legacy"` (MuJoCo's default): tetrahedra from the triangles'
 //!   area-weighted centroid, their volumes taken positive (too much volume for a
-//!   non-convex mesh); `"convex"`: the same over the convex hull (`maxhullvert`,
-//!   which stops MuJoCo's hull early, is refused); `"exact"`: signed tetrahedra, for
-//!   a closed mesh with outward triangles; `"shell"`: unit surface density on the
-//!   triangles;
+//!   non-convex mesh); `"convex"`: the same over the convex hull; `"exact"`: signed
+//!   tetrahedra, for a closed mesh with outward triangles; `"shell"`: unit surface
+//!   density on the triangles;
+//! - `maxhullvert` (-1, no limit, or above 3, as MuJoCo requires it): MuJoCo stops
+//!   its hull (qhull's `TA` option) once it has that many vertices, at points
+//!   chosen by qhull's order of additions, which is not reproduced here. So where
+//!   the hull gives the inertia (`"convex"`, or a mesh of vertices alone, whose
+//!   faces are the hull's) and the mesh has more distinct vertices than the limit,
+//!   the mesh is refused; a limit at least that count stops nothing and is read;
+//!   elsewhere the hull is MuJoCo's collision shape only and the limit changes no
+//!   inertia;
 //! - mass: the geom's `mass`, else `density` times the volume (area for a shell);
 //!   the inertia about the centre of mass through MuJoCo's eigen decomposition and
 //!   box of equal inertia; the geom's `pos` and orientation place the mesh frame.
+//!
+//! A box, sphere, capsule, cylinder or ellipsoid geom naming a `mesh` is fitted to
+//! it, as MuJoCo 4's compiler fits it (`mjCMesh::FitGeom`), its `size` ignored: from
+//! half sides `h` along the mesh's principal axes, those of its box of equal inertia
+//! (the default), or with `<compiler fitaabb="true">` those of its vertices'
+//! bounding box in that frame, a box or ellipsoid takes `h`; by default a sphere
+//! their mean, a cylinder the radius `r = (h0 + h1) / 2` and half length `h2`, a
+//! capsule that `r` and `max(0, h2 - r / 2)`; with `fitaabb` a sphere the largest,
+//! a cylinder `r = max(h0, h1)` and `h2`, a capsule that `r` and `h2 - r`; every size
+//! then times the geom's `fitscale` (default 1). The primitive sits in the mesh's
+//! principal frame (its origin at the bounding box's centre with `fitaabb`) placed
+//! by the geom's `pos` and orientation, and weighs its `mass` or `density` times its
+//! own volume. Refused naming the geom and line: another type naming a mesh, a
+//! `fromto` with a mesh, a `fitscale` that is not a positive number, and a fitted
+//! size that is not positive (MuJoCo refuses it too: a capsule fitted to a round
+//! mesh's bounding box has no length).
 //!
 //! Refused, each naming the `<mesh>`, its line and the file as written: a file that
 //! is missing, unreadable, of another format (`.msh` included), an OBJ without faces
@@ -478,6 +500,7 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
         meshdir: None,
         assetdir: None,
         strippath: false,
+        fit_aabb: false,
         meshes: HashMap::new(),
         mesh_masses: HashMap::new(),
     };
@@ -887,6 +910,10 @@ struct Reader<'t> {
     assetdir: Option<String>,
     /// `<compiler strippath>`: mesh files named without their folders.
     strippath: bool,
+    /// `<compiler fitaabb>`: a primitive geom naming a mesh is fitted to the mesh's
+    /// axis-aligned bounding box (in its principal frame) instead of its box of
+    /// equal inertia.
+    fit_aabb: bool,
     /// `<asset><mesh>` elements by name (their tags).
     meshes: HashMap<String, usize>,
     /// The mass properties of the meshes computed so far, or why they are refused.
@@ -1033,6 +1060,7 @@ impl<'t> Reader<'t> {
             ("alignfree", &mut self.alignfree),
             ("balanceinertia", &mut balance),
             ("strippath", &mut self.strippath),
+            ("fitaabb", &mut self.fit_aabb),
         ] {
             match t.attr(attr) {
                 None => {}
@@ -1121,17 +1149,17 @@ impl<'t> Reader<'t> {
             );
         }
         // Attributes known not to change the dynamics of what is read here.
-        const HARMLESS: [&str; 7] = [
+        const HARMLESS: [&str; 6] = [
             "texturedir",
             "discardvisual",
             "usethread",
             "fusestatic",
             "saveinertial",
-            "fitaabb",
             "coordinate",
         ];
-        const READ: [&str; 14] = [
+        const READ: [&str; 15] = [
             "strippath",
+            "fitaabb",
             "meshdir",
             "assetdir",
             "exactmeshinertia",
@@ -1938,14 +1966,16 @@ impl<'t> Reader<'t> {
                 );
                 continue;
             }
-            if kind != "mesh" && kind != "sdf" && attr(self, "mesh").is_some() {
+            // A primitive naming a mesh is fitted to it (its size and frame from the mesh's).
+            let fitted = kind != "mesh" && kind != "sdf" && attr(self, "mesh").is_some();
+            if fitted && !matches!(kind.as_str(), "box" | "sphere" | "capsule" | "cylinder" | "ellipsoid") {
                 self.error(
                     el.clone(),
                     t.line,
-                    ErrorKind::NotSupported(format!(
-                        "{geom} of type `{kind}` names a mesh, which MuJoCo fits the {kind} to (its size and \
-                         placement from the mesh's inertia); that fitting is not done here: give the geom \
-                         type=\"mesh\", or its own size and no mesh"
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} of type `{kind}` names a mesh, but MuJoCo fits only a box, sphere, capsule, \
+                         cylinder or ellipsoid to a mesh (and refuses the model otherwise): give it one of those \
+                         types, or type=\"mesh\", or no mesh"
                     )),
                 );
                 continue;
@@ -1985,7 +2015,7 @@ impl<'t> Reader<'t> {
                 }
                 None => [0.0; 3],
             };
-            let (pos, rotation) = self.geom_frame(t, &class, "geom", el);
+            let (mut pos, mut rotation) = self.geom_frame(t, &class, "geom", el);
             if fromto && !matches!(kind.as_str(), "capsule" | "cylinder" | "box" | "ellipsoid") {
                 self.error(
                     el.clone(),
@@ -1995,6 +2025,42 @@ impl<'t> Reader<'t> {
                     )),
                 );
                 continue;
+            }
+            let mut sizes = sizes;
+            if fitted {
+                if fromto {
+                    self.error(
+                        el.clone(),
+                        t.line,
+                        ErrorKind::InvalidMjcf(format!(
+                            "{geom} names a mesh and has a `fromto`, which MuJoCo refuses (\"fromto cannot be used \
+                             with mesh geom\"): place it with `pos` and an orientation"
+                        )),
+                    );
+                    continue;
+                }
+                let fitscale = match attr(self, "fitscale") {
+                    None => 1.0,
+                    Some(v) => match v.trim().parse::<f64>() {
+                        Ok(x) if x.is_finite() && x > 0.0 => x,
+                        _ => {
+                            self.error(
+                                el.clone(),
+                                t.line,
+                                ErrorKind::InvalidMjcf(format!(
+                                    "{geom} has fitscale=\"{v}\", which is not a positive number (it scales the \
+                                     size fitted to the mesh, and MuJoCo refuses a size that is not positive)"
+                                )),
+                            );
+                            continue;
+                        }
+                    },
+                };
+                let Some((s, placed)) = self.fitted_geom(t, &class, el, &geom, &kind, fitscale, (pos, rotation)) else {
+                    continue;
+                };
+                sizes = s;
+                (pos, rotation) = placed;
             }
             if kind == "mesh" {
                 if let Some(part) = self.mesh_geom(t, &class, el, &geom, mass, density, (pos, rotation)) {
@@ -2075,6 +2141,24 @@ impl<'t> Reader<'t> {
                     continue;
                 }
             };
+            if fitted && needed.iter().any(|&x| x.is_nan() || x <= 0.0) {
+                let mesh = attr(self, "mesh").unwrap_or_default();
+                let how = if self.fit_aabb {
+                    "its bounding box (<compiler fitaabb=\"true\">)"
+                } else {
+                    "its box of equal inertia"
+                };
+                self.error(
+                    el.clone(),
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{geom} fitted to mesh `{mesh}` from {how} gets size=\"{}\", which MuJoCo refuses (a \
+                         {kind}'s sizes must be positive); give it another type, or type=\"mesh\"",
+                        needed.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+                    )),
+                );
+                continue;
+            }
             if needed.iter().any(|&x| x.is_nan() || x <= 0.0) {
                 self.error(
                     el.clone(),
@@ -2123,12 +2207,29 @@ impl<'t> Reader<'t> {
         density: f64,
         (pos, rotation): (Vec3, Mat3),
     ) -> Option<Inertial> {
+        let (_, props) = self.geom_mesh(t, class, el, geom, "mesh")?;
+        let m = mass.unwrap_or(density * props.measure);
+        let local = Inertial {
+            mass: m,
+            com: props.com,
+            inertia: from_principal(props.moments.map(|x| m * x), &props.axes),
+        };
+        Some(local.transformed(&Placement {
+            rotation,
+            translation: pos,
+        }))
+    }
+
+    /// The name and mass properties of the mesh a geom of type `kind` names, or
+    /// `None` with the error (on the geom's line when it names no mesh or an
+    /// unknown one, on the `<mesh>`'s when the mesh cannot be had).
+    fn geom_mesh(&mut self, t: &Tag, class: &str, el: &Element, geom: &str, kind: &str) -> Option<(String, MeshMass)> {
         let Some(name) = self.class_attr(t, class, "geom", "mesh") else {
             self.error(
                 el.clone(),
                 t.line,
                 ErrorKind::InvalidMjcf(format!(
-                    "{geom} of type `mesh` names no mesh; give it mesh=\"NAME\" of a <mesh> in <asset>"
+                    "{geom} of type `{kind}` names no mesh; give it mesh=\"NAME\" of a <mesh> in <asset>"
                 )),
             );
             return None;
@@ -2152,26 +2253,75 @@ impl<'t> Reader<'t> {
                 r
             }
         };
-        let props = match props {
-            Ok(p) => p,
+        match props {
+            Ok(p) => Some((name, p)),
             Err(e) => {
                 // Once, however many geoms use the mesh.
                 if !self.errors.contains(&e) {
                     self.errors.push(e);
                 }
-                return None;
+                None
             }
+        }
+    }
+
+    /// A primitive geom naming a mesh, fitted to it as MuJoCo 4's compiler fits it
+    /// (`mjCMesh::FitGeom`, called from `mjCGeom::Compile`), from half sides `h` in
+    /// the mesh's principal frame: its box of equal inertia, or with `<compiler
+    /// fitaabb="true">` its vertices' bounding box. By default a box or ellipsoid
+    /// takes `h`, a sphere their mean, a cylinder `(h0 + h1) / 2` and `h2`, a capsule
+    /// that radius `r` and `max(0, h2 - r / 2)`; with `fitaabb` a sphere takes the
+    /// largest, a cylinder `max(h0, h1)` and `h2`, a capsule that radius and
+    /// `h2 - r`. All times `fitscale`. Its frame is the mesh's principal frame (its
+    /// origin moved to the bounding box's centre with `fitaabb`) placed by the
+    /// geom's `pos` and orientation. The sizes and the placement in the body frame,
+    /// or `None` with the error.
+    #[allow(clippy::too_many_arguments)]
+    fn fitted_geom(
+        &mut self,
+        t: &Tag,
+        class: &str,
+        el: &Element,
+        geom: &str,
+        kind: &str,
+        fitscale: f64,
+        (pos, rotation): (Vec3, Mat3),
+    ) -> Option<([f64; 3], (Vec3, Mat3))> {
+        let (_, props) = self.geom_mesh(t, class, el, geom, kind)?;
+        let b = props.box_half;
+        let a = &props.aabb;
+        let (sizes, center) = if self.fit_aabb {
+            let h = a.half;
+            let s = match kind {
+                "sphere" => [h[0].max(h[1]).max(h[2]), 0.0, 0.0],
+                "capsule" => {
+                    let r = h[0].max(h[1]);
+                    [r, h[2] - r, 0.0]
+                }
+                "cylinder" => [h[0].max(h[1]), h[2], 0.0],
+                _ => h,
+            };
+            (s, a.center)
+        } else {
+            let s = match kind {
+                "sphere" => [(b[0] + b[1] + b[2]) / 3.0, 0.0, 0.0],
+                "capsule" => {
+                    let r = (b[0] + b[1]) / 2.0;
+                    [r, (b[2] - r / 2.0).max(0.0), 0.0]
+                }
+                "cylinder" => [(b[0] + b[1]) / 2.0, b[2], 0.0],
+                _ => b,
+            };
+            (s, [0.0; 3])
         };
-        let m = mass.unwrap_or(density * props.measure);
-        let local = Inertial {
-            mass: m,
-            com: props.com,
-            inertia: from_principal(props.moments.map(|x| m * x), &props.axes),
-        };
-        Some(local.transformed(&Placement {
-            rotation,
-            translation: pos,
-        }))
+        // The mesh frame in the geom frame: MuJoCo's mjuu_frameaccum of the geom's
+        // frame with the mesh's (its position moved to the box's centre).
+        let offset = math::add(&props.com, &math::mat_vec(&props.axes, &center));
+        let placed = (
+            math::add(&pos, &math::mat_vec(&rotation, &offset)),
+            math::mat_mul(&rotation, &props.axes),
+        );
+        Some((sizes.map(|x| x * fitscale), placed))
     }
 
     /// Notes a `<mesh>` of `<asset>` under its name (its file's name without folder
@@ -2270,25 +2420,47 @@ impl<'t> Reader<'t> {
             (Some(f), None) => self.mesh_file(f, flip).map_err(invalid)?,
             (None, Some(v)) => inline_mesh(v, t.attr("face")).map_err(invalid)?,
         };
-        if mode == MeshInertia::Convex {
-            if let Some(v) = self
-                .class_attr(t, &class, "mesh", "maxhullvert")
-                .filter(|v| v.trim() != "-1")
-            {
-                return Err(mesh_error(
-                    t.line,
-                    ErrorKind::NotSupported(format!(
-                        "{what}: maxhullvert=\"{v}\" stops MuJoCo's hull (qhull) early, which changes the inertia \
-                         of inertia=\"convex\" in a way not reproduced here; remove maxhullvert, or choose another \
-                         inertia"
-                    )),
-                ));
-            }
-        }
         // No faces (vertices alone), or the convex mode: the convex hull, built on
         // the vertices as read (as MuJoCo builds it) and turned outwards after the
         // transformation (a mirroring scale turns it inside out).
         let needs_hull = mode == MeshInertia::Convex || mesh.faces.is_empty();
+        if let Some(v) = self.class_attr(t, &class, "mesh", "maxhullvert") {
+            let limit = match v.trim().parse::<i64>() {
+                Ok(n) if n == -1 || n > 3 => n,
+                _ => {
+                    return Err(invalid(format!(
+                        "maxhullvert=\"{v}\" is neither -1 (no limit, the default) nor an integer above 3 \
+                         (MuJoCo refuses it)"
+                    )))
+                }
+            };
+            // MuJoCo passes the limit to qhull as `TA(maxhullvert - 4)`: qhull stops
+            // adding points once the hull has `maxhullvert` vertices, which it can
+            // only reach, with a point still outside, when the mesh has more
+            // distinct vertices than that.
+            let distinct = mjcf_mesh::distinct_points(&mesh.vertices);
+            if needs_hull && limit != -1 && (limit as u64) < distinct as u64 {
+                let role = if mode == MeshInertia::Convex {
+                    "the hull gives its inertia (inertia=\"convex\")"
+                } else {
+                    "the hull's triangles are its faces (it has no `face`)"
+                };
+                return Err(mesh_error(
+                    t.line,
+                    ErrorKind::NotSupported(format!(
+                        "{what}: maxhullvert=\"{v}\" stops MuJoCo's convex hull (qhull, option TA{}) at {limit} of \
+                         its {distinct} distinct vertices, at the points qhull's own order of additions picks, which \
+                         is not reproduced here, and {role}; remove maxhullvert or make it at least {distinct}{}",
+                        limit - 4,
+                        if mesh.faces.is_empty() {
+                            ""
+                        } else {
+                            ", or choose another inertia"
+                        }
+                    )),
+                ));
+            }
+        }
         let mut hull = if needs_hull {
             Some(mjcf_mesh::convex_hull(&mesh.vertices).map_err(invalid)?)
         } else {

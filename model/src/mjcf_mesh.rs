@@ -64,6 +64,42 @@ pub(crate) struct MeshMass {
     pub com: Vec3,
     pub axes: Mat3,
     pub moments: Vec3,
+    /// The half sides of the box of equal inertia (MuJoCo's `boxsz`), along `axes`.
+    pub box_half: Vec3,
+    /// What a primitive fitted to the mesh's bounding box takes from it.
+    pub aabb: AabbFit,
+}
+
+/// The axis-aligned bounding box of a mesh's vertices in its principal frame (the
+/// frame of `com` and `axes`, MuJoCo's `aamm`), which a primitive geom is fitted to
+/// with `<compiler fitaabb="true">`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct AabbFit {
+    /// The box's centre, in the principal frame.
+    pub center: Vec3,
+    /// The box's half sides.
+    pub half: Vec3,
+}
+
+impl AabbFit {
+    /// The box of `vertices` (mesh frame) moved to the principal frame of centre
+    /// `com` and axes `axes`, as MuJoCo moves them (`v' = axesᵀ (v - com)`).
+    fn of(vertices: &[Vec3], com: &Vec3, axes: &Mat3) -> AabbFit {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for v in vertices {
+            let v = math::mat_vec(&math::transpose(axes), &math::sub(v, com));
+            for i in 0..3 {
+                lo[i] = lo[i].min(v[i]);
+                hi[i] = hi[i].max(v[i]);
+            }
+        }
+        let center = [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0);
+        AabbFit {
+            center,
+            half: [0, 1, 2].map(|i| hi[i] - center[i]),
+        }
+    }
 }
 
 /// Reads a binary STL file as MuJoCo does (`mjCMesh::LoadSTL`): 1 to 200,000
@@ -363,6 +399,15 @@ pub(crate) fn convex_hull(vertices: &[Vec3]) -> Result<Vec<[usize; 3]>, String> 
     Ok(faces.into_iter().filter(|f| f.alive).map(|f| f.v).collect())
 }
 
+/// How many distinct points `vertices` holds (`-0` and `0` the same coordinate).
+pub(crate) fn distinct_points(vertices: &[Vec3]) -> usize {
+    vertices
+        .iter()
+        .map(|v| v.map(|x| (x + 0.0).to_bits()))
+        .collect::<std::collections::HashSet<_>>()
+        .len()
+}
+
 /// The mesh moved by `refpos`, turned by `refquat` (`w x y z`, normalised) and scaled
 /// by `scale`, in MuJoCo's order (`mjCMesh::ApplyTransformations`).
 pub(crate) fn transform(mesh: &mut TriMesh, refpos: Vec3, refquat: [f64; 4], scale: Vec3) {
@@ -511,6 +556,8 @@ pub(crate) fn mass_properties(
         com,
         axes,
         moments,
+        box_half: b,
+        aabb: AabbFit::of(v, &com, &axes),
     })
 }
 

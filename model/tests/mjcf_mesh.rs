@@ -75,6 +75,75 @@ fn each_inertia_mode_gives_mujocos_inertia() {
 }
 
 #[test]
+fn primitives_fitted_to_a_meshs_box_of_equal_inertia_give_mujocos_inertia() {
+    let (inertial, dynamics) = against_mujoco("fit_inertia");
+    assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
+}
+
+#[test]
+fn primitives_fitted_to_a_meshs_bounding_box_give_mujocos_inertia() {
+    let (inertial, dynamics) = against_mujoco("fit_aabb");
+    assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
+}
+
+#[test]
+fn geoms_that_cannot_be_fitted_to_a_mesh_are_refused() {
+    let dir = TempDir::new("mesh-fit");
+    // A regular octahedron: with fitaabb a capsule fitted to it has no straight part.
+    let octahedron = "<mesh name=\"m\" vertex=\"1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1\"/>";
+    let refused = |geom: &str, compiler: &str, line: usize, says: &str| {
+        let text = model_with(octahedron)
+            .replace("<geom type=\"mesh\" mesh=\"m\"/>", geom)
+            .replace("<asset>", &format!("{compiler}<asset>"));
+        let top = dir.write("top.xml", text.as_bytes());
+        load_error(&top, line, says);
+    };
+    refused(
+        "<geom type=\"plane\" mesh=\"m\"/>",
+        "",
+        7,
+        "<geom type=\"plane\"> of type `plane` names a mesh, but MuJoCo fits only a box, sphere, capsule, \
+         cylinder or ellipsoid to a mesh",
+    );
+    refused(
+        "<geom name=\"g\" type=\"capsule\" mesh=\"m\" fromto=\"0 0 0 0 0 1\"/>",
+        "",
+        7,
+        "geom `g` names a mesh and has a `fromto`, which MuJoCo refuses",
+    );
+    for scale in ["0", "-1", "big"] {
+        refused(
+            &format!("<geom name=\"g\" type=\"box\" mesh=\"m\" fitscale=\"{scale}\"/>"),
+            "",
+            7,
+            &format!("geom `g` has fitscale=\"{scale}\", which is not a positive number"),
+        );
+    }
+    refused(
+        "<geom name=\"g\" type=\"capsule\" mesh=\"m\"/>",
+        "<compiler fitaabb=\"true\"/>",
+        7,
+        "geom `g` fitted to mesh `m` from its bounding box (<compiler fitaabb=\"true\">) gets size=\"1 0\", which \
+         MuJoCo refuses (a capsule's sizes must be positive)",
+    );
+    refused(
+        "<geom name=\"g\" type=\"sphere\" mesh=\"n\"/>",
+        "",
+        7,
+        "geom `g` names mesh `n`, which no <mesh> in <asset> defines",
+    );
+    refused(
+        "<geom type=\"box\" mesh=\"m\"/>",
+        "<compiler fitaabb=\"yes\"/>",
+        2,
+        "<compiler fitaabb=\"yes\"> is neither `true` nor `false`",
+    );
+    // Without fitaabb the same capsule fits the box of equal inertia.
+    let text = model_with(octahedron).replace("type=\"mesh\"", "type=\"capsule\"");
+    assert!(parse_mjcf(&text).is_ok());
+}
+
+#[test]
 fn scaled_moved_weighed_and_inline_meshes_give_mujocos_inertia() {
     let (inertial, dynamics) = against_mujoco("scaled");
     assert!(inertial < 1e-10 && dynamics < 1e-10, "{inertial:e} {dynamics:e}");
@@ -264,9 +333,10 @@ fn mesh_attributes_and_geoms_are_checked() {
         7,
         "which MuJoCo refuses on a mesh geom; give the <mesh> inertia=\"shell\" instead",
     );
+    // A box naming the box mesh is fitted to it: the same box (48 kg).
     let text = model_with("<mesh name=\"m\" file=\"box.stl\"/>").replace("type=\"mesh\"", "type=\"box\"");
     let top = dir.write("top.xml", text.as_bytes());
-    load_error(&top, 7, "of type `box` names a mesh, which MuJoCo fits the box to");
+    assert!((load_mjcf(&top).unwrap().bodies[0].inertial.mass - 48.0).abs() < 1e-4);
     // Text without its file has no folder for the mesh file; an inline mesh needs none.
     let e = parse_mjcf(&model_with("<mesh name=\"m\" file=\"box.stl\"/>")).unwrap_err();
     assert!(
@@ -280,6 +350,70 @@ fn mesh_attributes_and_geoms_are_checked() {
     let i = &model.bodies[0].inertial;
     assert!((i.mass - 1000.0 / 6.0).abs() < 1e-9, "{}", i.mass);
     assert!(i.com.iter().all(|c| (c - 0.25).abs() < 1e-12), "{:?}", i.com);
+}
+
+#[test]
+fn maxhullvert_is_refused_only_where_it_stops_the_hull_that_gives_the_inertia() {
+    // A wedge with its faces (6 distinct vertices) and the same vertices alone.
+    let vertex = "0 0 0  0.2 0 0  0 0.3 0  0 0 0.1  0.2 0 0.1  0 0.3 0.1";
+    let face = "0 2 1  3 4 5  0 1 4  0 4 3  1 2 5  1 5 4  2 0 3  2 3 5";
+    let mass = |mesh: &str| parse_mjcf(&model_with(mesh)).map(|m| m.bodies[0].inertial.mass);
+    let full = mass(&format!("<mesh name=\"m\" vertex=\"{vertex}\"/>")).unwrap();
+    // 0.2 x 0.3 / 2 x 0.1 at 1000 kg/m³, in single precision.
+    assert!((full - 3.0).abs() < 1e-6, "{full}");
+    // The convex mode stopped early.
+    let e = mass(&format!(
+        "<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" inertia=\"convex\" maxhullvert=\"5\"/>"
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains(
+            "line 3: robot: <mesh name=\"m\">: maxhullvert=\"5\" stops MuJoCo's convex hull (qhull, option TA1) at 5 \
+             of its 6 distinct vertices, at the points qhull's own order of additions picks, which is not reproduced \
+             here, and the hull gives its inertia (inertia=\"convex\"); remove maxhullvert or make it at least 6, \
+             or choose another inertia"
+        ),
+        "{e}"
+    );
+    // Vertices alone: the hull's triangles are the faces, in every mode (MuJoCo's
+    // default, legacy, here).
+    let e = mass(&format!("<mesh name=\"m\" vertex=\"{vertex}\" maxhullvert=\"4\"/>"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(
+            "line 3: robot: <mesh name=\"m\">: maxhullvert=\"4\" stops MuJoCo's convex hull (qhull, option TA0) at 4 \
+             of its 6 distinct vertices, at the points qhull's own order of additions picks, which is not reproduced \
+             here, and the hull's triangles are its faces (it has no `face`); remove maxhullvert or make it at least 6"
+        ),
+        "{e}"
+    );
+    // A limit qhull cannot reach, and a hull that gives no inertia (legacy with
+    // faces: MuJoCo's hull is then for collisions only), change nothing.
+    for mesh in [
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" maxhullvert=\"6\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" inertia=\"convex\" maxhullvert=\"40\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" maxhullvert=\"4\"/>"),
+        format!("<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" inertia=\"convex\" maxhullvert=\"-1\"/>"),
+    ] {
+        assert!((mass(&mesh).unwrap() - full).abs() < 1e-9, "{mesh}");
+    }
+    // MuJoCo's own bounds.
+    for v in ["3", "0", "-2", "8.5", "many", ""] {
+        let e = mass(&format!(
+            "<mesh name=\"m\" vertex=\"{vertex}\" face=\"{face}\" maxhullvert=\"{v}\"/>"
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains(&format!(
+                "line 3: robot: <mesh name=\"m\">: maxhullvert=\"{v}\" is neither -1 (no limit, the default) nor an \
+                 integer above 3 (MuJoCo refuses it)"
+            )),
+            "{e}"
+        );
+    }
 }
 
 #[test]

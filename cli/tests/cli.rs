@@ -451,3 +451,34 @@ fn free_flyer_in_info_and_generate_and_refused_at_run_time() {
         "--time-budget -1: out of range; expected a number with 0 < x ≤ 1000000 (s)",
     );
 }
+
+#[test]
+fn mimic_robots_load_where_supported_and_are_refused_by_name_elsewhere() {
+    let gripper =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/mimic/arm_linkage_gripper.urdf");
+    // info: the coordinates, each follower's rule, the base parameters; no generated code.
+    let o = run!("info", gripper);
+    assert_ok(&o);
+    let out = stdout(&o);
+    assert!(
+        out.contains("7 velocity coordinates; joints that follow another (<mimic>)"),
+        "{out}"
+    );
+    assert!(out.contains("left_inner_finger_joint = -1 · finger_joint + 0"), "{out}");
+    assert!(out.contains("Base parameters (standard)"), "{out}");
+    assert!(
+        out.contains("Generated functions: none (joint `left_inner_finger_joint` follows joint `finger_joint`"),
+        "{out}"
+    );
+    // generate and identify refuse it, saying what to do instead.
+    let why =
+        "follows joint `finger_joint` (<mimic>), which generated code does not support yet; load the robot at run time";
+    assert_error(&run!("generate", gripper, "--name", "Gripper"), why);
+    let dir = temp_dir("cli", "mimic");
+    let data = dir.join("data.csv");
+    std::fs::write(&data, "t,q1\n0,0\n").unwrap();
+    assert_error(
+        &run!("identify", gripper, data),
+        "joint `left_inner_finger_joint` follows another (<mimic>); this command runs on robots whose joints each have a coordinate of their own",
+    );
+}

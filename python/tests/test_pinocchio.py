@@ -302,3 +302,37 @@ def test_centroidal(pair, states):
         their_dot = pin.computeCentroidalMapTimeVariation(pair.model, pair.data, pq, pv)
         check(pair, "centroidal_map_time_variation", ours, ag)
         check(pair, "centroidal_map_time_variation dAg v", ours_dot @ v, their_dot @ pv)
+
+
+def test_mimic_joints_match_pinocchio():
+    """A gripper whose knuckles and fingers follow one driven joint (`<mimic>`), as
+    Pinocchio loads it with `mimic=True`: one coordinate for the leader and its
+    followers."""
+    from conftest import ROOT
+
+    path = ROOT / "tests" / "fixtures" / "mimic" / "arm_linkage_gripper.urdf"
+    robot = load(path, False)
+    model = pin.buildModelFromUrdf(str(path), mimic=True)
+    data = model.createData()
+    assert (robot.nq, robot.nv) == (model.nq, model.nv) == (7, 7)
+    rng = np.random.default_rng(26)
+    q, v, a = (rng.uniform(-1, 1, (STATES, 7)) for _ in range(3))
+    tau = robot.rnea(q, v, a)
+    m = robot.crba(q)
+    for k in range(STATES):
+        want = pin.rnea(model, data, q[k], v[k], a[k])
+        record("arm_linkage_gripper", "rnea (mimic)", error(tau[k], want))
+        assert error(tau[k], want) < TOLERANCE
+        want = pin.crba(model, data, q[k])
+        want = np.triu(want) + np.triu(want, 1).T
+        record("arm_linkage_gripper", "crba (mimic)", error(m[k], want))
+        assert error(m[k], want) < TOLERANCE
+        fid = model.getFrameId("tcp")
+        pin.computeJointJacobians(model, data, q[k])
+        pin.updateFramePlacements(model, data)
+        want = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        got = robot.frame_jacobian(q[k], "tcp")
+        record("arm_linkage_gripper", "frame_jacobian (mimic)", error(got, want))
+        assert error(got, want) < TOLERANCE
+    # Forward dynamics (which Pinocchio does not run on mimic joints) undoes rnea.
+    assert error(robot.aba(q, v, tau), a) < 1e-10

@@ -46,7 +46,7 @@ pub use joints::{Coulomb, InvalidEpsilon, JointParams, JOINT_PARAMS_PER_JOINT};
 pub use nalgebra;
 pub use robot::{
     BodyRegressor, Centroidal, Derivatives, ForwardDynamics, Frames, InverseDynamics, JointDynamics, Kinematics,
-    MassMatrix, OpCount, Pose, Regressors, Robot, RobotDescription, Wrench,
+    MassMatrix, NotFinite, OpCount, Pose, Regressors, Robot, RobotDescription, Wrench,
 };
 pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
 pub use scalar::{OrderedScalar, Scalar};

@@ -165,8 +165,76 @@ pub trait MassMatrix: RobotDescription {
 /// Forward dynamics by the articulated-body algorithm. Selected by `forward_dynamics`.
 pub trait ForwardDynamics: RobotDescription {
     /// Forward dynamics by the articulated-body algorithm: `a = M⁻¹ (tau − h)`.
+    /// Where `M` is singular (a coordinate along which nothing with mass moves: the
+    /// model's load warned about it, naming the joint) or an input is not finite, `a`
+    /// is not finite; [`ForwardDynamics::try_aba`] says so instead.
     fn aba<S: Scalar>(q: &[S], v: &[S], tau: &[S], params: &[S], a: &mut [S]);
+
+    /// [`ForwardDynamics::aba`] with its result checked: an error naming the first
+    /// coordinate of `a` that is not finite, and why, rather than a value.
+    ///
+    /// ```
+    /// # #[cfg(feature = "macros")] {
+    /// use dyngen::prelude::*;
+    /// dyngen::robot! {
+    ///     name: Pendulum,
+    ///     incidence: [[-1], [1]],
+    ///     joints: [revolute(y)],
+    ///     body_joint_vectors: { (0, 1): [0.0, 0.0, 0.0], (1, 1): [0.0, 0.0, 0.5] },
+    ///     bodies: { 1: principal(mass: 2.0, moments: [0.01, 0.01, 0.001]) },
+    /// }
+    /// let mut a = [0.0];
+    /// // A pendulum of no mass: nothing resists the joint torque.
+    /// let e = Pendulum::try_aba(&[0.3], &[0.0], &[1.0], &[0.0; 10], &mut a).unwrap_err();
+    /// assert_eq!(e.coordinate, 0);
+    /// assert!(e.to_string().contains("the mass matrix is singular"));
+    /// // With its mass, the same torque gives an acceleration.
+    /// Pendulum::try_aba(&[0.3], &[0.0], &[1.0], Pendulum::nominal_params(), &mut a).unwrap();
+    /// # }
+    /// ```
+    fn try_aba(q: &[f64], v: &[f64], tau: &[f64], params: &[f64], a: &mut [f64]) -> Result<(), NotFinite> {
+        Self::aba(q, v, tau, params, a);
+        match a.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(coordinate) => Err(NotFinite {
+                coordinate,
+                inputs_finite: [q, v, tau, params].iter().all(|x| x.iter().all(|x| x.is_finite())),
+            }),
+        }
+    }
 }
+
+/// Why [`ForwardDynamics::try_aba`] has no acceleration to give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NotFinite {
+    /// The first coordinate (0-based) whose acceleration is not finite.
+    pub coordinate: usize,
+    /// Whether every input was finite (then `M` is singular at this state).
+    pub inputs_finite: bool,
+}
+
+impl core::fmt::Display for NotFinite {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let k = self.coordinate;
+        if self.inputs_finite {
+            write!(
+                f,
+                "forward dynamics has no finite acceleration for coordinate {k}: the mass matrix is singular at this \
+                 state (nothing with mass moves along some coordinate; the model's load warned which joint). Give the \
+                 bodies mass, or lock that joint"
+            )
+        } else {
+            write!(
+                f,
+                "forward dynamics has no finite acceleration for coordinate {k}: an input (q, v, tau or params) is \
+                 not finite"
+            )
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for NotFinite {}
 
 /// Every body's pose. Selected by `kinematics`.
 pub trait Kinematics: RobotDescription {

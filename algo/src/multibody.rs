@@ -47,6 +47,39 @@ pub struct Mimic {
     pub offset: f64,
 }
 
+/// Why a joint in a cycle of followers cannot be resolved ([`Mimic::resolve`]).
+pub const MIMIC_CYCLE: &str = "its leaders, followed in turn, run in a cycle; one joint of the cycle must lead";
+
+impl Mimic {
+    /// Each of `mimics` (at most one per joint, of a tree of `joints` joints) with its
+    /// leader followed to one that follows no other: `q = k (k' q_leader + b') + b`.
+    ///
+    /// # Errors
+    /// A joint whose leaders, followed in turn, run in a cycle.
+    pub fn resolve(mimics: &[Mimic], joints: usize) -> Result<Vec<Mimic>, usize> {
+        let leader_of = |j: usize| mimics.iter().find(|m| m.joint == j);
+        mimics
+            .iter()
+            .map(|m| {
+                let (mut r, mut steps) = (*m, 0);
+                while let Some(next) = leader_of(r.leader) {
+                    steps += 1;
+                    if steps > joints {
+                        return Err(m.joint);
+                    }
+                    r = Mimic {
+                        joint: r.joint,
+                        leader: next.leader,
+                        multiplier: r.multiplier * next.multiplier,
+                        offset: r.multiplier * next.offset + r.offset,
+                    };
+                }
+                Ok(r)
+            })
+            .collect()
+    }
+}
+
 /// How the coordinates of the tree (every joint its own, as [`Joint::q_offset`] and
 /// [`Joint::v_offset`] lay them out) follow the multibody's: `q_tree = E q + b`,
 /// `v_tree = E v`. The algorithms run on the tree, and reduce what they return with
@@ -223,24 +256,10 @@ impl Multibody {
                 return bad(m.joint, "it follows two leaders");
             }
         }
-        // Each follower resolved to an independent leader: q = a q_leader + b.
-        let mut resolved: Vec<Mimic> = Vec::with_capacity(mimics.len());
-        for m in mimics {
-            let (mut r, mut steps) = (*m, 0);
-            while let Some(next) = follows[r.leader] {
-                steps += 1;
-                if steps > n {
-                    return bad(m.joint, "its leaders form a cycle");
-                }
-                r = Mimic {
-                    joint: r.joint,
-                    leader: next.leader,
-                    multiplier: r.multiplier * next.multiplier,
-                    offset: r.multiplier * next.offset + r.offset,
-                };
-            }
-            resolved.push(r);
-        }
+        let resolved = Mimic::resolve(mimics, n).map_err(|joint| TreeError::BadMimic {
+            joint,
+            reason: MIMIC_CYCLE,
+        })?;
         let (mut nq, mut nv) = (0, 0);
         let mut offsets = Vec::with_capacity(n);
         for (k, j) in self.joints.iter().enumerate() {

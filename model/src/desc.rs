@@ -623,32 +623,35 @@ impl Description {
                 });
             }
         }
-        // A follower of a follower follows the first leader: q = a (a' q + b') + b.
-        let given: Vec<Option<Mimic>> = model.joints.iter().map(|j| j.mimic).collect();
-        let n = given.len();
-        for (f, first) in given.iter().enumerate() {
-            let Some(mut m) = *first else { continue };
-            let mut steps = 0;
-            while let Some(next) = given[m.leader - 1] {
-                steps += 1;
-                if steps > n {
-                    let name = model.joints[f].name.clone();
-                    errors.push(ModelError {
-                        line: self.mimics.iter().find(|d| d.joint == name).and_then(|d| d.line),
-                        element: Element::Joint(name),
-                        kind: ErrorKind::BadMimic(
-                            "its leaders, followed in turn, run in a cycle; one joint of the cycle must lead".into(),
-                        ),
+        // A follower of a follower follows the first leader.
+        let given: Vec<dyngen_algo::Mimic> = (model.joints.iter().enumerate())
+            .filter_map(|(k, j)| {
+                j.mimic.map(|m| dyngen_algo::Mimic {
+                    joint: k,
+                    leader: m.leader - 1,
+                    multiplier: m.multiplier,
+                    offset: m.offset,
+                })
+            })
+            .collect();
+        match dyngen_algo::Mimic::resolve(&given, model.joints.len()) {
+            Ok(resolved) => {
+                for r in resolved {
+                    model.joints[r.joint].mimic = Some(Mimic {
+                        leader: r.leader + 1,
+                        multiplier: r.multiplier,
+                        offset: r.offset,
                     });
-                    break;
                 }
-                m = Mimic {
-                    leader: next.leader,
-                    multiplier: m.multiplier * next.multiplier,
-                    offset: m.multiplier * next.offset + m.offset,
-                };
             }
-            model.joints[f].mimic = Some(m);
+            Err(joint) => {
+                let name = model.joints[joint].name.clone();
+                errors.push(ModelError {
+                    line: self.mimics.iter().find(|d| d.joint == name).and_then(|d| d.line),
+                    element: Element::Joint(name),
+                    kind: ErrorKind::BadMimic(dyngen_algo::MIMIC_CYCLE.into()),
+                });
+            }
         }
         errors
     }

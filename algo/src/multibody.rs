@@ -124,7 +124,8 @@ pub struct JointSpec {
 pub enum TreeError {
     /// Joint `joint` (0-based) names a parent that is not an earlier body.
     ParentNotBefore { joint: usize, parent: usize },
-    /// A free flyer anywhere but as the first joint, on the base.
+    /// A free flyer on a moving body (free flyers hang from the base: a floating base
+    /// first, then any free bodies beside it).
     FreeFlyerNotAtRoot { joint: usize },
     /// A [`Mimic`] that cannot be: a joint or a leader out of range or without
     /// exactly one coordinate, a joint following itself, following twice, or a cycle.
@@ -142,7 +143,7 @@ impl core::fmt::Display for TreeError {
             TreeError::FreeFlyerNotAtRoot { joint } => {
                 write!(
                     f,
-                    "joint {joint} is a free flyer; only the first joint, on the base, may be one"
+                    "joint {joint} is a free flyer on a moving body; a free flyer hangs from the base (parent 0)"
                 )
             }
             TreeError::BadMimic { joint, reason } => write!(f, "mimic joint {joint}: {reason}"),
@@ -162,7 +163,7 @@ impl Multibody {
                     parent: s.parent,
                 });
             }
-            if s.kind == JointType::FreeFlyer && (i != 0 || s.parent != 0) {
+            if s.kind == JointType::FreeFlyer && s.parent != 0 {
                 return Err(TreeError::FreeFlyerNotAtRoot { joint: i });
             }
             let joint = Joint {

@@ -50,9 +50,23 @@ pub enum RobotSource {
     Urdf(syn::LitStr),
 }
 
-/// Why generated code cannot be made for `model`, if it cannot: a joint that follows
-/// another (`<mimic>`), which only the run-time algorithms take so far.
+/// Why generated code cannot be made for `model`, if it cannot: a free flyer beyond
+/// the floating base (a second free body), or a joint that follows another
+/// (`<mimic>`), which only the run-time algorithms take so far.
 pub fn unsupported(model: &Model) -> Option<String> {
+    if let Some(j) = model
+        .joints
+        .iter()
+        .skip(1)
+        .find(|j| j.kind == dyngen_model::JointKind::FreeFlyer)
+    {
+        return Some(format!(
+            "joint `{}` is a second free flyer (a free body beside the floating base); generated code takes one \
+             floating base, as joint 1. Load the robot at run time instead (`dyngen_model::load_robot`, then \
+             `Model::multibody` and `dyngen_algo`'s algorithms, or `dyngen.load` in Python)",
+            j.name
+        ));
+    }
     let j = model.mimic_joint()?;
     let leader = j.mimic.map_or("", |m| model.joints[m.leader - 1].name.as_str());
     Some(format!(

@@ -448,7 +448,7 @@ impl Description {
             let origin = placement.compose(&j.origin);
             let (body, placement) = match &j.kind {
                 DeclaredJointType::Moving(kind) => {
-                    if *kind == JointKind::FreeFlyer && (owner != 0 || !model.joints.is_empty()) {
+                    if *kind == JointKind::FreeFlyer && owner != 0 {
                         errors.push(err(
                             Element::Joint(j.name.clone()),
                             j.line,

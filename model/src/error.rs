@@ -184,9 +184,9 @@ impl fmt::Display for ErrorKind {
             ),
             ErrorKind::FreeFlyerNotAtRoot => write!(
                 f,
-                "a floating (free-flyer) joint must join the root link to the robot's first body, and only one may \
-                 (in MJCF: a free joint only in a body directly in <worldbody>, before any other moving joint); make \
-                 it the joint of the root link's child, or leave the base fixed"
+                "a floating (free-flyer) joint must join the root link to a body (in MJCF: a free joint only in a \
+                 body directly in <worldbody>); make it the joint of a child of the root link, or leave the body \
+                 fixed"
             ),
             ErrorKind::ZeroAxis => write!(f, "the axis is zero; give a nonzero direction such as `0 0 1`"),
             ErrorKind::NonFiniteValue(what) => write!(f, "{what} is not a finite number"),

@@ -142,8 +142,9 @@
 //!   (the same rotation, of the body in the joint frame). Velocities are the same in
 //!   both: the angular velocity in the body frame.
 //! - `free` and `<freejoint>`: [`JointKind::FreeFlyer`], only in a body directly in
-//!   `<worldbody>` (MuJoCo refuses a free joint deeper down; a floating base is also
-//!   the first moving joint, see [`ErrorKind::FreeFlyerNotAtRoot`]). MuJoCo ignores a
+//!   `<worldbody>` (MuJoCo refuses a free joint deeper down, see
+//!   [`ErrorKind::FreeFlyerNotAtRoot`]); several free bodies load, each a free flyer
+//!   on the world, as in MuJoCo (a robot and a ball, say). MuJoCo ignores a
 //!   free joint's `pos`, `axis` and `range`, and so does this reader; `<freejoint>`
 //!   has no damping or friction. The free flyer's origin is the world frame: the
 //!   body's own `pos` and orientation are only MuJoCo's initial `qpos0`, and `q` is

@@ -1057,7 +1057,7 @@ fn a_free_joint_below_the_top_level_is_refused() {
         &text,
         Element::Joint("f".into()),
         5,
-        "(in MJCF: a free joint only in a body directly in <worldbody>, before any other moving joint)",
+        "(in MJCF: a free joint only in a body directly in <worldbody>)",
     );
     // With the file name and line, as for URDF.
     let dir = std::env::temp_dir().join(format!("dyngen-mjcf-free-{}", std::process::id()));
@@ -1070,18 +1070,17 @@ fn a_free_joint_below_the_top_level_is_refused() {
     assert_eq!(message.lines().count(), 1, "{message}");
     assert!(
         message.ends_with(
-            "nested.xml:5: joint `f`: a floating (free-flyer) joint must join the root link to the robot's first \
-             body, and only one may (in MJCF: a free joint only in a body directly in <worldbody>, before any \
-             other moving joint); make it the joint of the root link's child, or leave the base fixed"
+            "nested.xml:5: joint `f`: a floating (free-flyer) joint must join the root link to a body (in MJCF: a \
+             free joint only in a body directly in <worldbody>); make it the joint of a child of the root link, or \
+             leave the body fixed"
         ),
         "{message}"
     );
 }
 
 #[test]
-fn a_free_body_after_a_moving_one_is_refused() {
-    // Top level, as MuJoCo allows, but not the first moving joint: the model floats
-    // one base at most, on joint 1.
+fn a_free_body_after_a_moving_one_loads_as_a_second_free_flyer() {
+    // Top level, as MuJoCo allows: a free flyer on the world beside the hinged body.
     let text = mjcf(&[
         "<body name=\"a\">",
         "<joint name=\"j\"/>",
@@ -1092,9 +1091,17 @@ fn a_free_body_after_a_moving_one_is_refused() {
         "<freejoint name=\"f\"/>",
         "</body>",
     ]);
-    let kind = only_error(&text, Element::Joint("f".into()), 9, "must join the root link");
-    assert_eq!(kind, ErrorKind::FreeFlyerNotAtRoot);
-    // Nor with the free flyer of `LoadOptions::free_flyer` on top.
+    let model = dyngen_model::parse_mjcf(&text).unwrap();
+    assert_eq!((model.nq(), model.nv()), (8, 7));
+    assert_eq!(
+        (model.joints[1].kind, model.joints[1].parent),
+        (JointKind::FreeFlyer, 0)
+    );
+    // Not a floating base (joint 1 is the hinge), and no generated code for it.
+    assert!(!model.is_floating());
+    let body = model.multibody().unwrap();
+    assert_eq!((body.nq(), body.nv()), (8, 7));
+    // But not on the free flyer of `LoadOptions::free_flyer`: the body floats already.
     let options = dyngen_model::LoadOptions {
         free_flyer: true,
         ..Default::default()

@@ -55,12 +55,6 @@ const REFUSED: &[(&str, &str)] = &[
     ),
     // A template the Python task fills in: no body moves.
     ("lqr", "has no moving joint"),
-    // A second free body (the ball) besides the quadruped's own: two trees, and a
-    // model has one floating base.
-    (
-        "quadruped",
-        "line 200: joint `ball_root`: a floating (free-flyer) joint must join the root link to the robot's first body",
-    ),
 ];
 
 /// The dyngen coordinates of MuJoCo's `qpos` and `qvel`, and the matrix `T⁻¹`

@@ -74,20 +74,11 @@ pub fn com_jacobian<S: Real>(
     check_len("jacobian", jacobian, 3 * multibody.nv());
     crate::forward_kinematics(multibody, workspace, q);
     let com = total_com(multibody, workspace, params);
-    let nv = multibody.tree_nv();
-    let tree = |w: &mut Workspace<S>, _: &[S], _: &[S], _: &[S], out: &mut [S]| com_jacobian_tree(multibody, w, out);
     match multibody.reduction {
-        Some(_) => on_tree(
-            multibody,
-            workspace,
-            None,
-            None,
-            None,
-            3 * nv,
-            Reduce::Cols(3),
-            jacobian,
-            tree,
-        ),
+        Some(_) => {
+            let tree = |w: &mut Workspace<S>, _: [&[S]; 3], out: &mut [S]| com_jacobian_tree(multibody, w, out);
+            on_tree(multibody, workspace, [None; 3], Reduce::Cols(3, jacobian), tree)
+        }
         None => com_jacobian_tree(multibody, workspace, jacobian),
     }
     com
@@ -121,21 +112,11 @@ pub fn centroidal_map<S: Real>(
     check_len("a_g", a_g, 6 * multibody.nv());
     crate::forward_kinematics(multibody, workspace, q);
     let com = total_com(multibody, workspace, params);
-    let nv = multibody.tree_nv();
-    let tree =
-        |w: &mut Workspace<S>, _: &[S], _: &[S], _: &[S], out: &mut [S]| centroidal_map_tree(multibody, w, com, out);
     match multibody.reduction {
-        Some(_) => on_tree(
-            multibody,
-            workspace,
-            None,
-            None,
-            None,
-            6 * nv,
-            Reduce::Cols(6),
-            a_g,
-            tree,
-        ),
+        Some(_) => {
+            let tree = |w: &mut Workspace<S>, _: [&[S]; 3], out: &mut [S]| centroidal_map_tree(multibody, w, com, out);
+            on_tree(multibody, workspace, [None; 3], Reduce::Cols(6, a_g), tree)
+        }
         None => centroidal_map_tree(multibody, workspace, com, a_g),
     }
     com

@@ -17,20 +17,8 @@ use crate::Real;
 pub fn crba<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], params: &[S], m: &mut [S]) {
     if multibody.reduction.is_some() {
         check_len("m", m, multibody.nv() * multibody.nv());
-        let tree =
-            |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], out: &mut [S]| crba_tree(multibody, w, q, params, out);
-        let nv = multibody.tree_nv();
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            None,
-            None,
-            nv * nv,
-            Reduce::Both,
-            m,
-            tree,
-        );
+        let tree = |w: &mut Workspace<S>, [q, _, _]: [&[S]; 3], out: &mut [S]| crba_tree(multibody, w, q, params, out);
+        return on_tree(multibody, workspace, [Some(q), None, None], Reduce::Both(m), tree);
     }
     crba_tree(multibody, workspace, q, params, m);
 }

@@ -92,20 +92,10 @@ pub fn compute_frame_jacobian<S: Real>(
     jacobian: &mut [S],
 ) {
     if multibody.reduction.is_some() {
-        let tree = |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], _: &mut [S]| {
+        let tree = |w: &mut Workspace<S>, [q, _, _]: [&[S]; 3], _: &mut [S]| {
             compute_frame_jacobian_tree(multibody, w, q, body, frame, reference, jacobian)
         };
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            None,
-            None,
-            0,
-            Reduce::None,
-            &mut [],
-            tree,
-        );
+        return on_tree(multibody, workspace, [Some(q), None, None], Reduce::None, tree);
     }
     compute_frame_jacobian_tree(multibody, workspace, q, body, frame, reference, jacobian);
 }

@@ -29,19 +29,8 @@ pub(crate) fn placements<S: Real>(multibody: &Multibody, workspace: &mut Workspa
 /// `forwardKinematics(model, data, q)` (`data.liMi`, `data.oMi`).
 pub fn forward_kinematics<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S]) {
     if multibody.reduction.is_some() {
-        let tree =
-            |w: &mut Workspace<S>, q: &[S], _: &[S], _: &[S], _: &mut [S]| forward_kinematics_tree(multibody, w, q);
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            None,
-            None,
-            0,
-            Reduce::None,
-            &mut [],
-            tree,
-        );
+        let tree = |w: &mut Workspace<S>, [q, _, _]: [&[S]; 3], _: &mut [S]| forward_kinematics_tree(multibody, w, q);
+        return on_tree(multibody, workspace, [Some(q), None, None], Reduce::None, tree);
     }
     forward_kinematics_tree(multibody, workspace, q);
 }
@@ -72,19 +61,8 @@ fn forward_kinematics_tree<S: Real>(multibody: &Multibody, workspace: &mut Works
 /// If a slice's length does not match the multibody.
 pub fn body_motions<S: Real>(multibody: &Multibody, workspace: &mut Workspace<S>, q: &[S], v: &[S], a: &[S]) {
     if multibody.reduction.is_some() {
-        let tree =
-            |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], _: &mut [S]| body_motions_tree(multibody, w, q, v, a);
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            Some(v),
-            Some(a),
-            0,
-            Reduce::None,
-            &mut [],
-            tree,
-        );
+        let tree = |w: &mut Workspace<S>, [q, v, a]: [&[S]; 3], _: &mut [S]| body_motions_tree(multibody, w, q, v, a);
+        return on_tree(multibody, workspace, [Some(q), Some(v), Some(a)], Reduce::None, tree);
     }
     body_motions_tree(multibody, workspace, q, v, a);
 }

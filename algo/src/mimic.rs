@@ -113,57 +113,57 @@ impl Reduction {
     }
 }
 
-/// How a result along the tree's coordinates becomes the multibody's.
-#[derive(Clone, Copy)]
-pub(crate) enum Reduce {
+/// How a result along the tree's coordinates becomes the multibody's, written into
+/// the slice it holds.
+pub(crate) enum Reduce<'a, S> {
     /// Nothing to reduce (the result is not along the coordinates).
     None,
     /// `Eᵀ x`, `x` having this many columns.
-    Rows(usize),
+    Rows(usize, &'a mut [S]),
     /// `x E`, `x` having this many rows.
-    Cols(usize),
+    Cols(usize, &'a mut [S]),
     /// `Eᵀ x E`.
-    Both,
+    Both(&'a mut [S]),
 }
 
-/// Runs `tree` (an algorithm on the tree's coordinates) on `q`, `v`, `a` expanded
-/// (those given), with room for a result of `out_len` along the tree's coordinates,
-/// and reduces that result into `out` as `reduce` says.
-#[allow(clippy::too_many_arguments)]
+/// Runs `tree` (an algorithm on the tree's coordinates) on `[q, v, a]` expanded
+/// (those given: the others hold what they last held, for `tree` to leave unread),
+/// with room for its result along the tree's coordinates, which it then reduces as
+/// `reduce` says.
 pub(crate) fn on_tree<S: Real, R>(
     multibody: &Multibody,
     workspace: &mut Workspace<S>,
-    q: Option<&[S]>,
-    v: Option<&[S]>,
-    a: Option<&[S]>,
-    out_len: usize,
-    reduce: Reduce,
-    out: &mut [S],
-    tree: impl FnOnce(&mut Workspace<S>, &[S], &[S], &[S], &mut [S]) -> R,
+    inputs: [Option<&[S]>; 3],
+    reduce: Reduce<'_, S>,
+    tree: impl FnOnce(&mut Workspace<S>, [&[S]; 3], &mut [S]) -> R,
 ) -> R {
     let r = multibody.reduction.as_deref().expect("a multibody with mimic joints");
     let c = workspace.context;
     let mut b = core::mem::take(&mut workspace.mimic);
+    let [q, v, a] = inputs;
     if let Some(q) = q {
         check_len("q", q, r.nq);
         r.expand_q(c, q, &mut b.q);
     }
-    if let Some(v) = v {
-        check_len("v", v, r.nv);
-        r.expand_v(c, v, &mut b.v);
+    for (name, x, buffer) in [("v", v, &mut b.v), ("a", a, &mut b.a)] {
+        if let Some(x) = x {
+            check_len(name, x, r.nv);
+            r.expand_v(c, x, buffer);
+        }
     }
-    if let Some(a) = a {
-        check_len("a", a, r.nv);
-        r.expand_v(c, a, &mut b.a);
-    }
-    let result = tree(workspace, &b.q, &b.v, &b.a, &mut b.out[..out_len]);
+    let (tree_nv, nv) = (r.v.len(), r.nv);
+    let out_len = match &reduce {
+        Reduce::None => 0,
+        Reduce::Rows(k, _) | Reduce::Cols(k, _) => k * tree_nv,
+        Reduce::Both(_) => tree_nv * tree_nv,
+    };
+    let result = tree(workspace, [&b.q, &b.v, &b.a], &mut b.out[..out_len]);
     let full = &b.out[..out_len];
     match reduce {
         Reduce::None => {}
-        Reduce::Rows(cols) => r.reduce_rows(c, full, cols, out),
-        Reduce::Cols(rows) => r.reduce_cols(c, full, rows, out),
-        Reduce::Both => {
-            let (tree_nv, nv) = (r.v.len(), r.nv);
+        Reduce::Rows(cols, out) => r.reduce_rows(c, full, cols, out),
+        Reduce::Cols(rows, out) => r.reduce_cols(c, full, rows, out),
+        Reduce::Both(out) => {
             r.reduce_rows(c, full, tree_nv, &mut b.half[..nv * tree_nv]);
             r.reduce_cols(c, &b.half[..nv * tree_nv], nv, out);
         }

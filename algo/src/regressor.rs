@@ -70,22 +70,12 @@ pub fn joint_torque_regressor<S: Real>(
     y: &mut [S],
 ) {
     if multibody.reduction.is_some() {
-        let (nv, cols) = (multibody.tree_nv(), PARAMS_PER_BODY * multibody.bodies());
-        check_len("y", y, multibody.nv() * cols);
-        let tree = |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], out: &mut [S]| {
+        check_len("y", y, multibody.nv() * PARAMS_PER_BODY * multibody.bodies());
+        let tree = |w: &mut Workspace<S>, [q, v, a]: [&[S]; 3], out: &mut [S]| {
             joint_torque_regressor_tree(multibody, w, q, v, a, out)
         };
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            Some(v),
-            Some(a),
-            nv * cols,
-            Reduce::Rows(cols),
-            y,
-            tree,
-        );
+        let rows = Reduce::Rows(PARAMS_PER_BODY * multibody.bodies(), y);
+        return on_tree(multibody, workspace, [Some(q), Some(v), Some(a)], rows, tree);
     }
     joint_torque_regressor_tree(multibody, workspace, q, v, a, y);
 }
@@ -151,20 +141,10 @@ pub fn joint_wrench_regressor<S: Real>(
     w: &mut [S],
 ) {
     if multibody.reduction.is_some() {
-        let tree = |ws: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], _: &mut [S]| {
+        let tree = |ws: &mut Workspace<S>, [q, v, a]: [&[S]; 3], _: &mut [S]| {
             joint_wrench_regressor_tree(multibody, ws, q, v, a, w)
         };
-        return on_tree(
-            multibody,
-            workspace,
-            Some(q),
-            Some(v),
-            Some(a),
-            0,
-            Reduce::None,
-            &mut [],
-            tree,
-        );
+        return on_tree(multibody, workspace, [Some(q), Some(v), Some(a)], Reduce::None, tree);
     }
     joint_wrench_regressor_tree(multibody, workspace, q, v, a, w);
 }

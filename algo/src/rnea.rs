@@ -33,19 +33,13 @@ pub fn rnea<S: Real>(
     tau: &mut [S],
 ) {
     if multibody.reduction.is_some() {
-        let tree = |w: &mut Workspace<S>, q: &[S], v: &[S], a: &[S], out: &mut [S]| {
-            rnea_tree(multibody, w, q, v, a, params, out)
-        };
-        let nv = multibody.tree_nv();
+        let tree =
+            |w: &mut Workspace<S>, [q, v, a]: [&[S]; 3], out: &mut [S]| rnea_tree(multibody, w, q, v, a, params, out);
         return on_tree(
             multibody,
             workspace,
-            Some(q),
-            Some(v),
-            Some(a),
-            nv,
-            Reduce::Rows(1),
-            tau,
+            [Some(q), Some(v), Some(a)],
+            Reduce::Rows(1, tau),
             tree,
         );
     }

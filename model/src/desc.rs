@@ -624,17 +624,7 @@ impl Description {
             }
         }
         // A follower of a follower follows the first leader.
-        let given: Vec<dyngen_algo::Mimic> = (model.joints.iter().enumerate())
-            .filter_map(|(k, j)| {
-                j.mimic.map(|m| dyngen_algo::Mimic {
-                    joint: k,
-                    leader: m.leader - 1,
-                    multiplier: m.multiplier,
-                    offset: m.offset,
-                })
-            })
-            .collect();
-        match dyngen_algo::Mimic::resolve(&given, model.joints.len()) {
+        match dyngen_algo::Mimic::resolve(&model.algo_mimics(), model.joints.len()) {
             Ok(resolved) => {
                 for r in resolved {
                     model.joints[r.joint].mimic = Some(Mimic {

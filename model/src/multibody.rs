@@ -49,10 +49,12 @@ impl Model {
                 }
             })
             .collect();
-        let mimics: Vec<dyngen_algo::Mimic> = self
-            .joints
-            .iter()
-            .enumerate()
+        Multibody::new(self.gravity, &specs)?.with_mimics(&self.algo_mimics())
+    }
+
+    /// The joints that follow others as the algorithms number them (0-based).
+    pub(crate) fn algo_mimics(&self) -> Vec<dyngen_algo::Mimic> {
+        (self.joints.iter().enumerate())
             .filter_map(|(k, j)| {
                 j.mimic.map(|m| dyngen_algo::Mimic {
                     joint: k,
@@ -61,7 +63,6 @@ impl Model {
                     offset: m.offset,
                 })
             })
-            .collect();
-        Multibody::new(self.gravity, &specs)?.with_mimics(&mimics)
+            .collect()
     }
 }

@@ -1,6 +1,7 @@
 //! The algorithms allocate nothing per call: every buffer lives in the workspace,
 //! made once. Counted by a global allocator on a free-flyer humanoid (31 joints
-//! under a free flyer: ball-free, but 6-coordinate root) and the planar mobile arm.
+//! under a free flyer: ball-free, but 6-coordinate root), the planar mobile arm and a
+//! gripper with mimic joints.
 
 use dyngen_algo::{
     aba, aba_derivatives, body_motions, centroidal_map, centroidal_map_time_variation, com_jacobian,
@@ -37,6 +38,8 @@ fn no_algorithm_allocates_per_call() {
     for (urdf, free_flyer) in [
         ("robots/humanoid31/humanoid31.urdf", true),
         ("tests/fixtures/mobile_arm.urdf", false),
+        // Mimic joints: the tree's coordinates and results live in the workspace too.
+        ("tests/fixtures/mimic/arm_linkage_gripper.urdf", false),
     ] {
         let options = LoadOptions {
             free_flyer,

@@ -148,3 +148,18 @@ fn manifest_path(path: &str) -> std::path::PathBuf {
         _ => p.to_path_buf(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_macro_refuses_mimic_joints_at_the_file_name() {
+        let input = quote! { name: Gripper, urdf: "../tests/fixtures/mimic/arm_linkage_gripper.urdf" };
+        let e = expand_robot_macro(input).unwrap_err().to_string();
+        assert!(
+            e.starts_with("joint `left_inner_finger_joint` follows joint `finger_joint` (<mimic>)"),
+            "{e}"
+        );
+    }
+}

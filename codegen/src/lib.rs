@@ -51,14 +51,16 @@ pub enum RobotSource {
 }
 
 /// Why generated code cannot be made for `model`, if it cannot: a joint that follows
-/// another (`<mimic>`), which only the run-time algorithms take so far.
+/// another (URDF `<mimic>`, MJCF `<equality><joint>`), which only the run-time
+/// algorithms take so far.
 pub fn unsupported(model: &Model) -> Option<String> {
     let j = model.mimic_joint()?;
     let leader = j.mimic.map_or("", |m| model.joints[m.leader - 1].name.as_str());
     Some(format!(
-        "joint `{}` follows joint `{leader}` (<mimic>), which generated code does not support yet; load the robot \
-         at run time instead (`dyngen_model::load_robot`, then `Model::multibody` and `dyngen_algo`'s algorithms, or \
-         `dyngen.load` in Python), or remove the <mimic> element to make the joint independent",
+        "joint `{}` follows joint `{leader}` (a URDF <mimic> or an MJCF <equality><joint>), which generated code \
+         does not support yet; load the robot at run time instead (`dyngen_model::load_robot`, then \
+         `Model::multibody` and `dyngen_algo`'s algorithms, or `dyngen.load` in Python), or remove that <mimic> or \
+         <equality><joint> to make the joint independent",
         j.name
     ))
 }

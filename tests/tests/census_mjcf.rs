@@ -338,6 +338,12 @@ fn joint_couplings_are_mimic_joints_with_mujocos_reduced_dynamics() {
         worst[1] = worst[1].max(rel_err(&with_rotors, &json_numbers(&s["M"]), 1e-12));
         worst[2] = worst[2].max(rel_err(&bias, &json_numbers(&s["bias"]), 1e-12));
     }
+    // Generated code refuses the followers, naming the MJCF element.
+    let why = dyngen_codegen::unsupported(&model).unwrap();
+    assert!(
+        why.starts_with("joint `twin` follows joint `elbow` (a URDF <mimic> or an MJCF <equality><joint>)"),
+        "{why}"
+    );
     println!(
         "equality.xml: max rel. error M {:.1e}, M + diag(Ia) {:.1e}, bias {:.1e}",
         worst[0], worst[1], worst[2]

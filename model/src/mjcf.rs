@@ -1197,18 +1197,22 @@ impl<'t> Reader<'t> {
         };
         let (Some(joint2), Some(ref2)) = (joint2, ref2) else {
             let held = ref1 + c[0];
+            let unit = match self.joint_refs.get(joint1) {
+                Some((MjcfJoint::Slide, _)) => "m",
+                _ => "rad",
+            };
             let how = if c[0] == 0.0 {
                 "remove the <joint> from its body, which then stays where the file places it (at q = ref)".to_string()
             } else {
                 format!(
-                    "remove the <joint> from its body and place the body as it is at q = {held} (the file places \
-                     it at q = ref = {ref1})"
+                    "remove the <joint> from its body and place the body as it is at q = {held} {unit} (the file \
+                     places it at q = ref = {ref1} {unit})"
                 )
             };
             return warn(
                 self,
                 format!(
-                    "without joint2 it locks joint `{joint1}` at q = ref + c0 = {held}, and the model has no locked \
+                    "without joint2 it locks joint `{joint1}` at q = ref + c0 = {held} {unit}, and the model has no locked \
                      joints: `{joint1}` is left free; to lock it, {how}"
                 ),
             );

@@ -1532,15 +1532,15 @@ fn equality_constraints_not_in_the_model_are_warned_with_the_reason() {
         ),
         (
             19,
-            "<equality> <joint name=\"lock\"> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.2, \
+            "<equality> <joint name=\"lock\"> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.2 m, \
              and the model has no locked joints: `s` is left free; to lock it, remove the <joint> from its body, \
              which then stays where the file places it (at q = ref)",
         ),
         (
             20,
-            "<equality> <joint> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.7, and the model \
+            "<equality> <joint> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.7 m, and the model \
              has no locked joints: `s` is left free; to lock it, remove the <joint> from its body and place the \
-             body as it is at q = 0.7 (the file places it at q = ref = 0.2)",
+             body as it is at q = 0.7 m (the file places it at q = ref = 0.2 m)",
         ),
         (
             22,
@@ -1585,6 +1585,10 @@ fn equality_constraints_not_in_the_model_are_warned_with_the_reason() {
         .filter_map(|x| x.mimic.map(|m| (x.name.as_str(), m.leader)))
         .collect();
     assert_eq!(followers, [("k", 1)]);
+    // A hinge locked: its position in radians, whatever the file's unit.
+    let w = warnings_of(&with_equality(&["<joint joint1=\"k\"/>"]));
+    let at = format!("locks joint `k` at q = ref + c0 = {} rad,", 10f64.to_radians());
+    assert!(w.len() == 1 && w[0].contains(&at), "{w:?}");
 }
 
 /// `active` from the element, else its class, else the class's ancestors.

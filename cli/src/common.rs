@@ -88,10 +88,10 @@ pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
         return Err(CliError::input(
             path,
             format!(
-                "joint `{}` follows another (<mimic>); this command runs on robots whose joints each have a \
-                 coordinate of their own. The run-time algorithms take mimic joints (`dyngen.load` in Python, \
-                 `dyngen_model::Model::multibody` in Rust); or remove the <mimic> element to identify the joint \
-                 as an independent one",
+                "joint `{}` follows another (a URDF <mimic> or an MJCF <equality><joint>); this command runs on \
+                 robots whose joints each have a coordinate of their own. The run-time algorithms take such joints \
+                 (`dyngen.load` in Python, `dyngen_model::Model::multibody` in Rust); or remove the coupling to \
+                 identify the joint as an independent one",
                 j.name
             ),
         ));

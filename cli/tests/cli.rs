@@ -472,13 +472,13 @@ fn mimic_robots_load_where_supported_and_are_refused_by_name_elsewhere() {
     );
     // generate and identify refuse it, saying what to do instead.
     let why =
-        "follows joint `finger_joint` (<mimic>), which generated code does not support yet; load the robot at run time";
+        "follows joint `finger_joint` (a URDF <mimic> or an MJCF <equality><joint>), which generated code does not support yet; load the robot at run time";
     assert_error(&run!("generate", gripper, "--name", "Gripper"), why);
     let dir = temp_dir("cli", "mimic");
     let data = dir.join("data.csv");
     std::fs::write(&data, "t,q1\n0,0\n").unwrap();
     assert_error(
         &run!("identify", gripper, data),
-        "joint `left_inner_finger_joint` follows another (<mimic>); this command runs on robots whose joints each have a coordinate of their own",
+        "joint `left_inner_finger_joint` follows another (a URDF <mimic> or an MJCF <equality><joint>); this command runs on robots whose joints each have a coordinate of their own",
     );
 }

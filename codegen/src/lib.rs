@@ -51,8 +51,8 @@ pub enum RobotSource {
 }
 
 /// Why generated code cannot be made for `model`, if it cannot: a free flyer beyond
-/// the floating base (a second free body), or a joint that follows another
-/// (`<mimic>`), which only the run-time algorithms take so far.
+/// the floating base (a second free body), or a joint that follows another (URDF
+/// `<mimic>`, MJCF `<equality><joint>`), which only the run-time algorithms take so far.
 pub fn unsupported(model: &Model) -> Option<String> {
     if let Some(j) = model
         .joints
@@ -70,9 +70,10 @@ pub fn unsupported(model: &Model) -> Option<String> {
     let j = model.mimic_joint()?;
     let leader = j.mimic.map_or("", |m| model.joints[m.leader - 1].name.as_str());
     Some(format!(
-        "joint `{}` follows joint `{leader}` (<mimic>), which generated code does not support yet; load the robot \
-         at run time instead (`dyngen_model::load_robot`, then `Model::multibody` and `dyngen_algo`'s algorithms, or \
-         `dyngen.load` in Python), or remove the <mimic> element to make the joint independent",
+        "joint `{}` follows joint `{leader}` (a URDF <mimic> or an MJCF <equality><joint>), which generated code \
+         does not support yet; load the robot at run time instead (`dyngen_model::load_robot`, then \
+         `Model::multibody` and `dyngen_algo`'s algorithms, or `dyngen.load` in Python), or remove that <mimic> or \
+         <equality><joint> to make the joint independent",
         j.name
     ))
 }
@@ -158,7 +159,7 @@ mod tests {
         let input = quote! { name: Gripper, urdf: "../tests/fixtures/mimic/arm_linkage_gripper.urdf" };
         let e = expand_robot_macro(input).unwrap_err().to_string();
         assert!(
-            e.starts_with("joint `left_inner_finger_joint` follows joint `finger_joint` (<mimic>)"),
+            e.starts_with("joint `left_inner_finger_joint` follows joint `finger_joint` (a URDF <mimic>"),
             "{e}"
         );
     }

@@ -36,7 +36,8 @@ pub struct JointDesc {
     pub line: Option<usize>,
 }
 
-/// A joint that follows another (URDF `<mimic>`): `q = multiplier · q_leader + offset`.
+/// A joint that follows another (URDF `<mimic>`, a linear MJCF `<equality><joint>`):
+/// `q = multiplier · q_leader + offset`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MimicDesc {
     /// The following joint and its leader, by name.

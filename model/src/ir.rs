@@ -205,15 +205,17 @@ pub struct Joint {
     pub axis: Vec3,
     pub limits: Option<Limits>,
     pub dynamics: JointDynamics,
-    /// The joint this one follows (URDF `<mimic>`): then it has no coordinate of its
-    /// own, its coordinate being `multiplier · q_leader + offset`.
+    /// The joint this one follows (URDF `<mimic>`, MJCF `<equality><joint>`): then it
+    /// has no coordinate of its own, its coordinate being `multiplier · q_leader +
+    /// offset`.
     pub mimic: Option<Mimic>,
 }
 
-/// How a joint follows another (URDF `<mimic>`, Pinocchio's mimic joint): its
-/// coordinate is `multiplier · q_leader + offset`, its velocity and acceleration
-/// `multiplier` times the leader's. The leader (1-based) follows no other joint: a
-/// chain of followers is resolved to its first leader when the model is built.
+/// How a joint follows another (URDF `<mimic>`, a linear MJCF `<equality><joint>`,
+/// Pinocchio's mimic joint): its coordinate is `multiplier · q_leader + offset`, its
+/// velocity and acceleration `multiplier` times the leader's. The leader (1-based)
+/// follows no other joint: a chain of followers is resolved to its first leader when
+/// the model is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mimic {
     pub leader: usize,

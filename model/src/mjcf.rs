@@ -172,14 +172,45 @@
 //! `<worldbody>` or with other joints in its body, `<frame>`,
 //! `<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, unknown classes,
 //! `fullinertia` with an orientation on the `<inertial>` (MuJoCo refuses it too),
-//! `<compiler coordinate="global">`, the geoms above. Left out with a warning naming
-//! the element and its line: each element of `<equality>` and `<tendon>` (the
-//! dynamics treat the joints as independent), a joint's `stiffness`, a ball joint's
-//! `range`, and every `<compiler>` attribute not read that is not known to leave the
-//! dynamics alone (and `exactmeshinertia`, which MuJoCo 4 refuses). Cameras, lights,
+//! `<compiler coordinate="global">`, the geoms above, the `<equality><joint>`s MuJoCo
+//! refuses (below). Left out with a warning naming the element and its line: the
+//! elements of `<equality>` the model cannot hold (below) and each element of
+//! `<tendon>` (the dynamics treat the joints as independent), a joint's `stiffness`, a
+//! ball joint's `range`, and every `<compiler>` attribute not read that is not known to
+//! leave the dynamics alone (and `exactmeshinertia`, which MuJoCo 4 refuses). Cameras, lights,
 //! assets other than meshes (and meshes that no geom giving an inertia uses),
 //! actuators, sensors, geoms of bodies with an `<inertial>` and the rest are
 //! skipped.
+//!
+//! # Equality constraints
+//!
+//! MuJoCo's `<equality><joint joint1 joint2 polycoef="c0 c1 c2 c3 c4">` holds
+//! `q1 - ref1 = c0 + c1 (q2 - ref2) + c2 (q2 - ref2)² + c3 (…)³ + c4 (…)⁴`, with `ref`
+//! each joint's `qpos0` (in radians for a hinge whatever the file's angle unit;
+//! `polycoef` is used as written, never converted) and the numbers not written
+//! keeping the default `0 1 0 0 0`. Where that is linear (`c2 = c3 = c4 = 0`) and
+//! `joint2` is given, joint1 follows joint2 as a mimic joint ([`MimicDesc`], see
+//! [`crate::ir::Mimic`]): multiplier `c1`, offset `ref1 + c0 - c1 ref2`, so that
+//! `q1 = c1 q2 + offset` in `qpos` terms. MuJoCo enforces the coupling softly,
+//! through its constraint solver; the model holds it exactly, with one coordinate
+//! for a leader and its followers. `active` (of the element, else of its `<default>`
+//! class's `<equality>`) `"false"` skips a constraint without a warning: MuJoCo
+//! starts with it off, so its dynamics are the model's (MuJoCo can switch it on at
+//! run time; the model cannot).
+//!
+//! Refused as MuJoCo refuses them, naming the `<equality>` element and its line, active
+//! or not: a `<joint>` without `joint1`, naming no joint of the model or a ball or
+//! free joint, with `joint1` and `joint2` the same joint, a `polycoef` that is not up
+//! to 5 numbers, an `active` that is neither `true` nor `false`, an unknown `class`.
+//!
+//! Left out with a warning naming the element, its line and why: a `<joint>` with a
+//! nonlinear `polycoef` (naming the nonzero `c2`, `c3`, `c4`; the joints stay
+//! independent), one without `joint2` (MuJoCo locks joint1 at `ref + c0`; the joint
+//! is left free, and the warning tells how to lock it: remove the joint, and place
+//! its body at that position), one whose joint1 already follows a joint (a joint
+//! follows one at most) or whose joint2 follows joint1 through the couplings before
+//! it (a cycle); `<connect>` and `<weld>` (a closed loop or a fixed pose the tree does
+//! not hold), `<tendon>` (no tendons in the model), `<flex>` and `<flexstrain>`.
 //!
 //! Siblings are numbered in declaration order, as MuJoCo numbers its bodies. An
 //! element with `name=""` is unnamed, as in MuJoCo (a body `body_ID`, a joint
@@ -204,7 +235,9 @@
 //! line N` for each include in between); errors whose kind has no message of its own
 //! are given as [`ErrorKind::InvalidMjcf`] with that prefix and their text.
 
-use crate::desc::{DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, SiblingOrder, DEFAULT_GRAVITY};
+use crate::desc::{
+    DeclaredJointType, Description, JointDesc, LinkDesc, LoadOptions, MimicDesc, SiblingOrder, DEFAULT_GRAVITY,
+};
 use crate::error::{Element, ErrorKind, ModelError, ModelErrors};
 use crate::ir::{Inertial, JointDynamics, JointKind, Limits, Model, Placement};
 use crate::math::{self, Mat3, Vec3};
@@ -504,6 +537,8 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
         fit_aabb: false,
         meshes: HashMap::new(),
         mesh_masses: HashMap::new(),
+        joint_refs: HashMap::new(),
+        mimics: Vec::new(),
     };
     reader.errors = include_errors;
     reader.read_document(root);
@@ -516,7 +551,7 @@ fn read(text: &str, path: Option<&Path>) -> Result<Read, Vec<ModelError>> {
             gravity: reader.gravity,
             links: reader.links,
             joints: reader.joints,
-            mimics: Vec::new(),
+            mimics: reader.mimics,
         },
         root_line: Some(tags[root].line),
         errors: reader.errors,
@@ -807,14 +842,14 @@ fn relocate(sources: &[Source], errors: Vec<ModelError>) -> Vec<ModelError> {
 }
 
 /// A `<default>` class: its parent class and the attributes it sets, by element
-/// (`joint`, `geom`, `site`).
+/// (`joint`, `geom`, `site`, `mesh`, `equality`).
 struct Class {
     parent: Option<String>,
     attrs: HashMap<String, Vec<(String, String)>>,
 }
 
 /// Elements whose attributes `<default>` classes give here.
-const CLASS_ELEMENTS: [&str; 4] = ["joint", "geom", "site", "mesh"];
+const CLASS_ELEMENTS: [&str; 5] = ["joint", "geom", "site", "mesh", "equality"];
 
 /// `<compiler inertiafromgeom>`: whether a body's inertial comes from its geoms.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -863,6 +898,11 @@ struct Owner<'a> {
     placement: &'a Placement,
     /// Whether the body has no child bodies (MuJoCo aligns only those).
     childless: bool,
+}
+
+/// ` name="N"` for an element named N, else nothing: for messages.
+fn named(t: &Tag) -> String {
+    t.attr("name").map_or_else(String::new, |n| format!(" name=\"{n}\""))
 }
 
 /// MJCF joint types.
@@ -919,6 +959,11 @@ struct Reader<'t> {
     meshes: HashMap<String, usize>,
     /// The mass properties of the meshes computed so far, or why they are refused.
     mesh_masses: HashMap<String, Result<MeshMass, ModelError>>,
+    /// Each joint read, by name: its type and its `ref` in the model's units
+    /// (radians or metres; 0 for ball and free joints), for `<equality><joint>`.
+    joint_refs: HashMap<String, (MjcfJoint, f64)>,
+    /// The joints that follow others (`<equality><joint>` couplings).
+    mimics: Vec<MimicDesc>,
 }
 
 impl<'t> Reader<'t> {
@@ -1004,29 +1049,224 @@ impl<'t> Reader<'t> {
                 }
             }
         }
-        // Constraints between joints: the model's joints are independent.
-        for section in ["equality", "tendon"] {
-            for s in self.children_named(root, section) {
-                for c in self.children[s].clone() {
-                    let t = &tags[c];
-                    let name = t.attr("name").map_or_else(String::new, |n| format!(" name=\"{n}\""));
-                    let what = if section == "equality" {
-                        "an equality constraint"
-                    } else {
-                        "a tendon (its length, limits, stiffness, damping and any constraint or actuator on it)"
-                    };
-                    self.warnings.push(ModelError {
-                        element: Element::Robot,
-                        line: Some(t.line),
-                        kind: ErrorKind::Ignored(format!(
-                            "<{section}> <{}{name}> is left out: {what} is not in the model, whose dynamics treat \
-                             the joints as independent",
-                            t.name
-                        )),
-                    });
-                }
+        // Joint couplings become followers; the other constraints are not in the model.
+        for s in self.children_named(root, "equality") {
+            for c in self.children[s].clone() {
+                self.read_equality(&tags[c]);
             }
         }
+        for s in self.children_named(root, "tendon") {
+            for c in self.children[s].clone() {
+                let t = &tags[c];
+                self.warnings.push(ModelError {
+                    element: Element::Robot,
+                    line: Some(t.line),
+                    kind: ErrorKind::Ignored(format!(
+                        "<tendon> <{}{}> is left out: a tendon (its length, limits, stiffness, damping and any \
+                         constraint or actuator on it) is not in the model, whose dynamics treat the joints as \
+                         independent",
+                        t.name,
+                        named(t)
+                    )),
+                });
+            }
+        }
+    }
+
+    /// One element of `<equality>`: a linear `<joint>` coupling becomes a follower
+    /// ([`MimicDesc`]); what MuJoCo refuses is refused; an inactive constraint is
+    /// skipped; every other constraint is left out with a warning that says why.
+    fn read_equality(&mut self, t: &'t Tag) {
+        let label = format!("<equality> <{}{}>", t.name, named(t));
+        let class = self.class_of(t, "class", "main", &Element::Robot);
+        let active = match self.class_attr(t, &class, "equality", "active").as_deref() {
+            None | Some("true") => true,
+            Some("false") => false,
+            Some(other) => {
+                self.error(
+                    Element::Robot,
+                    t.line,
+                    ErrorKind::InvalidMjcf(format!(
+                        "{label}: active=\"{other}\" is neither `true` nor `false` (MuJoCo refuses it too)"
+                    )),
+                );
+                return;
+            }
+        };
+        let why = match t.name.as_str() {
+            "joint" => return self.read_joint_coupling(t, &label, active),
+            "connect" => {
+                "a connect constraint (a ball joint between two bodies outside the tree: a closed kinematic loop) \
+                 is not in the model, whose bodies form a tree; its dynamics are those of the open tree"
+            }
+            "weld" => {
+                "a weld constraint (two bodies held in a fixed relative pose, or a body held to the world: a closed \
+                 loop unless the bodies are parent and child) is not in the model, whose bodies form a tree; to \
+                 weld a body to its parent, give it no joint"
+            }
+            "tendon" => "a tendon coupling is not in the model, which has no tendons; its joints stay independent",
+            "flex" | "flexstrain" => "a flex constraint is not in the model, which has rigid bodies only",
+            _ => "a constraint of this kind is not in the model, whose joints are independent",
+        };
+        if active {
+            self.warnings.push(ModelError {
+                element: Element::Robot,
+                line: Some(t.line),
+                kind: ErrorKind::Ignored(format!("{label} is left out: {why}")),
+            });
+        }
+    }
+
+    /// `<equality><joint joint1 joint2 polycoef>`: MuJoCo holds `q1 - ref1 = c0 + c1
+    /// (q2 - ref2) + c2 (q2 - ref2)² + c3 (…)³ + c4 (…)⁴` (`ref` as `qpos0`, in radians
+    /// or metres; `polycoef` as written, never converted from degrees). With `joint2`
+    /// and `c2 = c3 = c4 = 0`, joint1 follows joint2: `q1 = c1 q2 + ref1 + c0 - c1 ref2`.
+    fn read_joint_coupling(&mut self, t: &'t Tag, label: &str, active: bool) {
+        let refuse = |this: &mut Self, why: String| {
+            this.error(
+                Element::Robot,
+                t.line,
+                ErrorKind::InvalidMjcf(format!("{label}: {why} (MuJoCo refuses it too)")),
+            )
+        };
+        // MuJoCo keeps the default `0 1 0 0 0` past the numbers written.
+        let mut c = [0.0, 1.0, 0.0, 0.0, 0.0];
+        if let Some(v) = t.attr("polycoef") {
+            let words: Vec<&str> = v.split_whitespace().collect();
+            let numbers: Vec<f64> = words.iter().filter_map(|w| w.parse::<f64>().ok()).collect();
+            if words.len() > 5 || numbers.len() != words.len() || numbers.iter().any(|x| !x.is_finite()) {
+                return refuse(
+                    self,
+                    format!(
+                        "polycoef=\"{v}\" is not up to 5 finite numbers; give `c0 c1 c2 c3 c4` (default `0 1 0 0 0`, \
+                         the numbers not written keep it)"
+                    ),
+                );
+            }
+            c[..numbers.len()].copy_from_slice(&numbers);
+        }
+        let Some(joint1) = t.attr("joint1") else {
+            return refuse(self, "no `joint1`; name the joint that the coupling moves".into());
+        };
+        let scalar = |this: &mut Self, attr: &str, name: &str| -> Option<f64> {
+            match this.joint_refs.get(name) {
+                Some(&(MjcfJoint::Hinge | MjcfJoint::Slide, reference)) => Some(reference),
+                Some(&(kind, _)) => {
+                    let kind = if kind == MjcfJoint::Ball { "ball" } else { "free" };
+                    refuse(
+                        this,
+                        format!("{attr}=\"{name}\" is a {kind} joint; only hinge and slide joints can be coupled"),
+                    );
+                    None
+                }
+                None => {
+                    refuse(
+                        this,
+                        format!("{attr}=\"{name}\" names no joint of this model; name a hinge or slide joint"),
+                    );
+                    None
+                }
+            }
+        };
+        let Some(ref1) = scalar(self, "joint1", joint1) else {
+            return;
+        };
+        let joint2 = t.attr("joint2");
+        let ref2 = match joint2 {
+            Some(j) if j == joint1 => {
+                return refuse(
+                    self,
+                    format!("joint1 and joint2 both name `{j}`; a joint cannot follow itself"),
+                )
+            }
+            Some(j) => match scalar(self, "joint2", j) {
+                Some(r) => Some(r),
+                None => return,
+            },
+            None => None,
+        };
+        if !active {
+            // MuJoCo starts with it off: the joints are independent, as in the model.
+            return;
+        }
+        let warn = |this: &mut Self, why: String| {
+            this.warnings.push(ModelError {
+                element: Element::Robot,
+                line: Some(t.line),
+                kind: ErrorKind::Ignored(format!("{label} is left out: {why}")),
+            })
+        };
+        let (Some(joint2), Some(ref2)) = (joint2, ref2) else {
+            let held = ref1 + c[0];
+            let unit = match self.joint_refs.get(joint1) {
+                Some((MjcfJoint::Slide, _)) => "m",
+                _ => "rad",
+            };
+            let how = if c[0] == 0.0 {
+                "remove the <joint> from its body, which then stays where the file places it (at q = ref)".to_string()
+            } else {
+                format!(
+                    "remove the <joint> from its body and place the body as it is at q = {held} {unit} (the file \
+                     places it at q = ref = {ref1} {unit})"
+                )
+            };
+            return warn(
+                self,
+                format!(
+                    "without joint2 it locks joint `{joint1}` at q = ref + c0 = {held} {unit}, and the model has no locked \
+                     joints: `{joint1}` is left free; to lock it, {how}"
+                ),
+            );
+        };
+        let nonlinear: Vec<String> = (2..5)
+            .filter(|&k| c[k] != 0.0)
+            .map(|k| format!("c{k} = {}", c[k]))
+            .collect();
+        if !nonlinear.is_empty() {
+            return warn(
+                self,
+                format!(
+                    "its polycoef has {}, a nonlinear coupling, and a follower moves linearly with its leader; \
+                     joint `{joint1}` is left independent of `{joint2}` (only c0 and c1 may be nonzero for it to \
+                     follow: q1 = c1 q2 + offset)",
+                    nonlinear.join(", ")
+                ),
+            );
+        }
+        if let Some(m) = self.mimics.iter().find(|m| m.joint == joint1) {
+            let (leader, line) = (m.leader.clone(), m.line.unwrap_or(0));
+            return warn(
+                self,
+                format!(
+                    "joint `{joint1}` already follows `{leader}` (the coupling at line {line}), and a joint \
+                     follows one joint at most; couple `{leader}` and `{joint2}` instead if they move together"
+                ),
+            );
+        }
+        // joint2's leaders, followed in turn: joint1 among them closes a cycle.
+        let mut leader = joint2;
+        let mut steps = 0;
+        while let Some(m) = self.mimics.iter().find(|m| m.joint == leader) {
+            leader = m.leader.as_str();
+            steps += 1;
+            if leader == joint1 || steps > self.mimics.len() {
+                return warn(
+                    self,
+                    format!(
+                        "joint `{joint2}` already follows `{joint1}` through the couplings above, so this one \
+                         closes a cycle of couplings; the model keeps the couplings above and leaves this one out \
+                         (it is redundant if it agrees with them)"
+                    ),
+                );
+            }
+        }
+        self.mimics.push(MimicDesc {
+            joint: joint1.to_string(),
+            leader: joint2.to_string(),
+            multiplier: c[1],
+            offset: ref1 + c[0] - c[1] * ref2,
+            line: Some(t.line),
+        });
     }
 
     fn read_compiler(&mut self, t: &Tag) {
@@ -1648,6 +1888,7 @@ impl<'t> Reader<'t> {
                 return None;
             }
         };
+        self.joint_refs.entry(name.clone()).or_insert((kind, 0.0));
         let scalar = |this: &mut Self, a: &str| number(this, a, 1).map_or(0.0, |v| v[0]);
         let dynamics = JointDynamics {
             armature: scalar(self, "armature"),
@@ -1748,6 +1989,12 @@ impl<'t> Reader<'t> {
         // MuJoCo's body placement is at q = ref (`qpos0`): the joint's zero is that
         // placement moved back by `ref` about or along the axis.
         let reference = scalar(self, "ref");
+        let model_ref = if slide { reference } else { self.angle(reference) };
+        if let Some(entry) = self.joint_refs.get_mut(&name) {
+            if entry.0 == kind {
+                entry.1 = model_ref;
+            }
+        }
         let n = math::norm(&axis);
         let origin = if reference != 0.0 && n > 0.0 && n.is_finite() {
             let unit = math::scale(1.0 / n, &axis);
@@ -1803,6 +2050,7 @@ impl<'t> Reader<'t> {
         dynamics: JointDynamics,
     ) -> Option<(JointDesc, Vec3)> {
         let el = Element::Joint(name.clone());
+        self.joint_refs.entry(name.clone()).or_insert((MjcfJoint::Free, 0.0));
         if owner.parent != WORLD {
             // MuJoCo: "free joint can only be used on top level".
             self.error(el, t.line, ErrorKind::FreeFlyerNotAtRoot);

@@ -9,8 +9,10 @@
 //! compiler-adjusted inertias and its dynamics with joint `ref` and several joints in
 //! one body (`scripts/make_mjcf_armature_fixtures.py`), `<include>` splices files
 //! (each refusal named with the `<include>`'s line, errors in included files with
-//! theirs), and one test per refused construct checks the message names the element
-//! and its line.
+//! theirs), linear `<equality><joint>` couplings are mimic joints with MuJoCo's offset,
+//! each `<equality>` element the model cannot hold is warned about with its reason,
+//! and one test per refused construct checks the message names the element and its
+//! line.
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
@@ -1453,31 +1455,218 @@ fn warnings_of(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// Four bodies in a chain: hinges `j` (ref 30°) and `k` (ref 10°), a slide `s` (ref
+/// 0.2) and a ball joint; `<equality>` holds `elements`, the first on line 18.
+fn with_equality(elements: &[&str]) -> String {
+    mjcf(&[
+        "<body name=\"a\">",
+        INERTIAL,
+        "<joint name=\"j\" ref=\"30\"/>",
+        "<body name=\"b\">",
+        INERTIAL,
+        "<joint name=\"k\" ref=\"10\" axis=\"0 1 0\"/>",
+        "<body name=\"c\">",
+        INERTIAL,
+        "<joint name=\"s\" type=\"slide\" ref=\"0.2\" axis=\"1 0 0\"/>",
+        "<body name=\"d\">",
+        INERTIAL,
+        "<joint name=\"ball\" type=\"ball\"/>",
+        "</body></body></body></body>",
+    ])
+    .replace(
+        "</mujoco>",
+        &format!("<equality>\n{}\n</equality>\n</mujoco>", elements.join("\n")),
+    )
+}
+
+/// A linear `<equality><joint>` makes joint1 follow joint2 as MuJoCo holds it:
+/// `q1 - ref1 = c0 + c1 (q2 - ref2)`, `ref` in radians (converted from the file's
+/// degrees), `polycoef` as written, its missing numbers MuJoCo's default `0 1 0 0 0`.
 #[test]
-fn equality_and_tendon_are_left_out_with_a_warning() {
-    let mut text = mjcf(&["<body name=\"a\">", INERTIAL, "<joint name=\"j\"/>", "</body>"]);
+fn linear_joint_couplings_are_mimic_joints() {
+    let model = parse_mjcf(&with_equality(&[
+        "<joint name=\"double\" joint1=\"k\" joint2=\"j\" polycoef=\"0.1 2\"/>",
+        "<joint joint1=\"s\" joint2=\"j\" polycoef=\"-0.05 0.5 0 0 0\"/>",
+    ]))
+    .unwrap();
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(model.nv(), 4, "j and the ball joint");
+    let (j, k) = (30f64.to_radians(), 10f64.to_radians());
+    let follower = |name: &str| model.joints.iter().find(|x| x.name == name).unwrap().mimic.unwrap();
+    let m = follower("k");
+    assert_eq!((m.leader, m.multiplier), (1, 2.0));
+    assert!((m.offset - (k + 0.1 - 2.0 * j)).abs() < 1e-15, "{m:?}");
+    let m = follower("s");
+    assert_eq!((m.leader, m.multiplier), (1, 0.5));
+    assert!((m.offset - (0.2 - 0.05 - 0.5 * j)).abs() < 1e-15, "{m:?}");
+    // Without polycoef, joint1 moves as joint2 from the references: offset ref1 - ref2.
+    let model = parse_mjcf(&with_equality(&["<joint joint1=\"k\" joint2=\"j\" polycoef=\"\"/>"])).unwrap();
+    let m = model.joints[1].mimic.unwrap();
+    assert_eq!((m.leader, m.multiplier), (1, 1.0));
+    assert!((m.offset - (k - j)).abs() < 1e-15, "{m:?}");
+}
+
+/// What the model cannot hold is left out with a warning naming the element, its line
+/// and why; an inactive constraint (MuJoCo starts with it off) is skipped silently.
+#[test]
+fn equality_constraints_not_in_the_model_are_warned_with_the_reason() {
+    let mut text = with_equality(&[
+        "<joint name=\"bend\" joint1=\"k\" joint2=\"j\" polycoef=\"0 1 0 0.3 -1\"/>",
+        "<joint name=\"lock\" joint1=\"s\"/>",
+        "<joint joint1=\"s\" polycoef=\"0.5\"/>",
+        "<joint joint1=\"k\" joint2=\"j\" active=\"false\"/>",
+        "<connect body1=\"a\" body2=\"c\" anchor=\"0 0 0\"/>",
+        "<weld name=\"w\" body1=\"d\"/>",
+        "<tendon tendon1=\"t\"/>",
+        "<flex flex=\"f\"/>",
+        "<weld body1=\"d\" active=\"false\"/>",
+        "<joint joint1=\"k\" joint2=\"j\"/>",
+        "<joint joint1=\"k\" joint2=\"s\"/>",
+        "<joint joint1=\"j\" joint2=\"k\"/>",
+    ]);
     text = text.replace(
         "</mujoco>",
-        "<equality>\n<joint name=\"couple\" joint1=\"j\"/>\n<weld body1=\"a\"/>\n</equality>\n\
-         <tendon>\n<fixed name=\"t\"><joint joint=\"j\" coef=\"1\"/></fixed>\n</tendon>\n</mujoco>",
+        "<tendon>\n<fixed name=\"t\"><joint joint=\"j\" coef=\"1\"/></fixed>\n</tendon>\n</mujoco>",
     );
-    let w = warnings_of(&text);
-    assert_eq!(w.len(), 3, "{w:?}");
-    assert!(
-        w[0].starts_with(
-            "line 9: robot: <equality> <joint name=\"couple\"> is left out: an equality constraint is not in the \
-             model, whose dynamics treat the joints as independent"
+    let model = parse_mjcf(&text).unwrap();
+    let w: Vec<String> = model.warnings.iter().map(|w| w.warning_message()).collect();
+    let expected = [
+        (
+            18,
+            "<equality> <joint name=\"bend\"> is left out: its polycoef has c3 = 0.3, c4 = -1, a nonlinear \
+             coupling, and a follower moves linearly with its leader; joint `k` is left independent of `j` (only \
+             c0 and c1 may be nonzero for it to follow: q1 = c1 q2 + offset)",
         ),
-        "{w:?}"
+        (
+            19,
+            "<equality> <joint name=\"lock\"> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.2 m, \
+             and the model has no locked joints: `s` is left free; to lock it, remove the <joint> from its body, \
+             which then stays where the file places it (at q = ref)",
+        ),
+        (
+            20,
+            "<equality> <joint> is left out: without joint2 it locks joint `s` at q = ref + c0 = 0.7 m, and the model \
+             has no locked joints: `s` is left free; to lock it, remove the <joint> from its body and place the \
+             body as it is at q = 0.7 m (the file places it at q = ref = 0.2 m)",
+        ),
+        (
+            22,
+            "<equality> <connect> is left out: a connect constraint (a ball joint between two bodies outside the \
+             tree: a closed kinematic loop) is not in the model",
+        ),
+        (
+            23,
+            "<equality> <weld name=\"w\"> is left out: a weld constraint (two bodies held in a fixed relative pose",
+        ),
+        (
+            24,
+            "<equality> <tendon> is left out: a tendon coupling is not in the model, which has no tendons",
+        ),
+        (
+            25,
+            "<equality> <flex> is left out: a flex constraint is not in the model, which has rigid bodies only",
+        ),
+        (
+            28,
+            "<equality> <joint> is left out: joint `k` already follows `j` (the coupling at line 27), and a joint \
+             follows one joint at most; couple `j` and `s` instead if they move together",
+        ),
+        (
+            29,
+            "<equality> <joint> is left out: joint `k` already follows `j` through the couplings above, so this \
+             one closes a cycle of couplings",
+        ),
+        (32, "<tendon> <fixed name=\"t\"> is left out: a tendon"),
+    ];
+    assert_eq!(w.len(), expected.len(), "{w:#?}");
+    for (message, (line, says)) in w.iter().zip(expected) {
+        assert!(
+            message.starts_with(&format!("line {line}: robot: {says}")),
+            "{message}\n{w:#?}"
+        );
+    }
+    // The one coupling kept: k follows j, on line 27.
+    let followers: Vec<(&str, usize)> = model
+        .joints
+        .iter()
+        .filter_map(|x| x.mimic.map(|m| (x.name.as_str(), m.leader)))
+        .collect();
+    assert_eq!(followers, [("k", 1)]);
+    // A hinge locked: its position in radians, whatever the file's unit.
+    let w = warnings_of(&with_equality(&["<joint joint1=\"k\"/>"]));
+    let at = format!("locks joint `k` at q = ref + c0 = {} rad,", 10f64.to_radians());
+    assert!(w.len() == 1 && w[0].contains(&at), "{w:?}");
+}
+
+/// `active` from the element, else its class, else the class's ancestors.
+#[test]
+fn equality_active_comes_from_the_default_class() {
+    let text = with_equality(&[
+        "<joint joint1=\"k\" joint2=\"j\"/>",
+        "<joint joint1=\"s\" joint2=\"j\" class=\"on\"/>",
+        "<weld body1=\"d\"/>",
+    ])
+    .replace(
+        "<worldbody>",
+        "<default><equality active=\"false\"/><default class=\"on\"><equality active=\"true\"/></default></default>\n\
+         <worldbody>",
     );
-    assert!(
-        w[1].starts_with("line 10: robot: <equality> <weld> is left out"),
-        "{w:?}"
+    let model = parse_mjcf(&text).unwrap();
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let followers: Vec<&str> = model
+        .joints
+        .iter()
+        .filter(|x| x.mimic.is_some())
+        .map(|x| x.name.as_str())
+        .collect();
+    assert_eq!(followers, ["s"]);
+}
+
+/// What MuJoCo refuses in `<equality><joint>` is refused, active or not, naming the
+/// element and its line and saying what is valid.
+#[test]
+fn joint_couplings_mujoco_refuses_are_refused() {
+    for (element, says) in [
+        (
+            "<joint joint1=\"nope\" joint2=\"j\"/>",
+            "<equality> <joint>: joint1=\"nope\" names no joint of this model; name a hinge or slide joint (MuJoCo \
+             refuses it too)",
+        ),
+        (
+            "<joint name=\"c\" joint1=\"k\" joint2=\"ball\" active=\"false\"/>",
+            "<equality> <joint name=\"c\">: joint2=\"ball\" is a ball joint; only hinge and slide joints can be \
+             coupled (MuJoCo refuses it too)",
+        ),
+        (
+            "<joint joint1=\"k\" joint2=\"k\"/>",
+            "joint1 and joint2 both name `k`; a joint cannot follow itself",
+        ),
+        (
+            "<joint joint2=\"k\"/>",
+            "no `joint1`; name the joint that the coupling moves",
+        ),
+        (
+            "<joint joint1=\"k\" joint2=\"j\" polycoef=\"0 1 0 0 0 0\"/>",
+            "polycoef=\"0 1 0 0 0 0\" is not up to 5 finite numbers; give `c0 c1 c2 c3 c4` (default `0 1 0 0 0`",
+        ),
+        (
+            "<joint joint1=\"k\" joint2=\"j\" polycoef=\"0 one\"/>",
+            "is not up to 5 finite numbers",
+        ),
+        (
+            "<connect body1=\"a\" anchor=\"0 0 0\" active=\"yes\"/>",
+            "<equality> <connect>: active=\"yes\" is neither `true` nor `false`",
+        ),
+    ] {
+        only_error(&with_equality(&[element]), Element::Robot, 18, says);
+    }
+    let kind = only_error(
+        &with_equality(&["<joint joint1=\"k\" joint2=\"j\" class=\"nope\"/>"]),
+        Element::Robot,
+        18,
+        "nope",
     );
-    assert!(
-        w[2].starts_with("line 13: robot: <tendon> <fixed name=\"t\"> is left out: a tendon"),
-        "{w:?}"
-    );
+    assert!(matches!(kind, ErrorKind::UnknownClass(_)), "{kind:?}");
 }
 
 #[test]

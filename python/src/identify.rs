@@ -272,8 +272,8 @@ fn load_robot(robot_path: &Path) -> PyResult<Model> {
     }
     if let Some(j) = model.mimic_joint() {
         return Err(LoadError::new_err(format!(
-            "{}: joint `{}` follows another (<mimic>); identification runs on robots whose joints each have a \
-             coordinate of their own",
+            "{}: joint `{}` follows another (a URDF <mimic> or an MJCF <equality><joint>); identification \
+             runs on robots whose joints each have a coordinate of their own",
             robot_path.display(),
             j.name
         )));

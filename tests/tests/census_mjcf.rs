@@ -12,6 +12,10 @@
 //! with `T = blkdiag(Rᵀ, I)`, `M = T⁻ᵀ M_mj T⁻¹` and `b = T⁻ᵀ b_mj + M [ω × Rᵀṗ; 0]`
 //! (`M` without armature: `qfrc_bias` is the rigid bodies' alone).
 //!
+//! Also `equality.xml` (`scripts/make_mjcf_equality_fixtures.py`): joint couplings
+//! read as mimic joints, against MuJoCo's dynamics reduced to the leaders'
+//! coordinates.
+//!
 //! `cargo test -p dyngen-tests --test census_mjcf -- --nocapture` prints the table.
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
@@ -245,4 +249,98 @@ fn census_of_the_control_suite_is_mujocos() {
         }
         assert_eq!(r.loads, r.errors.is_some());
     }
+}
+
+/// `<equality><joint>` couplings (`tests/fixtures/mjcf/equality.xml`, written with
+/// MuJoCo 4.0 by `scripts/make_mjcf_equality_fixtures.py`): the linear ones are mimic
+/// joints whose multiplier and offset are MuJoCo's rule (`q1 - ref1 = c0 + c1 (q2 -
+/// ref2)`), and the run-time algorithms on the reduced coordinates give MuJoCo's
+/// dynamics reduced by `E` — `crba + diag(Ia)` is `Eᵀ qM E` (`Ia` the nominal
+/// armature, each follower's `k² Ia` folded into its leader), `crba` is the same
+/// without armature and `rnea(q, v, 0)` is `Eᵀ qfrc_bias` — to 1e-12 relative; the
+/// nonlinear coupling is left out with a warning on its line.
+#[test]
+fn joint_couplings_are_mimic_joints_with_mujocos_reduced_dynamics() {
+    use dyngen_algo::Workspace;
+    let model = load_mjcf(&workspace_root().join("tests/fixtures/mjcf/equality.xml")).unwrap();
+    let reference = load_json("mjcf/equality.json");
+    let names = |v: &Value| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|n| n.as_str().unwrap().to_string())
+            .collect()
+    };
+    let ours: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    assert_eq!(ours, names(&reference["joints"]));
+    let nv = model.nv();
+    assert_eq!(nv, names(&reference["reduced"]).len());
+    assert_eq!(model.gravity.to_vec(), json_numbers(&reference["gravity"]));
+    // Followers: MuJoCo's leader, multiplier and offset.
+    let followers = reference["followers"].as_array().unwrap();
+    assert_eq!(
+        model.joints.iter().filter(|j| j.mimic.is_some()).count(),
+        followers.len()
+    );
+    for f in followers {
+        let joint = model
+            .joints
+            .iter()
+            .find(|j| j.name == f["joint"].as_str().unwrap())
+            .unwrap();
+        let m = joint.mimic.unwrap_or_else(|| panic!("{} follows no joint", joint.name));
+        assert_eq!(model.joints[m.leader - 1].name, f["leader"].as_str().unwrap());
+        let (k, b) = (f["multiplier"].as_f64().unwrap(), f["offset"].as_f64().unwrap());
+        assert!(
+            (m.multiplier - k).abs() <= 1e-15,
+            "{}: {} vs {k}",
+            joint.name,
+            m.multiplier
+        );
+        assert!((m.offset - b).abs() <= 1e-15, "{}: {} vs {b}", joint.name, m.offset);
+    }
+    // The nonlinear coupling, and nothing else, is warned about.
+    let warnings: Vec<String> = model.warnings.iter().map(|w| w.warning_message()).collect();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0]
+            .starts_with("line 45: robot: <equality> <joint name=\"bend\"> is left out: its polycoef has c2 = 0.2"),
+        "{warnings:?}"
+    );
+    let ia: Vec<f64> = dyngen_model::joint_params::nominal_joint_params(&model)
+        .chunks(4)
+        .map(|p| p[0])
+        .collect();
+    assert!(
+        rel_err(&ia, &json_numbers(&reference["armature"]), 1e-12) <= 1e-15,
+        "{ia:?}"
+    );
+    let body = model.multibody().unwrap();
+    let mut ws = Workspace::new(&body, ());
+    let params = model.standard_params();
+    let mut worst = [0.0f64; 3];
+    for s in reference["samples"].as_array().unwrap() {
+        let (q, v) = (json_numbers(&s["q"]), json_numbers(&s["v"]));
+        let mut m = vec![0.0; nv * nv];
+        dyngen_algo::crba(&body, &mut ws, &q, &params, &mut m);
+        let mut bias = vec![0.0; nv];
+        dyngen_algo::rnea(&body, &mut ws, &q, &v, &vec![0.0; nv], &params, &mut bias);
+        let with_rotors: Vec<f64> = (0..nv * nv)
+            .map(|k| m[k] + if k / nv == k % nv { ia[k / nv] } else { 0.0 })
+            .collect();
+        worst[0] = worst[0].max(rel_err(&m, &json_numbers(&s["M_rigid"]), 1e-12));
+        worst[1] = worst[1].max(rel_err(&with_rotors, &json_numbers(&s["M"]), 1e-12));
+        worst[2] = worst[2].max(rel_err(&bias, &json_numbers(&s["bias"]), 1e-12));
+    }
+    // Generated code refuses the followers, naming the MJCF element.
+    let why = dyngen_codegen::unsupported(&model).unwrap();
+    assert!(
+        why.starts_with("joint `twin` follows joint `elbow` (a URDF <mimic> or an MJCF <equality><joint>)"),
+        "{why}"
+    );
+    println!(
+        "equality.xml: max rel. error M {:.1e}, M + diag(Ia) {:.1e}, bias {:.1e}",
+        worst[0], worst[1], worst[2]
+    );
+    assert!(worst.iter().all(|&e| e <= 1e-12), "{worst:?}");
 }

@@ -3,8 +3,8 @@
 
 use crate::common::{Progress, Result};
 use crate::error::CliError;
-use crate::svg;
 use clap::Args;
+use dyngen_identify::report as svg;
 use dyngen_paper::{Hooks, LineChart, PaperError};
 use indicatif::ProgressBar;
 use std::path::PathBuf;

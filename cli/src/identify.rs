@@ -778,7 +778,6 @@ fn write_svg(
     let model = dyngen_reference::Dynamics::model(robot);
     let predicted = with_spinner(progress, "predicting torques", || identified.predict(robot, traj))
         .map_err(|e| pipeline_error(data, e))?;
-    let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
     let errors = match args.truth_from_urdf {
         true => {
             let errors = identified.errors(model);
@@ -792,15 +791,8 @@ fn write_svg(
         }
         false => None,
     };
-    let title = format!(
-        "{}: {} on {}",
-        model.name,
-        identified.report.method,
-        data.file_name()
-            .map_or_else(|| data.display().to_string(), |f| f.to_string_lossy().into_owned())
-    );
-    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    let svg = crate::svg::svg_report(&title, traj.t(), &measured, &predicted, &joint_names, errors.as_deref())
+    let method = &identified.report.method;
+    let svg = report::identification_report(model, method, data, traj, &predicted, errors.as_deref())
         .map_err(|e| CliError::report(path, e))?;
     report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
     outln!("wrote the SVG report to {}", path.display());

@@ -24,7 +24,6 @@ mod nim;
 mod partial;
 mod ranges;
 mod simulate;
-mod svg;
 mod validate;
 
 use clap::{Parser, Subcommand};

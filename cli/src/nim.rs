@@ -257,14 +257,14 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
             })
             .collect();
         let title = format!("{}: NIM training, RMS relative error of one window's θ", model.name);
-        let text = crate::svg::svg_lines(&crate::svg::LineChart {
+        let text = dyngen_identify::report::svg_lines(&dyngen_identify::report::LineChart {
             title: &title,
             x_label: "Adam step",
             y_label: "RMS relative error",
             log_y: true,
             curves: &curves,
             reference: None,
-            legend: crate::svg::Corner::UpperRight,
+            legend: dyngen_identify::report::Corner::UpperRight,
         })
         .map_err(|e| CliError::report(svg, e))?;
         report::write_new(svg, &text, args.force).map_err(|e| CliError::report(svg, e))?;

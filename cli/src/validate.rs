@@ -296,7 +296,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
             args.data.display(),
             100.0 * validation.overall
         );
-        let svg = crate::svg::svg_report(&title, data.t(), &measured, &predicted, &joints, None)
+        let svg = dyngen_identify::report::svg_report(&title, data.t(), &measured, &predicted, &joints, None)
             .map_err(|e| CliError::report(path, e))?;
         report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
         outln!("wrote the SVG to {}", path.display());

@@ -37,12 +37,16 @@ def identify(
     recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
     validate: Optional[Union[str, "os.PathLike[str]"]] = None,
     validate_recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+    report: Optional[Union[str, "os.PathLike[str]"]] = None,
+    overwrite: bool = False,
 ) -> Dict[str, Any]:
     """Identifies the robot's inertial parameters from a recording, as ``dyngen
     identify`` does: ``mode`` ``"standard"``, ``"principal"`` or ``"mim"``; ``method``
     ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
     ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
-    ``"stribeck-smooth"``. Returns ``names``, ``values``, ``sigma``,
+    ``"stribeck-smooth"``. ``report``: write ``dyngen identify --report``'s SVG there
+    (measured against predicted efforts per joint); an existing file raises
+    ``FileExistsError`` unless ``overwrite``. Returns ``names``, ``values``, ``sigma``,
     ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,
     ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
     ``warnings``. Raises :class:`LoadError` or ``ValueError``."""

@@ -153,6 +153,8 @@ impl Choices<'_> {
     recipe = None,
     validate = None,
     validate_recipe = None,
+    report = None,
+    overwrite = false,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
@@ -169,6 +171,8 @@ pub fn identify<'py>(
     recipe: Option<PathBuf>,
     validate: Option<PathBuf>,
     validate_recipe: Option<PathBuf>,
+    report: Option<PathBuf>,
+    overwrite: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     if validate_recipe.is_some() && validate.is_none() {
         return Err(PyValueError::new_err(
@@ -210,6 +214,17 @@ pub fn identify<'py>(
             pre.window = recipe.window_text();
             pre.data = Some(DataSpan::of(&data_path, &loaded.trajectory));
         }
+        // The SVG report of `dyngen identify --report`: measured against predicted
+        // efforts on the identification data.
+        if let Some(path) = &report {
+            let traj = &loaded.trajectory;
+            let predicted = identified.predict(&robot, traj).map_err(|e| failed(&data_path, e))?;
+            let method = &identified.report.method;
+            let svg =
+                dyngen_identify::report::identification_report(&model, method, &data_path, traj, &predicted, None)
+                    .map_err(|e| report_error(path, e))?;
+            dyngen_identify::report::write_report(path, &svg, overwrite).map_err(|e| report_error(path, e))?;
+        }
         let validation = match &validate {
             None => None,
             Some(path) => {
@@ -249,6 +264,16 @@ pub fn identify<'py>(
         out.set_item("validation", d)?;
     }
     Ok(out)
+}
+
+/// A report that could not be written: `FileExistsError` for a file kept (without
+/// `overwrite`), `OSError` otherwise.
+fn report_error(path: &Path, e: dyngen_identify::report::ReportError) -> PyErr {
+    let message = format!("identify: report {}: {e}", path.display());
+    match e {
+        dyngen_identify::report::ReportError::Exists { .. } => pyo3::exceptions::PyFileExistsError::new_err(message),
+        _ => pyo3::exceptions::PyOSError::new_err(message),
+    }
 }
 
 /// The recipe at `path`, or the default.

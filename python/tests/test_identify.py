@@ -101,3 +101,21 @@ def test_validate_recipe_needs_validate(recording):
     _, _, path = recording
     with pytest.raises(ValueError, match=re.escape("`validate_recipe` is the recipe of the `validate` recording")):
         dyngen.identify(ROBOTS[0][1], path, validate_recipe=path)
+
+
+def test_svg_report(recording, tmp_path):
+    """`report=` writes `dyngen identify --report`'s SVG: one plot per joint, never over
+    an existing file unless asked."""
+    _, _, path = recording
+    svg = tmp_path / "report.svg"
+    dyngen.identify(ROBOTS[0][1], path, raw_states=True, report=svg)
+    text = svg.read_text()
+    assert text.startswith("<svg") and text.rstrip().endswith("</svg>"), text[:80]
+    robot = dyngen.load(ROBOTS[0][1])
+    assert all(name in text for name in robot.joint_names)
+    assert "ur5.csv" in text
+    with pytest.raises(FileExistsError, match="report.svg: file exists"):
+        dyngen.identify(ROBOTS[0][1], path, raw_states=True, report=svg)
+    svg.write_text("kept?")
+    dyngen.identify(ROBOTS[0][1], path, raw_states=True, report=svg, overwrite=True)
+    assert svg.read_text().startswith("<svg")

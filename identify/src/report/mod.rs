@@ -1,7 +1,8 @@
 //! What identification hands to people and to other tools: the parameters as JSON
 //! ([`ParameterReport`]), the URDF rewritten with identified inertials
 //! ([`rewrite_urdf_inertials`]), and beside it the joint terms a URDF cannot hold
-//! ([`JointParamsFile`]). SVG charts are drawn by the command line.
+//! ([`JointParamsFile`]), and SVG charts drawn with plotters ([`svg_report`]: measured
+//! against predicted torques, [`svg_lines`]: any [`LineChart`]).
 //!
 //! Each output is built as a string with no I/O; [`write_new`] writes it and never
 //! replaces an existing file unless asked to.
@@ -10,6 +11,7 @@ mod chart;
 mod error;
 mod joint_params;
 mod json;
+mod svg;
 mod urdf;
 
 pub use chart::{Corner, LineChart};
@@ -19,6 +21,7 @@ pub use json::{
     CombinationReport, CoulombReport, DataSpan, NonPhysical, ParamReport, ParamStatus, ParameterReport,
     Parameterisation, PredictionModel, Preprocessing, Term, SCHEMA,
 };
+pub use svg::{identification_report, svg_lines, svg_report, svg_report_with, SvgOptions};
 pub use urdf::{rewrite_urdf_dynamics, rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;

@@ -10,7 +10,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor;
 
-use dyngen_identify::report::ReportError;
+use super::ReportError;
 
 const MEASURED: RGBColor = RGBColor(31, 119, 180);
 const PREDICTED: RGBColor = RGBColor(214, 39, 40);
@@ -66,6 +66,27 @@ pub fn svg_report(
         param_errors,
         &SvgOptions::default(),
     )
+}
+
+/// The report of an identification by `method` on the recording `data` (loaded as
+/// `traj`): its measured joint efforts against `predicted` (one row per sample), with
+/// the parameter errors when the truth is known; titled with the robot, the method and
+/// the file name, as `dyngen identify --report` and the Python package write it.
+pub fn identification_report(
+    model: &dyngen_model::Model,
+    method: &str,
+    data: &std::path::Path,
+    traj: &crate::data::Trajectory,
+    predicted: &[Vec<f64>],
+    param_errors: Option<&[(String, Option<f64>)]>,
+) -> Result<String, ReportError> {
+    let file = data
+        .file_name()
+        .map_or_else(|| data.display().to_string(), |f| f.to_string_lossy().into_owned());
+    let title = format!("{}: {method} on {file}", model.name);
+    let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
+    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    svg_report(&title, traj.t(), &measured, predicted, &joint_names, param_errors)
 }
 
 /// [`svg_report`] with explicit layout options.
@@ -307,7 +328,7 @@ fn error_chart(area: &DrawingArea<SVGBackend<'_>, Shift>, errors: &[(String, Opt
     Ok(())
 }
 
-pub use dyngen_identify::report::{Corner, LineChart};
+use super::{Corner, LineChart};
 
 /// Lines against a common x axis, e.g. the paper's Fig. 5 (MSE against training
 /// step, log scale) or estimates against time. Non-finite points, and points with
@@ -411,7 +432,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dyngen_identify::report::write_report;
+    use crate::report::write_report;
 
     #[test]
     fn svg_report_has_a_plot_per_joint_and_labels() {

@@ -1,6 +1,7 @@
 //! What a line chart shows, as plain data: the libraries describe their figures (the
-//! paper's Fig. 5, training curves, payload tracking) and a front end draws them
-//! (the command line as SVG), so no library links a plotting crate.
+//! paper's Fig. 5, training curves, payload tracking) and a front end draws them (as
+//! SVG through the `svg` feature's `svg_lines`), so no library links a plotting crate
+//! unless asked.
 
 /// A corner of a chart, for its legend.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -1,8 +1,8 @@
 //! What identification hands to people and to other tools: the parameters as JSON
 //! ([`ParameterReport`]), the URDF rewritten with identified inertials
 //! ([`rewrite_urdf_inertials`]), and beside it the joint terms a URDF cannot hold
-//! ([`JointParamsFile`]), and SVG charts drawn with plotters ([`svg_report`]: measured
-//! against predicted torques, [`svg_lines`]: any [`LineChart`]).
+//! ([`JointParamsFile`]), and with the `svg` feature SVG charts drawn with plotters
+//! (`svg_report`: measured against predicted torques, `svg_lines`: any [`LineChart`]).
 //!
 //! Each output is built as a string with no I/O; [`write_new`] writes it and never
 //! replaces an existing file unless asked to.
@@ -11,6 +11,7 @@ mod chart;
 mod error;
 mod joint_params;
 mod json;
+#[cfg(feature = "svg")]
 mod svg;
 mod urdf;
 
@@ -21,6 +22,7 @@ pub use json::{
     CombinationReport, CoulombReport, DataSpan, NonPhysical, ParamReport, ParamStatus, ParameterReport,
     Parameterisation, PredictionModel, Preprocessing, Term, SCHEMA,
 };
+#[cfg(feature = "svg")]
 pub use svg::{identification_report, svg_lines, svg_report, svg_report_with, SvgOptions};
 pub use urdf::{rewrite_urdf_dynamics, rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 

@@ -210,11 +210,12 @@ fn check_model(model: &Model) -> Result<(), String> {
         return Err(format!("standard parameter {k} is {}", params[k]));
     }
     let reference = Reference::new(model);
-    let n = model.dof();
+    // Coordinates as the model counts them (a follower of a <mimic> has none).
+    let (nq, nv) = (model.nq(), model.nv());
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     for _ in 0..3 {
-        let mut state = || (0..n).map(|_| rng.gen_range(-1.0..1.0)).collect::<Vec<f64>>();
-        let (q, v, a) = (state(), state(), state());
+        let mut state = |n: usize| (0..n).map(|_| rng.gen_range(-1.0..1.0)).collect::<Vec<f64>>();
+        let (q, v, a) = (state(nq), state(nv), state(nv));
         let tau = reference.rnea(&q, &v, &a, &params);
         if tau.iter().any(|x| !x.is_finite()) {
             return Err(format!("rnea({q:?}, {v:?}, {a:?}) = {tau:?}"));

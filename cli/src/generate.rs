@@ -64,8 +64,10 @@ pub struct GenerateArgs {
     /// crba, aba, frame_jacobian, …) or group (inverse_dynamics, mass_matrix,
     /// forward_dynamics, kinematics, regressors, joint_dynamics, frames, centroidal,
     /// derivatives); each brings its whole group, the type implements that group's
-    /// trait of `dyngen`. Default: all.
-    #[arg(long, value_name = "LIST", value_parser = parse_functions)]
+    /// trait of `dyngen`. Default: all (and always all with --python, whose module
+    /// exposes inverse and forward dynamics, the mass matrix, regressors, frames and
+    /// centroidal dynamics).
+    #[arg(long, value_name = "LIST", value_parser = parse_functions, conflicts_with = "python")]
     pub functions: Option<Selection>,
 
     #[command(flatten)]

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{assert_error, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
+use common::{assert_error, assert_exit, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
 
 #[test]
 fn help_has_examples() {
@@ -147,6 +147,19 @@ fn generate_writes_a_python_package() {
         &dir
     );
     assert_error(&o, "is not the `dyngen` crate");
+    assert!(!other.exists(), "nothing written after a refusal");
+    // The module exposes every group, so a selection of functions is refused.
+    let o = run!(
+        "generate",
+        ur5(),
+        "--name",
+        "Ur5",
+        "--python",
+        &other,
+        "--functions",
+        "rnea"
+    );
+    assert_exit(&o, 2, "cannot be used with");
     assert!(!other.exists(), "nothing written after a refusal");
     let o = run!(
         "generate",

@@ -64,8 +64,13 @@ def test_batched_kernels_match_pinocchio_and_the_run_time_model(ur5_module, ur5,
         (ur5_module.aba(q, v, tau), a),
         (ur5_module.joint_torque_regressor(q, v, a), ur5.joint_torque_regressor(q, v, a)),
         (ur5_module.rnea(q, v, a, params=2 * ur5.params), 2 * tau),
+        (ur5_module.centroidal_map(q), ur5.centroidal_map(q)),
+    ] + [
+        (ur5_module.frame_jacobian(q, "tool0", reference), ur5.frame_jacobian(q, "tool0", reference))
+        for reference in ("local_world_aligned", "local", "world")
     ]:
         assert np.max(np.abs(ours - theirs)) <= 1e-11 * scale(theirs)
+    assert ur5_module.FRAME_NAMES == ur5.frame_names
 
 
 def test_one_state_equals_its_row_and_threads_do_not_change_results(ur5_module, states):
@@ -93,3 +98,7 @@ def test_errors(ur5_module, states):
         ur5_module.rnea(q, v, a, params=np.zeros(59))
     with pytest.raises(ValueError, match="`threads` must be at least 1"):
         ur5_module.rnea(q, v, a, threads=0)
+    with pytest.raises(ValueError, match="frame_jacobian: no frame `hand`; the frames are base_link, "):
+        ur5_module.frame_jacobian(q, "hand")
+    with pytest.raises(ValueError, match="frame_jacobian: reference `global` is none of"):
+        ur5_module.frame_jacobian(q, "tool0", "global")

@@ -35,6 +35,9 @@ import os
 import numpy as np
 import pinocchio as pin
 
+from make_census_fixtures import inertial, link, robot
+from make_census_fixtures import joint as census_joint
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT_DIR = os.path.join(ROOT, "tests", "fixtures", "mimic")
 GENERATOR = "scripts/make_mimic_fixtures.py"
@@ -42,33 +45,13 @@ SAMPLES = 4
 SEED = 2611
 
 
-def inertial(mass, moments, products=(0.0, 0.0, 0.0), xyz=(0.0, 0.0, 0.0)):
-    ixx, iyy, izz = moments
-    ixy, ixz, iyz = products
-    return (
-        f'<inertial><origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}"/><mass value="{mass}"/>'
-        f'<inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/></inertial>'
-    )
-
-
-def link(name, body=""):
-    return f'  <link name="{name}">{body}</link>'
-
-
-def joint(name, kind, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=(0, 0, 1), mimic=None):
-    text = f'  <joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-    text += f'<origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}"/>'
-    text += f'<axis xyz="{axis[0]} {axis[1]} {axis[2]}"/>'
-    if kind in ("revolute", "prismatic"):
-        text += '<limit lower="-3" upper="3" effort="100" velocity="5"/>'
+def joint(name, kind, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=None, mimic=None):
+    """The census's joint, with a `<mimic>` of (leader, multiplier, offset)."""
+    extra = ""
     if mimic is not None:
         leader, multiplier, offset = mimic
-        text += f'<mimic joint="{leader}" multiplier="{multiplier}" offset="{offset}"/>'
-    return text + "</joint>"
-
-
-def robot(name, lines):
-    return f'<?xml version="1.0"?>\n<robot name="{name}">\n' + "\n".join(lines) + "\n</robot>\n"
+        extra = f'<mimic joint="{leader}" multiplier="{multiplier}" offset="{offset}"/>'
+    return census_joint(name, kind, parent, child, xyz, rpy, axis, extra)
 
 
 def body(m, spread=1.0, xyz=(0.0, 0.01, 0.03)):

@@ -70,6 +70,24 @@ def states(model):
     return out
 
 
+def mass_and_bias(model, data, qpos, qvel):
+    """MuJoCo's `M` (with armature), `M` without armature, and `qfrc_bias` at (qpos, qvel)."""
+    armature = model.dof_armature.copy()
+    data.qpos[:] = qpos
+    data.qvel[:] = qvel
+    mujoco.mj_forward(model, data)
+    m = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, m)
+    bias = data.qfrc_bias.copy()
+    model.dof_armature[:] = 0
+    mujoco.mj_forward(model, data)
+    m_rigid = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, m_rigid)
+    model.dof_armature[:] = armature
+    mujoco.mj_forward(model, data)
+    return m, m_rigid, bias
+
+
 def reference(xml_path):
     model = mujoco.MjModel.from_xml_path(xml_path)
     data = mujoco.MjData(model)
@@ -78,17 +96,7 @@ def reference(xml_path):
     armature = model.dof_armature.copy()
     samples = []
     for qpos, qvel in states(model):
-        data.qpos[:] = qpos
-        data.qvel[:] = qvel
-        mujoco.mj_forward(model, data)
-        m = np.zeros((model.nv, model.nv))
-        mujoco.mj_fullM(model, data, m)
-        bias = data.qfrc_bias.copy()
-        model.dof_armature[:] = 0
-        mujoco.mj_forward(model, data)
-        m_rigid = np.zeros((model.nv, model.nv))
-        mujoco.mj_fullM(model, data, m_rigid)
-        model.dof_armature[:] = armature
+        m, m_rigid, bias = mass_and_bias(model, data, qpos, qvel)
         assert np.allclose(m - m_rigid, np.diag(armature), atol=1e-14, rtol=0)
         samples.append({"q": to_dyngen_q(model, qpos).tolist(), "v": qvel.tolist(), "M": m.tolist(),
                         "M_rigid": m_rigid.tolist(), "bias": bias.tolist(),

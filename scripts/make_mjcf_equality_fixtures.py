@@ -48,6 +48,8 @@ import os
 import mujoco
 import numpy as np
 
+from make_mjcf_armature_fixtures import mass_and_bias
+
 XML = """<!--
   Written by scripts/make_mjcf_equality_fixtures.py: a tree with <equality><joint>
   couplings. Linear ones (lead leads mirror and the slide half; elbow leads twin,
@@ -143,21 +145,11 @@ def reference(path):
         q = np.array([model.qpos0[j] for j in own]) + 0.3 * np.sin(1.3 * kq + 0.2) + 0.1 * kq
         v = 0.7 * np.cos(1.9 * kq + 0.5) if s else np.zeros(len(own))
         qpos, qvel = e @ q + b, e @ v
-        data.qpos[:] = qpos
-        data.qvel[:] = qvel
-        mujoco.mj_forward(model, data)
+        m, m_rigid, bias = mass_and_bias(model, data, qpos, qvel)
         # The linear couplings hold exactly at qpos: MuJoCo's residuals are zero.
         for r in range(data.nefc):
             if data.efc_type[r] == mujoco.mjtConstraint.mjCNSTR_EQUALITY and data.efc_id[r] in linear:
                 assert abs(data.efc_pos[r]) < 1e-14, (s, data.efc_id[r], data.efc_pos[r])
-        m = np.zeros((model.nv, model.nv))
-        mujoco.mj_fullM(model, data, m)
-        bias = data.qfrc_bias.copy()
-        model.dof_armature[:] = 0
-        mujoco.mj_forward(model, data)
-        m_rigid = np.zeros((model.nv, model.nv))
-        mujoco.mj_fullM(model, data, m_rigid)
-        model.dof_armature[:] = armature
         samples.append({"q": q.tolist(), "v": v.tolist(), "qpos": qpos.tolist(), "qvel": qvel.tolist(),
                         "M": (e.T @ m @ e).tolist(), "M_rigid": (e.T @ m_rigid @ e).tolist(),
                         "bias": (e.T @ bias).tolist()})

@@ -43,6 +43,7 @@ pub fn frame_jacobian<S: Real>(
     jacobian.fill(workspace.zero());
     let offset: Se3<S> = crate::joint::constant_se3(c, frame);
     let placement = workspace.world[body].compose(&offset);
+    let reduction = multibody.reduction.as_deref();
     let mut i = body;
     while i != 0 {
         let j = &multibody.joints[i - 1];
@@ -57,7 +58,7 @@ pub fn frame_jacobian<S: Real>(
                 ReferenceFrame::Local => placement.inv_act_motion(world),
             };
             let d = j.v_offset + e;
-            match multibody.reduction.as_deref() {
+            match reduction {
                 None => {
                     for (r, x) in column.to_array().into_iter().enumerate() {
                         jacobian[r * nv + d] = x;

@@ -287,8 +287,6 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     let validation = validation(&model, &data, &predicted, Some(&args.params))?;
     outln!("{validation}\n{}", exact_overall(&validation));
     if let Some(path) = &args.svg {
-        let measured: Vec<Vec<f64>> = (0..data.len()).map(|k| data.tau(k).to_vec()).collect();
-        let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
         let title = format!(
             "{}: {} predicting {} ({:.2} % overall)",
             model.name,
@@ -296,7 +294,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
             args.data.display(),
             100.0 * validation.overall
         );
-        let svg = dyngen_identify::report::svg_report(&title, data.t(), &measured, &predicted, &joints, None)
+        let svg = report::trajectory_report(&title, &model, &data, &predicted, None)
             .map_err(|e| CliError::report(path, e))?;
         report::write_report(path, &svg, args.force).map_err(|e| CliError::report(path, e))?;
         outln!("wrote the SVG to {}", path.display());

@@ -300,32 +300,27 @@ impl Model {
 
     /// Number of position coordinates, `Σ nq` over the joints that follow no other.
     pub fn nq(&self) -> usize {
-        self.own(&self.joints).map(|j| j.kind.nq()).sum()
+        own(&self.joints).map(|j| j.kind.nq()).sum()
     }
 
     /// Number of velocity coordinates (degrees of freedom), `Σ nv` over the joints that
     /// follow no other.
     pub fn nv(&self) -> usize {
-        self.own(&self.joints).map(|j| j.kind.nv()).sum()
+        own(&self.joints).map(|j| j.kind.nv()).sum()
     }
 
     /// Index in `q` of joint `j`'s first position (1-based joint); a follower's is its
     /// leader's.
     pub fn q_offset(&self, j: usize) -> usize {
         let j = self.joints[j - 1].mimic.map_or(j, |m| m.leader);
-        self.own(&self.joints[..j - 1]).map(|j| j.kind.nq()).sum()
+        own(&self.joints[..j - 1]).map(|j| j.kind.nq()).sum()
     }
 
     /// Index in `v` of joint `j`'s first velocity (1-based joint); a follower's is its
     /// leader's.
     pub fn v_offset(&self, j: usize) -> usize {
         let j = self.joints[j - 1].mimic.map_or(j, |m| m.leader);
-        self.own(&self.joints[..j - 1]).map(|j| j.kind.nv()).sum()
-    }
-
-    /// The joints among `joints` with coordinates of their own (following no other).
-    fn own<'a>(&self, joints: &'a [Joint]) -> impl Iterator<Item = &'a Joint> {
-        joints.iter().filter(|j| j.mimic.is_none())
+        own(&self.joints[..j - 1]).map(|j| j.kind.nv()).sum()
     }
 
     /// The first joint that follows another (`<mimic>`), if any: what the layers that
@@ -427,4 +422,9 @@ impl Model {
         }
         false
     }
+}
+
+/// The joints among `joints` with coordinates of their own (following no other).
+fn own(joints: &[Joint]) -> impl Iterator<Item = &Joint> {
+    joints.iter().filter(|j| j.mimic.is_none())
 }

@@ -23,7 +23,7 @@ pub use json::{
     Parameterisation, PredictionModel, Preprocessing, Term, SCHEMA,
 };
 #[cfg(feature = "svg")]
-pub use svg::{identification_report, svg_lines, svg_report, svg_report_with, SvgOptions};
+pub use svg::{identification_report, svg_lines, svg_report, svg_report_with, trajectory_report, SvgOptions};
 pub use urdf::{rewrite_urdf_dynamics, rewrite_urdf_inertials, rewrite_urdf_inertials_with, MergedLinks};
 
 use std::io::Write;

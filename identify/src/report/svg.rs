@@ -84,9 +84,21 @@ pub fn identification_report(
         .file_name()
         .map_or_else(|| data.display().to_string(), |f| f.to_string_lossy().into_owned());
     let title = format!("{}: {method} on {file}", model.name);
+    trajectory_report(&title, model, traj, predicted, param_errors)
+}
+
+/// [`svg_report`] of a recording `traj` of `model`'s joints: its measured efforts
+/// against `predicted` (one row per sample).
+pub fn trajectory_report(
+    title: &str,
+    model: &dyngen_model::Model,
+    traj: &crate::data::Trajectory,
+    predicted: &[Vec<f64>],
+    param_errors: Option<&[(String, Option<f64>)]>,
+) -> Result<String, ReportError> {
     let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
     let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    svg_report(&title, traj.t(), &measured, predicted, &joint_names, param_errors)
+    svg_report(title, traj.t(), &measured, predicted, &joint_names, param_errors)
 }
 
 /// [`svg_report`] with explicit layout options.

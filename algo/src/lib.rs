@@ -77,7 +77,7 @@ pub use jacobian::{
 };
 pub use joint::{constant_se3, quaternion_rotation, Axis, Joint, JointPlacement, JointType, Rotation};
 pub use kinematics::{body_motions, forward_kinematics};
-pub use multibody::{JointSpec, Mimic, Multibody, TreeError, Workspace, MIMIC_CYCLE, PARAMS_PER_BODY};
+pub use multibody::{JointMimic, JointSpec, Mimic, Multibody, TreeError, Workspace, MIMIC_CYCLE, PARAMS_PER_BODY};
 pub use real::{polynomial_sin_cos, Precision, Real};
 pub use regressor::{force_regressor, joint_torque_regressor, joint_wrench_regressor};
 pub use rnea::rnea;

@@ -47,6 +47,31 @@ pub struct Mimic {
     pub offset: f64,
 }
 
+/// How a joint of a description follows another, in the 1-based joint numbering of
+/// the model layers (`dyngen_model::Model`, a generated robot's `RobotModel`): its
+/// coordinate is `multiplier · q_leader + offset`, its velocity and acceleration
+/// `multiplier` times the leader's. The leader follows no other joint (chains are
+/// resolved with [`Mimic::resolve`] when a model is built). [`Mimic`] is the same rule
+/// with both joints 0-based, as [`Multibody::with_mimics`] takes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointMimic {
+    pub leader: usize,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+impl JointMimic {
+    /// The rule of joint `joint` (1-based) for [`Multibody::with_mimics`].
+    pub fn of_joint(self, joint: usize) -> Mimic {
+        Mimic {
+            joint: joint - 1,
+            leader: self.leader - 1,
+            multiplier: self.multiplier,
+            offset: self.offset,
+        }
+    }
+}
+
 /// Why a joint in a cycle of followers cannot be resolved ([`Mimic::resolve`]).
 pub const MIMIC_CYCLE: &str = "its leaders, followed in turn, run in a cycle; one joint of the cycle must lead";
 

@@ -466,10 +466,10 @@ fn free_flyer_in_info_and_generate_and_refused_at_run_time() {
 }
 
 #[test]
-fn mimic_robots_load_where_supported_and_are_refused_by_name_elsewhere() {
+fn mimic_robots_load_generate_and_are_refused_by_name_elsewhere() {
     let gripper =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/mimic/arm_linkage_gripper.urdf");
-    // info: the coordinates, each follower's rule, the base parameters; no generated code.
+    // info: the coordinates, each follower's rule, the base parameters, the generated functions.
     let o = run!("info", gripper);
     assert_ok(&o);
     let out = stdout(&o);
@@ -479,14 +479,16 @@ fn mimic_robots_load_where_supported_and_are_refused_by_name_elsewhere() {
     );
     assert!(out.contains("left_inner_finger_joint = -1 · finger_joint + 0"), "{out}");
     assert!(out.contains("Base parameters (standard)"), "{out}");
+    assert!(out.contains("Generated functions (operation counts)"), "{out}");
+    // generate: the followers in the model it carries; identify refuses, saying why.
+    let o = run!("generate", gripper, "--name", "Gripper");
+    assert_ok(&o);
+    let code = stdout(&o);
+    assert!(code.contains("pub struct Gripper"), "{}", &code[..code.len().min(2000)]);
     assert!(
-        out.contains("Generated functions: none (joint `left_inner_finger_joint` follows joint `finger_joint`"),
-        "{out}"
+        code.contains("multiplier: -1.0"),
+        "the followers' rules are in Gripper::MODEL"
     );
-    // generate and identify refuse it, saying what to do instead.
-    let why =
-        "follows joint `finger_joint` (a URDF <mimic> or an MJCF <equality><joint>), which generated code does not support yet; load the robot at run time";
-    assert_error(&run!("generate", gripper, "--name", "Gripper"), why);
     let dir = temp_dir("cli", "mimic");
     let data = dir.join("data.csv");
     std::fs::write(&data, "t,q1\n0,0\n").unwrap();

@@ -18,6 +18,7 @@
 use crate::algo::{BodyParams, JointTransform, ARG_A, ARG_PARAMS, ARG_Q, ARG_V, M3, V3};
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
 use crate::generate::{doc_attrs, Record, Sizes};
+use crate::mimic::Block;
 use crate::sym::{Expr, Graph, NodeId};
 use dyngen_model::{JointKind, Model};
 use proc_macro2::TokenStream;
@@ -523,7 +524,9 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let assemble_pose = |outs: &[TokenStream]| Record::Pose.build(outs);
 
     // Per frame: placement, Jacobian, motion; private, dispatched by the enum.
-    let large = n > above;
+    // The composition of a large tree's Jacobians puts each coordinate's axis in its
+    // column, which a leader moving bodies off its own path does not have.
+    let large = n > above && !crate::mimic::has_followers(model);
     let mut placement_fns = Vec::new();
     let mut jacobian_fns = Vec::new();
     let mut jacobian_dot_fns = Vec::new();
@@ -549,7 +552,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         let mut t = TokenStream::new();
         if !large {
             let g = Graph::new();
-            let outputs = build_placement(&g, model, f);
+            let outputs = crate::mimic::build(&g, model, &[Block::Plain(12)], |g, model| build_placement(g, model, f));
             let spec = FnSpec {
                 name: &pn,
                 public: false,
@@ -563,7 +566,9 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         }
 
         let g = Graph::new();
-        let outputs = build_jacobian(&g, model, f);
+        let outputs = crate::mimic::build(&g, model, &[Block::Plain(12), Block::Cols { rows: 6 }], |g, model| {
+            build_jacobian(g, model, f)
+        });
         let place = move |k: usize| {
             if k < 9 {
                 let (r, c) = (emit::usize_lit(k / 3), emit::usize_lit(k % 3));
@@ -603,7 +608,10 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
             continue;
         }
         let g = Graph::new();
-        let outputs = build_jacobian_time_variation(&g, model, f);
+        let layout = [Block::Plain(12), Block::Cols { rows: 6 }, Block::Cols { rows: 6 }];
+        let outputs = crate::mimic::build(&g, model, &layout, |g, model| {
+            build_jacobian_time_variation(g, model, f)
+        });
         let spec = FnSpec {
             name: &dn,
             public: false,
@@ -623,7 +631,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
         t.extend(emit_one(spec, &g, format!("frame_jacobian_time_variation[{label}]")));
 
         let g = Graph::new();
-        let outputs = build_motion(&g, model, f);
+        let outputs = crate::mimic::build(&g, model, &[Block::Plain(24)], |g, model| build_motion(g, model, f));
         let assemble = |o: &[TokenStream]| {
             let pose = Record::Pose.build(&o[..12]);
             let m = |s: &[TokenStream]| {
@@ -697,7 +705,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
 
     // All placements at once, and the centre of mass.
     let g = Graph::new();
-    let outputs = build_placements(&g, model);
+    let outputs = crate::mimic::build(&g, model, &[Block::Plain(12 * nf)], build_placements);
     let spec = FnSpec {
         name: "frame_placements",
         public: true,
@@ -716,7 +724,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
 
     let params = || arg(ARG_PARAMS, "params", 10 * sizes.n);
     let g = Graph::new();
-    let outputs = build_com(&g, model);
+    let outputs = crate::mimic::build(&g, model, &[Block::Plain(3)], build_com);
     let spec = FnSpec {
         name: "center_of_mass",
         public: true,
@@ -732,7 +740,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let com = emit_one(spec, &g, "center_of_mass".to_string());
 
     let g = Graph::new();
-    let outputs = build_com_jacobian(&g, model);
+    let outputs = crate::mimic::build(&g, model, &[Block::Cols { rows: 3 }], build_com_jacobian);
     let spec = FnSpec {
         name: "com_jacobian",
         public: true,
@@ -748,7 +756,7 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let com_jacobian = emit_one(spec, &g, "com_jacobian".to_string());
 
     let g = Graph::new();
-    let outputs = build_centroidal_map(&g, model);
+    let outputs = crate::mimic::build(&g, model, &[Block::Cols { rows: 6 }], build_centroidal_map);
     let spec = FnSpec {
         name: "centroidal_map",
         public: true,
@@ -764,7 +772,8 @@ pub(crate) fn generate(model: &Model, ty: &syn::Ident, sizes: &Sizes, options: &
     let centroidal = emit_one(spec, &g, "centroidal_map".to_string());
 
     let g = Graph::new();
-    let outputs = build_centroidal_map_time_variation(&g, model);
+    let layout = [Block::Cols { rows: 6 }; 2];
+    let outputs = crate::mimic::build(&g, model, &layout, build_centroidal_map_time_variation);
     let spec = FnSpec {
         name: "centroidal_map_time_variation",
         public: true,

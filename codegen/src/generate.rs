@@ -9,6 +9,7 @@ use crate::algo::{self, Force, Inputs, ARG_A, ARG_JOINT_PARAMS, ARG_PARAMS, ARG_
 use crate::base::{BaseParams, Bases};
 use crate::capability::{Capability, Selection};
 use crate::emit::{self, Arg, FnReport, FnSpec, Output};
+use crate::mimic::Block;
 use crate::sym::{Expr, Graph, NodeId};
 use dyngen_model::Model;
 use proc_macro2::TokenStream;
@@ -783,7 +784,24 @@ impl Algorithm {
             args: self.args.iter().map(|a| a.arg(sizes)).collect(),
             ret,
             output,
-            outputs: (self.build)(g, model, bases),
+            outputs: crate::mimic::build(g, model, &[self.layout(sizes)], |g, model| {
+                (self.build)(g, model, bases)
+            }),
+        }
+    }
+
+    /// How its outputs go by velocity coordinate (see [`crate::mimic`]).
+    fn layout(&self, sizes: &Sizes) -> Block {
+        match self.shape {
+            Shape::Vector(Len::V) => Block::Rows { cols: 1 },
+            Shape::Vector(len) => Block::Plain(sizes.of(len)),
+            Shape::PerBody(record) => Block::Plain(sizes.n * record.outputs()),
+            Shape::Matrix {
+                rows: Len::V,
+                cols: Len::V,
+            } => Block::Both,
+            Shape::Matrix { rows: Len::V, cols } => Block::Rows { cols: sizes.of(cols) },
+            Shape::Matrix { rows, cols } => Block::Plain(sizes.of(rows) * sizes.of(cols)),
         }
     }
 
@@ -849,7 +867,8 @@ impl Algorithm {
 /// always has its own graph: without rotor inertias the articulated inertia passed to
 /// the parent has zero rows along the joint axes, which the one with them lacks.
 fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -> Option<TokenStream> {
-    if sizes.nv <= above {
+    let followers = crate::mimic::has_followers(model);
+    if sizes.nv <= above && !(followers && algorithm.name == "aba") {
         return None;
     }
     let [n_l, nq_l, np_l] = [sizes.nv, sizes.nq, 10 * sizes.n].map(emit::usize_lit);
@@ -873,6 +892,26 @@ fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -
         )
     };
     let (params, ret, body, how) = match algorithm.name {
+        "aba" if followers => {
+            let ancestors = crate::joints::ancestors(model);
+            (
+                quote!(q: &[S; #nq_l], v: &[S; #n_l], tau: &[S; #n_l], params: &[S; #np_l]),
+                quote!(-> [S; #n_l]),
+                quote! {
+                    #ancestors
+                    let mut m = [[#zero; #n_l]; #n_l];
+                    Self::crba(q, params, &mut m);
+                    let h = Self::nonlinear_effects(q, v, params);
+                    let mut a = *tau;
+                    for j in 0..#n_l {
+                        a[j] -= h[j];
+                    }
+                    ::dyngen::__private::tree_ldl_solve(&ANCESTORS, &mut m, &mut a);
+                    a
+                },
+                "`M` of [`Self::crba`] and `h` of [`Self::nonlinear_effects`], solved by a dense `LᵀDL`\nfactorisation (joints follow others: a leader moves bodies off its own path, and\nthe articulated-body recursion does not apply)".to_string(),
+            )
+        }
         "nonlinear_effects" => (
             quote!(q: &[S; #nq_l], v: &[S; #n_l], params: &[S; #np_l]),
             quote!(-> [S; #n_l]),
@@ -908,10 +947,12 @@ fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -
         _ => return None,
     };
     let fname = format_ident!("{}", algorithm.name);
-    let doc = doc_attrs(&format!(
-        "{}\n\nComposed (a robot of more than {above} velocity coordinates): {how}.",
-        (algorithm.doc)(sizes)
-    ));
+    let why = if sizes.nv > above {
+        format!("Composed (a robot of more than {above} velocity coordinates)")
+    } else {
+        "Composed".to_string()
+    };
+    let doc = doc_attrs(&format!("{}\n\n{why}: {how}.", (algorithm.doc)(sizes)));
     Some(quote! {
         #doc
         #[inline]
@@ -935,7 +976,12 @@ pub fn generate(model: &Model, name: &str, bases: &Bases, options: &Options) -> 
     };
     let ty = format_ident!("{}", name);
     let home = emit::home(&ty);
-    let selected = options.functions.closure();
+    let mut selected = options.functions.closure();
+    if crate::mimic::has_followers(model) && selected.contains(Capability::ForwardDynamics) {
+        // Forward dynamics then solves `M a = τ − h` (see `composed`).
+        selected.insert(Capability::MassMatrix);
+        selected.insert(Capability::InverseDynamics);
+    }
     let mut functions = Vec::new();
     let mut items = Vec::new();
     let mut bodies = Vec::new();
@@ -1088,10 +1134,13 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
     let mut reports = Vec::new();
 
     let g = Graph::new();
-    let d = derivatives::rnea_derivatives(&g, model);
-    let mut outputs = ids(&d.dtau_dq);
-    outputs.extend(ids(&d.dtau_dv));
-    outputs.extend(ids(&d.m));
+    let outputs = crate::mimic::build(&g, model, &[Block::Both; 3], |g, model| {
+        let d = derivatives::rnea_derivatives(g, model);
+        let mut outputs = ids(&d.dtau_dq);
+        outputs.extend(ids(&d.dtau_dv));
+        outputs.extend(ids(&d.m));
+        outputs
+    });
     let spec = FnSpec {
         name: "rnea_derivatives",
         public: true,
@@ -1115,7 +1164,13 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
     // derivatives with the joint models their armature.
     let nj_l = emit::usize_lit(4 * n);
     let g = Graph::new();
-    let mut m = algo::crba(&g, model);
+    let crba = crate::mimic::build(&g, model, &[Block::Both], |g, model| {
+        algo::crba(g, model).iter().flatten().map(|x| x.id()).collect()
+    });
+    let mut m: Vec<Vec<Expr<'_>>> = crba
+        .chunks(n)
+        .map(|row| row.iter().map(|&id| g.expr(id)).collect())
+        .collect();
     for (i, row) in m.iter_mut().enumerate() {
         row[i] = row[i] + g.input(algo::ARG_JOINT_PARAMS, (4 * i) as u32);
     }
@@ -1157,7 +1212,9 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
     // Forward dynamics and its derivatives. `driving` is τ (friction taken off, with
     // the joint models); each path leaves `∂τ/∂q`, `∂τ/∂v` at `a = q̈` in `dq`, `dv`,
     // `slope` adds friction's `∂/∂v` to `dv`, then the products by `−M⁻¹` run as loops.
-    let forward = if n > above {
+    // Joints that follow others: `M⁻¹` and forward dynamics are dense (`crate::mimic`).
+    let compose = n > above || crate::mimic::has_followers(model);
+    let forward = if compose {
         // Composed of the functions above, so a large tree carries one copy of each:
         // `M⁻¹` (with the rotor inertias), `q̈ = M⁻¹ (τ − h)`, rnea derivatives at `q̈`.
         let products = times_minus_minv(model, quote!(&d.dtau_dq), quote!(&d.dtau_dv));
@@ -1218,8 +1275,8 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
     let plain = forward(zeros, TokenStream::new());
     let aba_doc = doc_attrs(&format!(
         "Forward dynamics and its derivatives (Pinocchio's `computeABADerivatives`):\n`ddq = M⁻¹ (tau − h(q, v))`, `∂q̈/∂q = −M⁻¹ ∂τ/∂q`, `∂q̈/∂v = −M⁻¹ ∂τ/∂v` (at\n`a = ddq`) and `∂q̈/∂τ = M⁻¹`, written to `out`. {}; the products with `M⁻¹` run as\nloops. `AbaDerivatives::semi_implicit_euler` linearises one time step from it.\n`q, v, tau`: {n} positions, velocities, joint torques or forces; {}.",
-        if n > above {
-            "Composed of [`Self::inverse_inertia`], [`Self::nonlinear_effects`] and\n[`Self::rnea_derivatives`] (a large tree: one copy of their code)"
+        if compose {
+            "Composed of [`Self::inverse_inertia`], [`Self::nonlinear_effects`] and\n[`Self::rnea_derivatives`] (a large tree, or joints that follow others: one copy of\ntheir code)"
         } else {
             "`M⁻¹` from the tree's `LᵀDL` factorisation (no fill-in;\none division per velocity coordinate), `∂τ/∂q` and `∂τ/∂v` in closed form"
         },
@@ -1282,10 +1339,9 @@ fn derivative_items(model: &Model, sizes: &Sizes, options: &Options, home: &proc
 /// the tree has branches, dense loops when every pair of coordinates shares a path.
 fn times_minus_minv(model: &Model, dq: TokenStream, dv: TokenStream) -> TokenStream {
     let nv = model.nv();
-    let on_path = |a: usize, b: usize| {
-        let (ja, jb) = (model.joint_of_v(a), model.joint_of_v(b));
-        model.supports(ja, jb) || model.supports(jb, ja)
-    };
+    let parents = model.coordinate_parents();
+    let supports = |a: usize, b: usize| std::iter::successors(Some(b), |&c| parents[c]).any(|c| c == a);
+    let on_path = |a: usize, b: usize| supports(a, b) || supports(b, a);
     let support: Vec<Vec<usize>> = (0..nv).map(|c| (0..nv).filter(|&k| on_path(k, c)).collect()).collect();
     if support.iter().all(|rows| rows.len() == nv) {
         return quote!(::dyngen::__private::times_minus_minv(out, #dq, #dv););
@@ -1381,6 +1437,14 @@ fn model_expr(model: &Model) -> TokenStream {
         let armature = emit::f64_lit(j.dynamics.armature);
         let damping = emit::f64_lit(j.dynamics.damping);
         let friction = emit::f64_lit(j.dynamics.friction);
+        let mimic = match j.mimic {
+            Some(m) => {
+                let leader = emit::usize_lit(m.leader);
+                let [multiplier, offset] = [m.multiplier, m.offset].map(emit::f64_lit);
+                quote!(::core::option::Option::Some(::dyngen::JointMimic { leader: #leader, multiplier: #multiplier, offset: #offset }))
+            }
+            None => quote!(::core::option::Option::None),
+        };
         quote!(::dyngen::JointModel {
             name: #name,
             kind: ::dyngen::JointType::#kind,
@@ -1392,6 +1456,7 @@ fn model_expr(model: &Model) -> TokenStream {
             armature: #armature,
             damping: #damping,
             friction: #friction,
+            mimic: #mimic,
         })
     });
     let bodies = model.bodies.iter().map(|b| {

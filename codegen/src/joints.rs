@@ -39,6 +39,18 @@ fn doc(text: &str) -> TokenStream {
 /// The joint functions of the robot type and their `dyngen::JointDynamics` methods. On a robot of more
 /// than `compose_above` velocity coordinates `aba_joints` is composed of other
 /// functions rather than generated.
+/// `const ANCESTORS`: each velocity coordinate's ancestors in
+/// [`Model::coordinate_parents`], nearest first, for `dyngen::__private::tree_ldl_solve`.
+pub(crate) fn ancestors(model: &Model) -> TokenStream {
+    let parents = model.coordinate_parents();
+    let ancestors = (0..parents.len()).map(|d| {
+        let up = std::iter::successors(parents[d], |&p| parents[p]).map(emit::usize_lit);
+        quote!(&[#(#up),*])
+    });
+    let n_l = emit::usize_lit(parents.len());
+    quote!(const ANCESTORS: [&[usize]; #n_l] = [#(#ancestors),*];)
+}
+
 pub(crate) fn generate(
     model: &Model,
     bases: &Bases,
@@ -47,7 +59,10 @@ pub(crate) fn generate(
     compose_above: usize,
     home: &proc_macro2::Ident,
 ) -> JointFns {
-    let compose = sizes.nv > compose_above;
+    // Joints that follow others: the articulated-body recursion does not apply, and
+    // `M + diag(Ia)` is solved densely (`crate::mimic`).
+    let followers = crate::mimic::has_followers(model);
+    let compose = sizes.nv > compose_above || followers;
     // Rows and joint parameters go by velocity coordinate; parameters by body.
     let n = sizes.nv;
     let (np, nj, nb, nbj) = (10 * sizes.n, 4 * n, sizes.nb, sizes.nbj);
@@ -119,7 +134,9 @@ pub(crate) fn generate(
         sizes.params(),
         sizes.joint_params()
     ));
-    let aba_how = if compose {
+    let aba_how = if followers {
+        "`M + diag(Ia)` of [`Self::crba_joints`] and `h` of\n[`Self::nonlinear_effects`], solved by a dense `LᵀDL` factorisation (joints follow\nothers)".to_string()
+    } else if compose {
         format!(
             "`M + diag(Ia)` of [`Self::crba_joints`] and `h` of\n[`Self::nonlinear_effects`], solved by the tree's `LᵀDL` factorisation (no fill-in;\ncomposed, a robot of more than {compose_above} velocity coordinates)"
         )
@@ -133,13 +150,9 @@ pub(crate) fn generate(
         coulomb_doc
     ));
     let aba_body = if compose {
-        let parents = model.coordinate_parents();
-        let ancestors = (0..n).map(|d| {
-            let up = std::iter::successors(parents[d], |&p| parents[p]).map(emit::usize_lit);
-            quote!(&[#(#up),*])
-        });
+        let ancestors = ancestors(model);
         quote! {
-            const ANCESTORS: [&[usize]; #n_l] = [#(#ancestors),*];
+            #ancestors
             let mut m = [[#s::ZERO; #n_l]; #n_l];
             Self::crba_joints(q, params, joint_params, &mut m);
             let h = Self::nonlinear_effects(q, v, params);

@@ -216,6 +216,42 @@ impl Graph {
         outputs.iter().map(|&o| tan[o as usize]).collect()
     }
 
+    /// The outputs rebuilt with inputs replaced: `replace(arg, index)` gives the new
+    /// expression of an input (`None` keeps it). Every node of the outputs' cone is
+    /// rebuilt through the folding operators, in id order, and the sections are marked
+    /// again where they start, so the emitted code keeps its labels.
+    pub fn substitute<'g>(&'g self, outputs: &[NodeId], replace: impl Fn(u8, u32) -> Option<Expr<'g>>) -> Vec<NodeId> {
+        let live = self.live(outputs);
+        let marks = self.sections();
+        let (mut next_mark, mut label) = (0, None);
+        let mut new: Vec<NodeId> = (0..live.len() as NodeId).collect();
+        for (id, &l) in live.iter().enumerate() {
+            while marks.get(next_mark).is_some_and(|(start, _)| *start as usize <= id) {
+                label = Some(marks[next_mark].1.clone());
+                next_mark += 1;
+            }
+            if !l {
+                continue;
+            }
+            if let Some(label) = label.take() {
+                self.mark(label);
+            }
+            let e = |x: NodeId| self.expr(new[x as usize]);
+            new[id] = match self.node(id as NodeId) {
+                Node::Const(_) => id as NodeId,
+                Node::Input { arg, index } => replace(arg, index).map_or(id as NodeId, |x| x.id),
+                Node::Add(a, b) => (e(a) + e(b)).id,
+                Node::Sub(a, b) => (e(a) - e(b)).id,
+                Node::Mul(a, b) => (e(a) * e(b)).id,
+                Node::Div(a, b) => (e(a) / e(b)).id,
+                Node::Neg(a) => (-e(a)).id,
+                Node::Sin(a) => e(a).sin().id,
+                Node::Cos(a) => e(a).cos().id,
+            };
+        }
+        outputs.iter().map(|&o| new[o as usize]).collect()
+    }
+
     /// Which nodes the outputs depend on.
     pub fn live(&self, outputs: &[NodeId]) -> Vec<bool> {
         let nodes = self.nodes.borrow();

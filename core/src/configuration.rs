@@ -7,7 +7,9 @@
 //! # Layout
 //!
 //! Coordinates are laid out joint after joint in [`RobotModel::joints`] order, `nq` of
-//! them for positions and `nv` for velocities ([`JointType::nq`], [`JointType::nv`]):
+//! them for positions and `nv` for velocities ([`JointType::nq`], [`JointType::nv`]);
+//! a joint that follows another ([`JointModel::mimic`](crate::JointModel)) has none
+//! ([`RobotModel::own_joints`]):
 //!
 //! | joint | `q` | `v` |
 //! |---|---|---|
@@ -64,6 +66,7 @@
 //!             armature: 0.0,
 //!             damping: 0.0,
 //!             friction: 0.0,
+//!             mimic: None,
 //!         },
 //!         JointModel {
 //!             name: "hinge",
@@ -76,6 +79,7 @@
 //!             armature: 0.0,
 //!             damping: 0.0,
 //!             friction: 0.0,
+//!             mimic: None,
 //!         },
 //!     ],
 //!     bodies: &[BodyModel { name: "base", ..BODY }, BodyModel { name: "pendulum", ..BODY }],
@@ -193,7 +197,7 @@ pub fn integrate<S: OrderedScalar>(
     check_length("v", v.len(), nv)?;
     check_length("out", out.len(), nq)?;
     let (mut iq, mut iv) = (0, 0);
-    for (j, joint) in model.joints.iter().enumerate() {
+    for (j, joint) in model.own_joints() {
         let (kq, kv) = (joint.kind.nq(), joint.kind.nv());
         let (q, v, out) = (&q[iq..iq + kq], &v[iv..iv + kv], &mut out[iq..iq + kq]);
         match joint.kind {
@@ -273,7 +277,7 @@ pub fn difference<S: OrderedScalar>(
     check_length("q1", q1.len(), nq)?;
     check_length("out", out.len(), nv)?;
     let (mut iq, mut iv) = (0, 0);
-    for (j, joint) in model.joints.iter().enumerate() {
+    for (j, joint) in model.own_joints() {
         let (kq, kv) = (joint.kind.nq(), joint.kind.nv());
         let (a, b, out) = (&q0[iq..iq + kq], &q1[iq..iq + kq], &mut out[iv..iv + kv]);
         match joint.kind {
@@ -325,7 +329,7 @@ pub fn neutral<S: OrderedScalar>(model: &RobotModel, out: &mut [S]) -> Result<()
     let (nq, _) = dimensions(model);
     check_length("out", out.len(), nq)?;
     let mut iq = 0;
-    for joint in model.joints {
+    for (_, joint) in model.own_joints() {
         let k = joint.kind.nq();
         let out = &mut out[iq..iq + k];
         out.fill(S::ZERO);
@@ -352,7 +356,7 @@ pub fn normalize<S: OrderedScalar>(model: &RobotModel, q: &mut [S]) -> Result<()
     let (nq, _) = dimensions(model);
     check_length("q", q.len(), nq)?;
     let mut iq = 0;
-    for (j, joint) in model.joints.iter().enumerate() {
+    for (j, joint) in model.own_joints() {
         let k = joint.kind.nq();
         let q = &mut q[iq..iq + k];
         if matches!(joint.kind, JointType::Spherical | JointType::FreeFlyer) {
@@ -459,9 +463,8 @@ pub fn matrix_to_quaternion<S: OrderedScalar>(r: &Matrix3<S>) -> [S; 4] {
 /// `(nq, nv)` of the model.
 fn dimensions(model: &RobotModel) -> (usize, usize) {
     model
-        .joints
-        .iter()
-        .fold((0, 0), |(nq, nv), j| (nq + j.kind.nq(), nv + j.kind.nv()))
+        .own_joints()
+        .fold((0, 0), |(nq, nv), (_, j)| (nq + j.kind.nq(), nv + j.kind.nv()))
 }
 
 fn check_length(argument: &'static str, found: usize, expected: usize) -> Result<(), ConfigurationError> {

@@ -48,7 +48,7 @@ pub use robot::{
     BodyRegressor, Centroidal, Derivatives, ForwardDynamics, Frames, InverseDynamics, JointDynamics, Kinematics,
     MassMatrix, NotFinite, OpCount, Pose, Regressors, Robot, RobotDescription, Wrench,
 };
-pub use robot_model::{BodyModel, FrameModel, JointLimits, JointModel, JointType, RobotModel};
+pub use robot_model::{BodyModel, FrameModel, JointLimits, JointMimic, JointModel, JointType, RobotModel};
 pub use scalar::{OrderedScalar, Scalar};
 
 /// The traits a generated robot implements, to bring their methods into scope at

@@ -5,6 +5,10 @@
 /// What a joint allows: one enum for every layer, the algorithms' own.
 pub use dyngen_algo::JointType;
 
+/// How a joint follows another (URDF `<mimic>`, MJCF `<equality><joint>`), the leader
+/// 1-based.
+pub use dyngen_algo::JointMimic;
+
 /// Joint position, velocity and effort limits (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointLimits {
@@ -36,6 +40,9 @@ pub struct JointModel {
     pub damping: f64,
     /// Nominal Coulomb friction `Fc` (URDF `<dynamics friction>`): `τ += Fc·sign(q̇)`.
     pub friction: f64,
+    /// The joint this one follows: then it has no coordinate of its own, its position
+    /// being `multiplier · q_leader + offset`.
+    pub mimic: Option<JointMimic>,
 }
 
 /// One moving body; its frame is its joint's frame.
@@ -84,5 +91,12 @@ impl RobotModel {
     /// The index in [`RobotModel::frames`] of the frame named `name`.
     pub fn frame_index(&self, name: &str) -> Option<usize> {
         self.frames.iter().position(|f| f.name == name)
+    }
+
+    /// The joints with coordinates of their own (every joint but those that follow
+    /// another), with their 0-based index in [`RobotModel::joints`], in the order of
+    /// their coordinates in `q` and `v`.
+    pub fn own_joints(&self) -> impl Iterator<Item = (usize, &JointModel)> {
+        self.joints.iter().enumerate().filter(|(_, j)| j.mimic.is_none())
     }
 }

@@ -34,6 +34,7 @@ const fn joint(name: &'static str, kind: JointType, parent: usize) -> JointModel
         armature: 0.0,
         damping: 0.0,
         friction: 0.0,
+        mimic: None,
     }
 }
 
@@ -769,4 +770,51 @@ impl Parser<'_> {
             }
         }
     }
+}
+
+/// A joint that follows another has no coordinate: the operations skip it, so `q` and
+/// `v` hold the leaders' coordinates only (a revolute leader, its follower, a ball).
+#[test]
+fn followers_have_no_coordinates() {
+    const FOLLOWING: RobotModel = RobotModel {
+        name: "following",
+        gravity: [0.0, 0.0, -9.81],
+        base: "world",
+        joints: &[
+            joint("leader", JointType::Revolute, 0),
+            JointModel {
+                mimic: Some(dyngen::JointMimic {
+                    leader: 1,
+                    multiplier: -2.0,
+                    offset: 0.5,
+                }),
+                ..joint("follower", JointType::Revolute, 1)
+            },
+            joint("ball", JointType::Spherical, 2),
+        ],
+        bodies: &[BODY; 3],
+        frames: &[],
+    };
+    assert_eq!(FOLLOWING.own_joints().map(|(j, _)| j).collect::<Vec<_>>(), [0, 2]);
+    let mut q = [0.0; 5];
+    neutral(&FOLLOWING, &mut q).unwrap();
+    assert_eq!(q, [0.0, 0.0, 0.0, 0.0, 1.0]);
+    let mut out = [0.0; 5];
+    integrate(&FOLLOWING, &q, &[0.25, 0.0, 0.0, 0.0], &mut out).unwrap();
+    assert_eq!(out, [0.25, 0.0, 0.0, 0.0, 1.0]);
+    let mut v = [0.0; 4];
+    difference(&FOLLOWING, &q, &out, &mut v).unwrap();
+    assert_eq!(v, [0.25, 0.0, 0.0, 0.0]);
+    let wrong = integrate(&FOLLOWING, &[0.0; 6], &[0.0; 4], &mut [0.0; 6]);
+    assert!(
+        matches!(
+            wrong,
+            Err(ConfigurationError::Length {
+                argument: "q",
+                expected: 5,
+                found: 6
+            })
+        ),
+        "{wrong:?}"
+    );
 }

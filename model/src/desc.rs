@@ -4,7 +4,7 @@
 //! declaration order, or by joint name as Pinocchio and urdfdom number them).
 
 use crate::error::{Element, ErrorKind, ModelError};
-use crate::ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Mimic, Model, Placement};
+use crate::ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, JointMimic, Limits, Model, Placement};
 use crate::math;
 use std::collections::HashMap;
 
@@ -617,7 +617,7 @@ impl Description {
                     m.multiplier, m.offset
                 ));
             } else {
-                model.joints[f].mimic = Some(Mimic {
+                model.joints[f].mimic = Some(JointMimic {
                     leader: l + 1,
                     multiplier: m.multiplier,
                     offset: m.offset,
@@ -628,7 +628,7 @@ impl Description {
         match dyngen_algo::Mimic::resolve(&model.algo_mimics(), model.joints.len()) {
             Ok(resolved) => {
                 for r in resolved {
-                    model.joints[r.joint].mimic = Some(Mimic {
+                    model.joints[r.joint].mimic = Some(JointMimic {
                         leader: r.leader + 1,
                         multiplier: r.multiplier,
                         offset: r.offset,

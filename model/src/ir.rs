@@ -208,20 +208,13 @@ pub struct Joint {
     /// The joint this one follows (URDF `<mimic>`, MJCF `<equality><joint>`): then it
     /// has no coordinate of its own, its coordinate being `multiplier · q_leader +
     /// offset`.
-    pub mimic: Option<Mimic>,
+    pub mimic: Option<JointMimic>,
 }
 
 /// How a joint follows another (URDF `<mimic>`, a linear MJCF `<equality><joint>`,
-/// Pinocchio's mimic joint): its coordinate is `multiplier · q_leader + offset`, its
-/// velocity and acceleration `multiplier` times the leader's. The leader (1-based)
-/// follows no other joint: a chain of followers is resolved to its first leader when
-/// the model is built.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mimic {
-    pub leader: usize,
-    pub multiplier: f64,
-    pub offset: f64,
-}
+/// Pinocchio's mimic joint), the leader 1-based: one type for every layer, the
+/// algorithms' own.
+pub use dyngen_algo::JointMimic;
 
 /// A moving body of the checked model; its frame is its joint's frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -344,8 +337,14 @@ impl Model {
     /// `None` at the base. The coordinates of a joint with several form a chain, the
     /// first one hanging from the last coordinate of the parent joint (Featherstone's
     /// expanded tree), so the joint-space inertia matrix is nonzero only where one
-    /// coordinate supports another and factors without fill-in.
+    /// coordinate supports another and factors without fill-in. With joints that
+    /// follow others, a leader's coordinate also moves bodies off its own path and the
+    /// matrix has no such structure: the coordinates then form one chain (`d − 1` is
+    /// `d`'s parent), and what factors on this tree factors densely.
     pub fn coordinate_parents(&self) -> Vec<Option<usize>> {
+        if self.mimic_joint().is_some() {
+            return (0..self.nv()).map(|d| d.checked_sub(1)).collect();
+        }
         (0..self.nv())
             .map(|d| {
                 let j = self.joint_of_v(d);

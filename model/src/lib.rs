@@ -45,7 +45,7 @@ pub use desc::{
     WORLD_LINK,
 };
 pub use error::{Element, ErrorKind, ModelError, ModelErrors};
-pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, Limits, Mimic, Model, Placement};
+pub use ir::{Body, Frame, Inertial, Joint, JointDynamics, JointKind, JointMimic, Limits, Model, Placement};
 pub use mjcf::{
     load_mjcf, load_mjcf_options, load_mjcf_with, load_robot, load_robot_options, load_robot_with, parse_mjcf,
     parse_mjcf_options, parse_mjcf_with,

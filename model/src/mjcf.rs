@@ -190,7 +190,7 @@
 //! `polycoef` is used as written, never converted) and the numbers not written
 //! keeping the default `0 1 0 0 0`. Where that is linear (`c2 = c3 = c4 = 0`) and
 //! `joint2` is given, joint1 follows joint2 as a mimic joint ([`MimicDesc`], see
-//! [`crate::ir::Mimic`]): multiplier `c1`, offset `ref1 + c0 - c1 ref2`, so that
+//! [`crate::ir::JointMimic`]): multiplier `c1`, offset `ref1 + c0 - c1 ref2`, so that
 //! `q1 = c1 q2 + offset` in `qpos` terms. MuJoCo enforces the coupling softly,
 //! through its constraint solver; the model holds it exactly, with one coordinate
 //! for a leader and its followers. `active` (of the element, else of its `<default>`

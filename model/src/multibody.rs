@@ -55,14 +55,7 @@ impl Model {
     /// The joints that follow others as the algorithms number them (0-based).
     pub(crate) fn algo_mimics(&self) -> Vec<dyngen_algo::Mimic> {
         (self.joints.iter().enumerate())
-            .filter_map(|(k, j)| {
-                j.mimic.map(|m| dyngen_algo::Mimic {
-                    joint: k,
-                    leader: m.leader - 1,
-                    multiplier: m.multiplier,
-                    offset: m.offset,
-                })
-            })
+            .filter_map(|(k, j)| j.mimic.map(|m| m.of_joint(k + 1)))
             .collect()
     }
 }

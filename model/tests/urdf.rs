@@ -5,7 +5,7 @@
 use dyngen_model::math;
 use dyngen_model::urdf::urdf_description;
 use dyngen_model::{
-    load_urdf, parse_urdf, parse_urdf_with, to_urdf, Element, ErrorKind, JointKind, Mimic, Model, ModelError,
+    load_urdf, parse_urdf, parse_urdf_with, to_urdf, Element, ErrorKind, JointKind, JointMimic, Model, ModelError,
     ModelErrors,
 };
 use std::path::PathBuf;
@@ -697,7 +697,7 @@ fn mimic_joints_follow_their_leader() {
     assert_eq!(mimic("ja"), None);
     assert_eq!(
         mimic("jb"),
-        Some(Mimic {
+        Some(JointMimic {
             leader: 1,
             multiplier: -0.5,
             offset: 0.2
@@ -710,7 +710,7 @@ fn mimic_joints_follow_their_leader() {
     // URDF's defaults: multiplier 1, offset 0.
     assert_eq!(
         mimic("jd"),
-        Some(Mimic {
+        Some(JointMimic {
             leader: 1,
             multiplier: 1.0,
             offset: 0.0

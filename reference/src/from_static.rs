@@ -35,8 +35,7 @@ pub fn model_from_static(m: &RobotModel) -> Model {
                     damping: j.damping,
                     friction: j.friction,
                 },
-                // Generated code is made for models without followers only.
-                mimic: None,
+                mimic: j.mimic,
             })
             .collect(),
         bodies: m

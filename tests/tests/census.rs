@@ -396,3 +396,245 @@ fn mimic_joints_reduce_the_tree() {
         assert!(rel_err(&ddq, &a, 1.0) < 1e-12, "sample {s}: {ddq:?} {a:?}");
     }
 }
+
+/// Generated code for robots with mimic joints (`dyngen_tests::mimic`, generated in
+/// `build.rs`): against Pinocchio 4.1's mimic model on its fixtures (rnea, nonlinear
+/// effects, gravity, `M`, centre of mass, its Jacobian, `A_g`, frame Jacobians, and the
+/// regressor and rnea derivatives of the reduced tree), against the run-time algorithms
+/// (`Multibody::with_mimics`) for what the fixtures do not hold (`J̇`, `Ȧ_g`,
+/// body poses), and by identities for the rest: `aba` and `aba_joints` invert `rnea` and
+/// `rnea_joints`, `M⁻¹ M = E`, `M ∂q̈/∂x = −∂τ/∂x`, the frame motion is `J v` and
+/// `J a + J̇ v`, the base, principal, joint-wrench and per-body regressors reproduce what
+/// their parameters give.
+#[test]
+fn generated_mimic_robots_match_pinocchio() {
+    use dyngen_tests::mimic::{ArmLinkageGripper, MimicProbeFloating};
+    let mut worst = dyngen_tests::Worst::new(|_| 1e-12);
+    generated_mimic::<MimicProbeFloating>("mimic_probe_free_flyer", &mut worst);
+    generated_mimic::<ArmLinkageGripper>("arm_linkage_gripper", &mut worst);
+    println!("generated mimic robots, worst relative errors: {:#?}", worst.items);
+}
+
+fn generated_mimic<R: dyngen::Robot>(fixture: &str, worst: &mut dyngen_tests::Worst) {
+    use dyngen::{BodyRegressor, ReferenceFrame, Wrench};
+    use dyngen_algo::{DualWorkspace, Workspace};
+    let json = load_json(&format!("mimic/{fixture}.json"));
+    let (nq, nv, np) = (R::NQ, R::NV, R::NPARAMS);
+    assert_eq!(
+        (nq, nv),
+        (
+            json["nq"].as_u64().unwrap() as usize,
+            json["nv"].as_u64().unwrap() as usize
+        )
+    );
+    let model = dyngen_reference::model_from_static(&R::MODEL);
+    assert!(
+        model.mimic_joint().is_some(),
+        "{fixture}: the generated model lost its followers"
+    );
+    let params = R::nominal_params();
+    worst.add("params", fixture, 0, params, &json_numbers(&json["params"]), 1.0);
+    let body = model.multibody().unwrap();
+    let mut ws = Workspace::new(&body, ());
+    let mut dual = DualWorkspace::<f64, 1>::new(&body, ());
+    let times = |y: &[f64], x: &[f64]| -> Vec<f64> {
+        y.chunks(x.len())
+            .map(|r| r.iter().zip(x).map(|(a, b)| a * b).sum())
+            .collect()
+    };
+    let product = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        (0..nv * nv)
+            .map(|rc| (0..nv).map(|k| a[rc / nv * nv + k] * b[k * nv + rc % nv]).sum())
+            .collect()
+    };
+    let identity: Vec<f64> = (0..nv * nv).map(|rc| f64::from(u8::from(rc / nv == rc % nv))).collect();
+    for (s, sample) in json["samples"].as_array().unwrap().iter().enumerate() {
+        let [q, v, a] = ["q", "v", "a"].map(|k| json_numbers(&sample[k]));
+        let want = |key: &str| json_numbers(&sample[key]);
+        let mut tau = vec![0.0; nv];
+        R::rnea(&q, &v, &a, params, &mut tau);
+        worst.add("rnea", fixture, s, &tau, &want("tau"), 1.0);
+        let mut out = vec![0.0; nv];
+        R::nonlinear_effects(&q, &v, params, &mut out);
+        worst.add("nle", fixture, s, &out, &want("nle"), 1.0);
+        R::generalized_gravity(&q, params, &mut out);
+        worst.add("gravity", fixture, s, &out, &want("gravity"), 1.0);
+        let mut m = vec![0.0; nv * nv];
+        R::crba(&q, params, &mut m);
+        worst.add("crba", fixture, s, &m, &want("M"), 1.0);
+        worst.add("com", fixture, s, &R::center_of_mass(&q, params), &want("com"), 1.0);
+        let mut jcom = vec![0.0; 3 * nv];
+        R::com_jacobian(&q, params, &mut jcom);
+        worst.add("com_jacobian", fixture, s, &jcom, &want("com_jacobian"), 1.0);
+        let (mut ag, mut ag_dot) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+        R::centroidal_map(&q, params, &mut ag);
+        worst.add("centroidal_map", fixture, s, &ag, &want("centroidal_map"), 1.0);
+        R::centroidal_map_time_variation(&q, &v, params, &mut ag, &mut ag_dot);
+        let (mut ag_rt, mut ag_dot_rt) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+        dyngen_algo::centroidal_map_time_variation(&body, &mut dual, &q, &v, params, &mut ag_rt, &mut ag_dot_rt);
+        worst.add("centroidal_map_time_variation", fixture, s, &ag_dot, &ag_dot_rt, 1.0);
+        for (name, frame_want) in sample["frames"].as_object().unwrap() {
+            let f = R::MODEL.frame_index(name).unwrap();
+            let lwa = ReferenceFrame::LocalWorldAligned;
+            let (mut j, mut j_dot) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+            R::frame_jacobian(&q, f, lwa, &mut j).unwrap();
+            worst.add(
+                "frame jacobian",
+                fixture,
+                s,
+                &j,
+                &json_numbers(&frame_want["jacobian"]),
+                1.0,
+            );
+            R::frame_jacobian_time_variation(&q, &v, f, lwa, &mut j, &mut j_dot).unwrap();
+            let frame = &model.frames[f];
+            let offset = dyngen_algo::Se3 {
+                rotation: frame.placement.rotation,
+                translation: frame.placement.translation,
+            };
+            let (mut j_rt, mut j_dot_rt) = (vec![0.0; 6 * nv], vec![0.0; 6 * nv]);
+            dyngen_algo::frame_jacobian_time_variation(
+                &body,
+                &mut dual,
+                &q,
+                &v,
+                frame.body,
+                &offset,
+                dyngen_algo::ReferenceFrame::LocalWorldAligned,
+                &mut j_rt,
+                &mut j_dot_rt,
+            );
+            worst.add("frame jacobian time variation", fixture, s, &j_dot, &j_dot_rt, 1.0);
+            let motion = R::frame_motion(&q, &v, &a, f).unwrap();
+            let got: Vec<f64> = motion
+                .velocity
+                .linear
+                .iter()
+                .chain(motion.velocity.angular.iter())
+                .copied()
+                .collect();
+            worst.add("frame velocity", fixture, s, &got, &times(&j, &v), 1.0);
+            let got: Vec<f64> = motion
+                .acceleration
+                .linear
+                .iter()
+                .chain(motion.acceleration.angular.iter())
+                .copied()
+                .collect();
+            let classical: Vec<f64> = times(&j, &a)
+                .iter()
+                .zip(times(&j_dot, &v))
+                .map(|(x, y)| x + y)
+                .collect();
+            worst.add("frame classical acceleration", fixture, s, &got, &classical, 1.0);
+        }
+        let mut poses = vec![dyngen::Pose::default(); R::NBODIES];
+        R::forward_kinematics(&q, &mut poses);
+        dyngen_algo::forward_kinematics(&body, &mut ws, &q);
+        for (b, pose) in poses.iter().enumerate() {
+            let world = &ws.world[b + 1];
+            let want: Vec<f64> = world
+                .rotation
+                .iter()
+                .flatten()
+                .chain(&world.translation)
+                .copied()
+                .collect();
+            worst.add(
+                "forward kinematics",
+                fixture,
+                s,
+                &dyngen_tests::pose_vec(pose),
+                &want,
+                1.0,
+            );
+        }
+        let mut y = vec![0.0; nv * np];
+        R::joint_torque_regressor(&q, &v, &a, &mut y);
+        worst.add("regressor", fixture, s, &y, &want("regressor"), 1.0);
+        let (mut dq, mut dv, mut da) = (vec![0.0; nv * nv], vec![0.0; nv * nv], vec![0.0; nv * nv]);
+        R::rnea_derivatives(&q, &v, &a, params, &mut dq, &mut dv, &mut da);
+        worst.add("dtau_dq", fixture, s, &dq, &want("dtau_dq"), 1.0);
+        worst.add("dtau_dv", fixture, s, &dv, &want("dtau_dv"), 1.0);
+        worst.add("dtau_da", fixture, s, &da, &want("M"), 1.0);
+        // Forward dynamics and its derivatives, by their identities.
+        let pin_tau = want("tau");
+        R::aba(&q, &v, &pin_tau, params, &mut out);
+        worst.add("aba", fixture, s, &out, &a, 1.0);
+        let (mut ddq, mut ddq_dq, mut ddq_dv, mut minv) = (
+            vec![0.0; nv],
+            vec![0.0; nv * nv],
+            vec![0.0; nv * nv],
+            vec![0.0; nv * nv],
+        );
+        R::aba_derivatives(&q, &v, &pin_tau, params, &mut ddq, &mut ddq_dq, &mut ddq_dv, &mut minv);
+        worst.add("aba_derivatives ddq", fixture, s, &ddq, &a, 1.0);
+        let pin_m = want("M");
+        worst.add("M minv", fixture, s, &product(&pin_m, &minv), &identity, 1.0);
+        let neg = |k: &str| want(k).iter().map(|x| -x).collect::<Vec<_>>();
+        worst.add("M ddq_dq", fixture, s, &product(&pin_m, &ddq_dq), &neg("dtau_dq"), 1.0);
+        worst.add("M ddq_dv", fixture, s, &product(&pin_m, &ddq_dv), &neg("dtau_dv"), 1.0);
+        R::inverse_inertia(&q, params, &mut minv);
+        worst.add("inverse_inertia", fixture, s, &product(&pin_m, &minv), &identity, 1.0);
+        // The joint models: aba_joints inverts rnea_joints, the widened regressor
+        // reproduces it.
+        let joint_params: Vec<f64> = (0..nv).flat_map(|d| [0.01 * (d + 1) as f64, 0.2, 0.3, -0.05]).collect();
+        let coulomb = dyngen::Coulomb::smooth(0.05).unwrap();
+        let mut tau_j = vec![0.0; nv];
+        R::rnea_joints(&q, &v, &a, params, &joint_params, coulomb, &mut tau_j);
+        R::aba_joints(&q, &v, &tau_j, params, &joint_params, coulomb, &mut out);
+        worst.add("aba_joints", fixture, s, &out, &a, 1.0);
+        let mut yj = vec![0.0; nv * (np + 4 * nv)];
+        R::torque_regressor_joints(&q, &v, &a, coulomb, &mut yj);
+        let x: Vec<f64> = params.iter().chain(&joint_params).copied().collect();
+        worst.add("torque_regressor_joints", fixture, s, &times(&yj, &x), &tau_j, 1.0);
+        // The other regressors against what their parameters give.
+        let (mut beta, mut beta_p) = (vec![0.0; R::NBASE], vec![0.0; R::NBASE_PRINCIPAL]);
+        R::base_params(params, &mut beta);
+        R::principal_base_params(R::nominal_theta(), &mut beta_p);
+        let mut yb = vec![0.0; nv * R::NBASE];
+        R::base_regressor(&q, &v, &a, &mut yb);
+        worst.add("base_regressor", fixture, s, &times(&yb, &beta), &tau, 1.0);
+        let mut yp = vec![0.0; nv * R::NTHETA];
+        R::principal_regressor(&q, &v, &a, &mut yp);
+        worst.add(
+            "principal_regressor",
+            fixture,
+            s,
+            &times(&yp, R::nominal_theta()),
+            &tau,
+            1.0,
+        );
+        let mut ypb = vec![0.0; nv * R::NBASE_PRINCIPAL];
+        R::principal_base_regressor(&q, &v, &a, &mut ypb);
+        worst.add("principal_base_regressor", fixture, s, &times(&ypb, &beta_p), &tau, 1.0);
+        let mut wrenches = vec![Wrench::default(); R::NBODIES];
+        R::joint_wrenches(&q, &v, &a, params, &mut wrenches);
+        let wrenches: Vec<f64> = wrenches.iter().flat_map(dyngen_tests::wrench_vec).collect();
+        let mut yw = vec![0.0; 6 * R::NBODIES * np];
+        R::joint_wrench_regressor(&q, &v, &a, &mut yw);
+        worst.add(
+            "joint_wrench_regressor",
+            fixture,
+            s,
+            &times(&yw, params),
+            &wrenches,
+            1.0,
+        );
+        let (mut bodies, mut resultants) = (
+            vec![BodyRegressor::default(); R::NBODIES],
+            vec![Wrench::default(); R::NBODIES],
+        );
+        R::body_regressors(&q, &v, &a, &mut bodies);
+        R::body_resultants(&q, &v, &a, params, &mut resultants);
+        for (i, (ai, ri)) in bodies.iter().zip(&resultants).enumerate() {
+            let theta = nalgebra::Vector4::from_column_slice(&R::nominal_theta()[4 * i..4 * i + 4]);
+            let got: Vec<f64> = (ai.force * theta)
+                .iter()
+                .chain((ai.moment * theta).iter())
+                .copied()
+                .collect();
+            worst.add("body_regressors", fixture, s, &got, &dyngen_tests::wrench_vec(ri), 1.0);
+        }
+    }
+}

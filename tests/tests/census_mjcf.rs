@@ -332,11 +332,19 @@ fn joint_couplings_are_mimic_joints_with_mujocos_reduced_dynamics() {
         worst[1] = worst[1].max(rel_err(&with_rotors, &json_numbers(&s["M"]), 1e-12));
         worst[2] = worst[2].max(rel_err(&bias, &json_numbers(&s["bias"]), 1e-12));
     }
-    // Generated code refuses the followers, naming the MJCF element.
-    let why = dyngen_codegen::unsupported(&model).unwrap();
+    // Generated code takes the followers (as the URDF ones, checked against Pinocchio
+    // in `census.rs`): the rule is in the generated model, and `aba` solves densely.
+    let code = dyngen_codegen::Config::new()
+        .functions(dyngen_codegen::Selection::parse("aba").unwrap())
+        .generate_file(&model, "Equality", "equality.xml")
+        .unwrap();
     assert!(
-        why.starts_with("joint `twin` follows joint `elbow` (a URDF <mimic> or an MJCF <equality><joint>)"),
-        "{why}"
+        code.contains("JointMimic {"),
+        "the coupling is lost from the generated model"
+    );
+    assert!(
+        code.contains("tree_ldl_solve(&ANCESTORS"),
+        "aba does not solve M densely"
     );
     println!(
         "equality.xml: max rel. error M {:.1e}, M + diag(Ia) {:.1e}, bias {:.1e}",

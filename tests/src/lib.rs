@@ -14,13 +14,11 @@ pub mod composed {
     include!(concat!(env!("OUT_DIR"), "/ur5_composed.rs"));
 }
 
-/// Robots with joints that follow others (`<mimic>`; see `build.rs`): the mimic probe
-/// tree on a free flyer (followers with multipliers and offsets, a prismatic one, one
-/// in another branch than its leader) and an arm with a linkage gripper (five
-/// followers of one finger joint).
+/// A robot with joints that follow others (`<mimic>`; see `build.rs`): the mimic
+/// probe tree on a free flyer (followers with multipliers other than ±1 and offsets, a
+/// prismatic one, one in another branch than its leader).
 pub mod mimic {
     include!(concat!(env!("OUT_DIR"), "/mimic_probe_free_flyer.rs"));
-    include!(concat!(env!("OUT_DIR"), "/arm_linkage_gripper.rs"));
 }
 
 /// A 12-DOF branched tree (torso, head, two arms; revolute, continuous and

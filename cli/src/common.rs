@@ -77,24 +77,14 @@ pub fn load_model(path: &Path, args: &ModelArgs) -> Result<Model> {
 
 /// Like [`load_model`], for the commands that run the dynamics at run time
 /// (identification, simulation, validation, NIM): refuses a model without moving
-/// joints, one with a joint that follows another (`<mimic>`), and one with a free
-/// flyer, a ball or a planar joint, which only the generated code handles so far.
+/// joints, and one with a free flyer, a ball or a planar joint, which only the
+/// generated code handles so far. Joints that follow others (`<mimic>`) are taken:
+/// a recording has one joint per velocity coordinate, the leaders' (NIM refuses
+/// them, [`refuse_followers`]).
 pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
     let model = load_model(path, args)?;
     if model.dof() == 0 {
         return Err(CliError::input(path, "the robot has no moving joints"));
-    }
-    if let Some(j) = model.mimic_joint() {
-        return Err(CliError::input(
-            path,
-            format!(
-                "joint `{}` follows another (a URDF <mimic> or an MJCF <equality><joint>); this command runs on \
-                 robots whose joints each have a coordinate of their own. The run-time algorithms take such joints \
-                 (`dyngen.load` in Python, `dyngen_model::Model::multibody` in Rust); or remove the coupling to \
-                 identify the joint as an independent one",
-                j.name
-            ),
-        ));
     }
     if let Some(j) = model.multi_dof_joint() {
         return Err(CliError::input(
@@ -111,6 +101,23 @@ pub fn load_moving_model(path: &Path, args: &ModelArgs) -> Result<Model> {
         ));
     }
     Ok(model)
+}
+
+/// Refuses a model with a joint that follows another (`<mimic>`), for NIM, whose
+/// body networks take one joint per body.
+pub fn refuse_followers(model: &Model, path: &Path) -> Result<()> {
+    match model.mimic_joint() {
+        Some(j) => Err(CliError::input(
+            path,
+            format!(
+                "joint `{}` follows another (a URDF <mimic> or an MJCF <equality><joint>); NIM runs on robots whose \
+                 joints each have a coordinate of their own (identify, simulate and validate take such joints); \
+                 remove the coupling to treat the joint as an independent one",
+                j.name
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Progress bars on stderr, hidden with `--quiet` or when stdout is not a terminal.

@@ -538,7 +538,9 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     options.check().map_err(|e| pipeline_error(data, e))?;
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
-    let n = model.dof();
+    // The recording's joints: one per velocity coordinate (a joint that follows
+    // another has none).
+    let n = model.nv();
     let recipe = args.recording.recipe.recipe()?;
     // The validation recording's recipe, checked before any work.
     let validation_recipe = match &args.validate_recipe {

@@ -2,7 +2,7 @@
 //! along the joint motion of a CSV file (on simulated parameter draws), `predict`
 //! the principal parameters from measured data.
 
-use crate::common::{check_overwrite, load_moving_model, outln, ModelArgs, Progress, Result};
+use crate::common::{check_overwrite, load_moving_model, outln, refuse_followers, ModelArgs, Progress, Result};
 use crate::error::CliError;
 use clap::{Args, Subcommand};
 use dyngen_identify::data::Trajectory;
@@ -170,6 +170,7 @@ fn train(args: &TrainArgs, progress: &Progress) -> Result<()> {
         check_overwrite(svg, args.force)?;
     }
     let model = load_moving_model(&args.urdf, &args.gravity)?;
+    refuse_followers(&model, &args.urdf)?;
     let traj = read_data(&args.motion, &model, args.cutoff, args.recipe.as_deref())?;
     let motion = SampledMotion::from_data(&traj)
         .ok_or_else(|| CliError::input(&args.motion, "the motion has no velocities or accelerations"))?;
@@ -319,6 +320,7 @@ fn predict(args: &PredictArgs) -> Result<()> {
         check_overwrite(path, args.force)?;
     }
     let model = load_moving_model(&args.urdf, &args.gravity)?;
+    refuse_followers(&model, &args.urdf)?;
     let nim = Nim::load(&args.nim).map_err(|e| nim_file_error(&args.nim, e, false))?;
     let body_names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     if nim.body_names != body_names {

@@ -102,7 +102,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             let traj = load_recording(
                 data,
                 &recipe,
-                model.dof(),
+                model.nv(),
                 args.recording.cutoff(),
                 !args.recording.raw_states,
             )?;

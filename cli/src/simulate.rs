@@ -223,7 +223,7 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             // ExcitationDesign::default_samples).
             design.samples = ExcitationDesign::default_samples(args.harmonics);
             if let Some(text) = &args.max_acceleration {
-                let limits = per_joint("--max-acceleration", text, model.dof())?;
+                let limits = per_joint("--max-acceleration", text, model.nv())?;
                 if let Some(bad) = limits.iter().find(|&&a| a <= 0.0) {
                     return Err(CliError::usage(format!(
                         "--max-acceleration: {bad} is not a positive acceleration"
@@ -268,7 +268,8 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         }
     };
 
-    let n = model.dof();
+    // Per velocity coordinate: a joint that follows another (`<mimic>`) has none.
+    let n = model.nv();
     let nominal = dyngen_model::joint_params::nominal_joint_params(&model);
     let column = |flag: &str, text: &Option<String>, k: usize| -> Result<Vec<f64>> {
         match text {

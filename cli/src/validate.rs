@@ -57,7 +57,7 @@ pub fn validation(
     predicted: &[Vec<f64>],
     params: Option<&Path>,
 ) -> Result<Validation> {
-    let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let names: Vec<String> = model.own_joints().map(|j| j.name.clone()).collect();
     let overflow = |message: String| match params {
         Some(path) => CliError::input(path, message),
         None => CliError::failed(message),
@@ -96,7 +96,7 @@ pub fn exact_overall(v: &Validation) -> String {
 /// Refuses parameters identified for another robot: their joints (the residual
 /// channels of the JSON) must be the robot's, in order.
 fn check_joints(params: &ParameterReport, model: &Model, path: &Path) -> Result<()> {
-    let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let joints: Vec<&str> = model.own_joints().map(|j| j.name.as_str()).collect();
     let theirs: Vec<&str> = params.channels.iter().map(String::as_str).collect();
     if theirs.is_empty() || theirs == joints {
         return Ok(());
@@ -275,7 +275,7 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
     let data = load_recording(
         &args.data,
         &reading.recipe,
-        model.dof(),
+        model.nv(),
         reading.cutoff,
         reading.low_pass_states,
     )?;

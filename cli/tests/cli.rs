@@ -466,7 +466,7 @@ fn free_flyer_in_info_and_generate_and_refused_at_run_time() {
 }
 
 #[test]
-fn mimic_robots_load_generate_and_are_refused_by_name_elsewhere() {
+fn mimic_robots_load_generate_identify_and_are_refused_by_nim() {
     let gripper =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/mimic/arm_linkage_gripper.urdf");
     // info: the coordinates, each follower's rule, the base parameters, the generated functions.
@@ -480,7 +480,7 @@ fn mimic_robots_load_generate_and_are_refused_by_name_elsewhere() {
     assert!(out.contains("left_inner_finger_joint = -1 · finger_joint + 0"), "{out}");
     assert!(out.contains("Base parameters (standard)"), "{out}");
     assert!(out.contains("Generated functions (operation counts)"), "{out}");
-    // generate: the followers in the model it carries; identify refuses, saying why.
+    // generate: the followers in the model it carries.
     let o = run!("generate", gripper, "--name", "Gripper");
     assert_ok(&o);
     let code = stdout(&o);
@@ -489,11 +489,90 @@ fn mimic_robots_load_generate_and_are_refused_by_name_elsewhere() {
         code.contains("multiplier: -1.0"),
         "the followers' rules are in Gripper::MODEL"
     );
+    // simulate, identify and validate run on the leaders' coordinates: a noise-free
+    // recording with friction on every coordinate gives the friction back, and the
+    // parameters predict a second recording.
     let dir = temp_dir("cli", "mimic");
-    let data = dir.join("data.csv");
-    std::fs::write(&data, "t,q1\n0,0\n").unwrap();
+    let (train, check, params) = (dir.join("train.csv"), dir.join("check.csv"), dir.join("params.json"));
+    let friction = [
+        "--damping",
+        "0.3,0.2,0.2,0.1,0.1,0.1,0.05",
+        "--coulomb",
+        "0.5,0.4,0.3,0.2,0.2,0.1,0.1",
+    ];
+    let o = run!(
+        "simulate",
+        gripper,
+        "-o",
+        train,
+        "--experiment",
+        "fourier",
+        "--steps",
+        "400",
+        "--evaluations",
+        "200",
+        friction[0],
+        friction[1],
+        friction[2],
+        friction[3]
+    );
+    assert_ok(&o);
+    assert!(stderr(&o).contains("samples of 7 joints"), "{}", stderr(&o));
+    let header = std::fs::read_to_string(&train).unwrap();
+    assert!(header.starts_with("t,q1,q2,q3,q4,q5,q6,q7,v1,"), "{}", &header[..80]);
+    let o = run!(
+        "simulate",
+        gripper,
+        "-o",
+        check,
+        "--seed",
+        "7",
+        friction[0],
+        friction[1],
+        friction[2],
+        friction[3]
+    );
+    assert_ok(&o);
+    let o = run!(
+        "identify",
+        gripper,
+        train,
+        "--friction",
+        "sign",
+        "--params-json",
+        params,
+        "--validate",
+        check
+    );
+    assert_ok(&o);
+    let out = stdout(&o);
+    for (name, value) in [("Fv1", "0.3"), ("Fc2", "0.4"), ("Fv7", "0.05"), ("Fc7", "0.1")] {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_else(|| panic!("no {name} in {out}"));
+        let got: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        let want: f64 = value.parse().unwrap();
+        assert!(
+            (got - want).abs() < 1e-3 * want.max(1.0) + 1e-4,
+            "{name} = {got}, simulated with {want}"
+        );
+    }
+    let o = run!("validate", gripper, params, check);
+    assert_ok(&o);
+    let fraction: f64 = stdout(&o)
+        .lines()
+        .find_map(|l| l.strip_prefix("(as a fraction, full precision: "))
+        .and_then(|x| x.strip_suffix(')'))
+        .unwrap()
+        .parse()
+        .unwrap();
+    // Not zero: the check recording is low-passed (10 Hz) where Coulomb friction
+    // switches sign; 0.36 % when written.
+    assert!(fraction < 1e-2, "relative validation error {fraction}");
+    // NIM's body networks take one joint per body: refused by name.
     assert_error(
-        &run!("identify", gripper, data),
-        "joint `left_inner_finger_joint` follows another (a URDF <mimic> or an MJCF <equality><joint>); this command runs on robots whose joints each have a coordinate of their own",
+        &run!("nim", "train", gripper, train, "-o", dir.join("nim.json")),
+        "joint `left_inner_finger_joint` follows another (a URDF <mimic> or an MJCF <equality><joint>); NIM runs on robots",
     );
 }

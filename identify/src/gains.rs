@@ -61,8 +61,8 @@ pub fn identify_gains(
     opts: &Options,
 ) -> Result<GainEstimate, IdentifyError> {
     let n = dynamics.nv();
-    Payload::check_body(payload.body, n)?;
-    let rigid = 10 * n;
+    Payload::check_body(payload.body, dynamics.model().dof())?;
+    let rigid = dynamics.nparams();
     let pa = rigid + PER_JOINT * n;
     // Columns: A (π, φ), then −i_j of each joint (the stacked problem's k), then the
     // payload term l; the observation is −l. One accumulator serves both the stacked

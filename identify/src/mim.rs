@@ -549,26 +549,30 @@ impl fmt::Debug for TorqueRegressor {
 }
 
 impl TorqueRegressor {
-    /// Number of columns for a robot with `n` joints.
-    pub fn columns(&self, n: usize) -> usize {
+    /// Number of columns for `model`: 10 (standard) or 4 (principal) per body, and
+    /// with the joint terms 4 per velocity coordinate (a joint that follows another,
+    /// `<mimic>`, has none: its rotor and friction act on its leader's).
+    pub fn columns(&self, model: &Model) -> usize {
+        let (bodies, nv) = (model.dof(), model.nv());
         match self {
-            TorqueRegressor::Standard => 10 * n,
-            TorqueRegressor::Principal => 4 * n,
+            TorqueRegressor::Standard => 10 * bodies,
+            TorqueRegressor::Principal => 4 * bodies,
             TorqueRegressor::PrincipalBase { columns, .. } => *columns,
-            TorqueRegressor::StandardAndJoints(_) => (10 + PER_JOINT) * n,
+            TorqueRegressor::StandardAndJoints(_) => 10 * bodies + PER_JOINT * nv,
         }
     }
 
-    /// The names of the parameters, `columns(n)` of them ([`dyngen_model::names`],
+    /// The names of the parameters, `columns(model)` of them ([`dyngen_model::names`],
     /// [`dyngen_model::joint_params`]; `β1, β2, …` for a generated base regressor).
-    pub fn names(&self, n: usize) -> Vec<String> {
+    pub fn names(&self, model: &Model) -> Vec<String> {
+        let (bodies, nv) = (model.dof(), model.nv());
         match self {
-            TorqueRegressor::Standard => standard_param_names(n),
-            TorqueRegressor::Principal => principal_param_names(n),
+            TorqueRegressor::Standard => standard_param_names(bodies),
+            TorqueRegressor::Principal => principal_param_names(bodies),
             TorqueRegressor::PrincipalBase { columns, .. } => (1..=*columns).map(|k| format!("β{k}")).collect(),
             TorqueRegressor::StandardAndJoints(_) => {
-                let mut names = standard_param_names(n);
-                names.extend(dyngen_model::joint_params::joint_param_names(n));
+                let mut names = standard_param_names(bodies);
+                names.extend(dyngen_model::joint_params::joint_param_names(nv));
                 names
             }
         }
@@ -601,6 +605,10 @@ impl TorqueRegressor {
             TorqueRegressor::Principal => 4,
             TorqueRegressor::PrincipalBase { .. } => return None,
         };
+        // A leader's row also holds the bodies its followers move: not known here.
+        if model.mimic_joint().is_some() {
+            return None;
+        }
         Some(
             (1..=n)
                 .map(|j| {
@@ -625,8 +633,8 @@ impl TorqueRegressor {
             TorqueRegressor::Principal => dynamics.principal_regressor(q, v, a, y),
             TorqueRegressor::PrincipalBase { regressor, .. } => regressor(q, v, a, y),
             TorqueRegressor::StandardAndJoints(coulomb) => {
-                let n = q.len();
-                let (rigid, p) = (10 * n, (10 + PER_JOINT) * n);
+                let (n, rigid) = (v.len(), dynamics.nparams());
+                let p = rigid + PER_JOINT * n;
                 // The rigid-body rows land packed at the front of `y`; each is then
                 // moved to its place in the wider layout, last row first so that no
                 // row is overwritten before it is moved (no buffer on this hot path).
@@ -690,7 +698,7 @@ impl TorqueEstimate {
     /// the same prediction on the identifiable subspace: this is `Y_b β̂`).
     pub fn predict(&self, dynamics: &dyn Dynamics, q: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
         let n = dynamics.nv();
-        let p = self.regressor.columns(n);
+        let p = self.regressor.columns(dynamics.model());
         let mut y = vec![0.0; n * p];
         self.regressor
             .predict(dynamics, q, v, a, &self.estimate.solution, &mut y)
@@ -805,7 +813,7 @@ fn torque_estimate(
 ) -> Result<TorqueEstimate, IdentifyError> {
     check_range(recording, &range)?;
     let n = dynamics.nv();
-    let p = regressor.columns(n);
+    let p = regressor.columns(dynamics.model());
     check_truth(truth, p)?;
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n))?;
     if let Some(support) = regressor.row_support(dynamics.model()) {
@@ -847,7 +855,7 @@ pub fn torque(
     weighting: Weighting,
     opts: &Options,
 ) -> Result<TorqueEstimate, IdentifyError> {
-    let names = regressor.names(dynamics.nv());
+    let names = regressor.names(dynamics.model());
     torque_estimate(dynamics, recording, range, regressor, names, truth, weighting, opts)
 }
 

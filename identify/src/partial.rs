@@ -156,11 +156,11 @@ impl RobotIdentity {
         let model = dynamics.model();
         let n = dynamics.nv();
         let [q, v, a] = signature_state(n);
-        let mut signature = vec![0.0; n * regressor.columns(n)];
+        let mut signature = vec![0.0; n * regressor.columns(model)];
         regressor.eval(dynamics, &q, &v, &a, &mut signature);
         RobotIdentity {
             name: model.name.clone(),
-            joints: model.joints.iter().map(|j| j.name.clone()).collect(),
+            joints: model.own_joints().map(|j| j.name.clone()).collect(),
             parameters,
             gravity: model.gravity,
             signature,
@@ -366,7 +366,7 @@ impl Partial {
         options.check()?;
         let rows = RowOptions::of(options, recipe)?;
         let regressor = pipeline::torque_regressor(options);
-        let names = pipeline::param_names(dynamics.nv(), regressor);
+        let names = regressor.names(dynamics.model());
         let accumulator = pipeline::accumulate_recording(dynamics, traj, regressor, options)?
             .to_state()
             .map_err(PipelineError::from)?;
@@ -471,7 +471,7 @@ impl Partial {
         let options = self.options_with(given)?;
         options.check()?;
         let regressor = pipeline::torque_regressor(&options);
-        let names = pipeline::param_names(dynamics.nv(), regressor);
+        let names = regressor.names(dynamics.model());
         self.robot.compare(&RobotIdentity::of(dynamics, regressor, names))?;
         let acc = self.accumulator()?;
         let mut identified = pipeline::from_accumulator(dynamics.model(), &acc, regressor, &options)?;

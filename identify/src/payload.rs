@@ -129,7 +129,7 @@ pub fn identify(
     opts: &Options,
 ) -> Result<PayloadEstimate, IdentifyError> {
     let n = robot.dynamics.nv();
-    Payload::check_body(body, n)?;
+    Payload::check_body(body, robot.dynamics.model().dof())?;
     if data.dof() != n {
         return Err(IdentifyError::DimensionMismatch {
             what: "joints of the recording",
@@ -160,7 +160,7 @@ pub fn identify(
             TorqueRegressor::StandardAndJoints(coulomb)
         }
     };
-    let p = regressor.columns(n);
+    let p = regressor.columns(robot.dynamics.model());
     let at = PER_BODY * (body - 1);
     let mut y = vec![0.0; n * p];
     let mut acc = Accumulator::new(PER_BODY);

@@ -400,7 +400,19 @@ pub fn identify(
     need_derivatives(trajectory)?;
     match options.mode {
         Mode::Standard | Mode::Principal => from_torques(dynamics, trajectory, options),
-        Mode::Mim => by_mim(dynamics, trajectory, options),
+        Mode::Mim => {
+            if let Some(j) = dynamics.model().mimic_joint() {
+                return Err(PipelineError::InvalidOption {
+                    option: "mode",
+                    reason: format!(
+                        "mim takes one joint wrench per coordinate, and joint `{}` follows another (<mimic>) \
+                         without a coordinate of its own; use --mode standard or principal",
+                        j.name
+                    ),
+                });
+            }
+            by_mim(dynamics, trajectory, options)
+        }
     }
 }
 
@@ -466,18 +478,6 @@ fn from_torques(
     ))
 }
 
-/// The names of `regressor`'s columns on `n` joints.
-pub(crate) fn param_names(n: usize, regressor: TorqueRegressor) -> Vec<String> {
-    let mut names = match regressor {
-        TorqueRegressor::Principal => dyngen_model::names::principal_param_names(n),
-        _ => dyngen_model::names::standard_param_names(n),
-    };
-    if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
-        names.extend(dyngen_model::joint_params::joint_param_names(n));
-    }
-    names
-}
-
 /// The regressor `options` ask for, but for [`JointTerms::FrictionAuto`], whose ε
 /// the data choose (it gets `Fc·sign(q̇)` here).
 pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
@@ -525,13 +525,12 @@ struct TorqueFit<'a> {
 
 impl<'a> TorqueFit<'a> {
     fn new(model: &'a Model, regressor: TorqueRegressor, options: &'a IdentifyOptions) -> Self {
-        let n = model.dof();
         let mut nominal = nominal(model, options.mode);
         if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
             nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
         }
         let fitted = fitted_joint_terms(options);
-        let excluded = excluded_columns(regressor, n, fitted);
+        let excluded = excluded_columns(regressor, model, fitted);
         for &c in &excluded {
             // Ridge pulls a term left out toward 0, where it is held.
             nominal[c] = 0.0;
@@ -548,7 +547,7 @@ impl<'a> TorqueFit<'a> {
 
     /// The estimator of the options on `acc`, the columns held at 0 excluded.
     fn solve(&self, acc: &Accumulator) -> Result<crate::Estimate, IdentifyError> {
-        let (opts, n) = (&self.options.tolerances, self.model.dof());
+        let opts = &self.options.tolerances;
         let mut estimate = match self.options.estimator {
             Estimator::Ols => acc.ols(opts),
             Estimator::Wls => acc.wls(opts),
@@ -558,7 +557,9 @@ impl<'a> TorqueFit<'a> {
             Estimator::Consistent if matches!(self.regressor, TorqueRegressor::Principal) => {
                 acc.principal_consistent(&PrincipalOptions::default(), opts)
             }
-            Estimator::Consistent => acc.standard_consistent(&consistent_options(self.regressor, n, self.fitted), opts),
+            Estimator::Consistent => {
+                acc.standard_consistent(&consistent_options(self.regressor, self.model, self.fitted), opts)
+            }
         }?;
         // The columns held at 0 are no parameters of the model.
         for &c in &self.excluded {
@@ -596,7 +597,7 @@ impl<'a> TorqueFit<'a> {
         let rows: usize = acc.rows_per_channel().iter().sum();
         if rows <= estimate.solution.len() {
             return Err(PipelineError::TooFewRows {
-                samples: acc.rows() / self.model.dof().max(1),
+                samples: acc.rows() / self.model.nv().max(1),
                 rows,
                 params: estimate.solution.len(),
             });
@@ -631,10 +632,11 @@ impl<'a> TorqueFit<'a> {
         chosen_epsilon: Option<f64>,
     ) -> Identification {
         let (model, regressor, options) = (self.model, self.regressor, self.options);
-        let n = model.dof();
-        let names = param_names(n, regressor);
+        let (bodies, n) = (model.dof(), model.nv());
+        let names = regressor.names(model);
         let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
-        let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        // One joint per velocity coordinate (a joint that follows another has none).
+        let joint_names: Vec<&str> = model.own_joints().map(|j| j.name.as_str()).collect();
         let (parameterisation, coulomb) = match regressor {
             TorqueRegressor::Principal => (Parameterisation::Principal, None),
             TorqueRegressor::StandardAndJoints(c) => (
@@ -650,7 +652,7 @@ impl<'a> TorqueFit<'a> {
             ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
         let nonphysical = match regressor {
             TorqueRegressor::StandardAndJoints(_) => {
-                let values: Vec<Option<f64>> = report.parameters[10 * n..10 * n + PER_JOINT * n]
+                let values: Vec<Option<f64>> = report.parameters[10 * bodies..10 * bodies + PER_JOINT * n]
                     .iter()
                     .map(|p| match p.status {
                         // Not told apart from zero (or from the prior): not reported as identified.
@@ -784,13 +786,14 @@ pub fn fitted_joint_terms(options: &IdentifyOptions) -> [bool; PER_JOINT] {
 }
 
 /// The columns of the joint terms held at 0 for `regressor` on `n` joints.
-fn excluded_columns(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_JOINT]) -> Vec<usize> {
+fn excluded_columns(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> Vec<usize> {
+    let (bodies, n) = (model.dof(), model.nv());
     match regressor {
         TorqueRegressor::StandardAndJoints(_) => (0..n)
             .flat_map(|j| {
                 (0..PER_JOINT)
                     .filter(move |&k| !fitted[k])
-                    .map(move |k| 10 * n + PER_JOINT * j + k)
+                    .map(move |k| 10 * bodies + PER_JOINT * j + k)
             })
             .collect(),
         _ => Vec::new(),
@@ -800,19 +803,20 @@ fn excluded_columns(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_JOI
 /// The standard-form consistent estimator's options for `regressor` on `n` joints:
 /// `n` body blocks first, then per joint `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0`
 /// (those fitted).
-fn consistent_options(regressor: TorqueRegressor, n: usize, fitted: [bool; PER_JOINT]) -> StandardOptions {
+fn consistent_options(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> StandardOptions {
+    let (bodies, n) = (model.dof(), model.nv());
     let nonnegative = match regressor {
         TorqueRegressor::StandardAndJoints(_) => (0..n)
             .flat_map(|j| {
                 (0..3)
                     .filter(move |&k| fitted[k])
-                    .map(move |k| 10 * n + PER_JOINT * j + k)
+                    .map(move |k| 10 * bodies + PER_JOINT * j + k)
             })
             .collect(),
         _ => Vec::new(),
     };
     StandardOptions {
-        layout: Some(Layout { first: 0, bodies: n }),
+        layout: Some(Layout { first: 0, bodies }),
         nonnegative,
         ..StandardOptions::default()
     }
@@ -847,11 +851,11 @@ fn accumulate(
     options: &IdentifyOptions,
 ) -> Result<Accumulator, PipelineError> {
     let n = dynamics.nv();
-    let p = regressor.columns(n);
+    let p = regressor.columns(dynamics.model());
     let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
     // Joint terms left out of the model: their columns are zeroed in every row and
     // taken out of every row's support.
-    let excluded = excluded_columns(regressor, n, fitted_joint_terms(options));
+    let excluded = excluded_columns(regressor, dynamics.model(), fitted_joint_terms(options));
     if let Some(mut support) = regressor.row_support(dynamics.model()) {
         for cols in &mut support {
             cols.retain(|c| !excluded.contains(c));
@@ -1024,7 +1028,7 @@ pub fn predict_with(
             })
         }
     };
-    let p = regressor.columns(n);
+    let p = regressor.columns(dynamics.model());
     if prediction.solution.len() != p {
         return Err(PipelineError::InvalidOption {
             option: "prediction",
@@ -1064,7 +1068,7 @@ pub fn predict_with(
             let (q, v, a) = state(trajectory, k);
             let mut tau = regressor.predict(dynamics, q, v, a, &prediction.solution, &mut y);
             if let Some((s, coulomb)) = stribeck {
-                crate::stribeck::add_excess(&mut tau, v, &prediction.solution[10 * n..], s, coulomb);
+                crate::stribeck::add_excess(&mut tau, v, &prediction.solution[dynamics.nparams()..], s, coulomb);
             }
             tau
         })
@@ -1115,7 +1119,7 @@ impl Identification {
                     Prediction::Regressor(estimate) => {
                         let mut tau = estimate.predict(dynamics, q, v, a);
                         if let Some(fit) = &self.stribeck {
-                            let joints = &estimate.estimate.solution[10 * n..];
+                            let joints = &estimate.estimate.solution[dynamics.nparams()..];
                             crate::stribeck::add_excess(&mut tau, v, joints, &fit.joints, fit.coulomb);
                         }
                         tau
@@ -1231,10 +1235,10 @@ impl Identification {
         // shaped by the consistency bounds is a value).
         let (mut dynamics, mut dynamics_kept) = (Vec::new(), Vec::new());
         if self.report.parameterisation == Parameterisation::StandardAndJoints {
-            let n = model.dof();
-            for (j, joint) in model.joints.iter().enumerate() {
+            let bodies = model.dof();
+            for (j, joint) in model.own_joints().enumerate() {
                 let value = |m: usize| {
-                    let p = self.report.parameters.get(10 * n + 4 * j + m)?;
+                    let p = self.report.parameters.get(10 * bodies + 4 * j + m)?;
                     matches!(
                         p.status,
                         ParamStatus::Identified | ParamStatus::NotSignificant | ParamStatus::Constrained
@@ -1248,7 +1252,7 @@ impl Identification {
                         joint.name.clone(),
                         format!("identified Fv {fv:.4}, Fc {fc:.4}: negative"),
                     )),
-                    _ if self.report.parameters.get(10 * n + 4 * j + 1).map(|p| p.status)
+                    _ if self.report.parameters.get(10 * bodies + 4 * j + 1).map(|p| p.status)
                         == Some(ParamStatus::Excluded) =>
                     {
                         dynamics_kept.push((joint.name.clone(), "friction left out of the model".into()))
@@ -1280,18 +1284,18 @@ impl Identification {
             return None;
         }
         let coulomb = prediction.coulomb?;
-        let n = model.dof();
+        let (rigid, n) = (10 * model.dof(), model.nv());
         let params = &self.report.parameters;
-        let stribeck = self.stribeck.is_some() && params.len() >= 16 * n;
+        let stribeck = self.stribeck.is_some() && params.len() >= rigid + 6 * n;
         let joints = model
-            .joints
-            .iter()
+            .own_joints()
             .enumerate()
             .map(|(j, joint)| {
                 let mut parameters: Vec<ParamReport> =
-                    params[10 * n + PER_JOINT * j..10 * n + PER_JOINT * (j + 1)].to_vec();
+                    params[rigid + PER_JOINT * j..rigid + PER_JOINT * (j + 1)].to_vec();
                 if stribeck {
-                    parameters.extend_from_slice(&params[14 * n + 2 * j..14 * n + 2 * j + 2]);
+                    let at = rigid + PER_JOINT * n + 2 * j;
+                    parameters.extend_from_slice(&params[at..at + 2]);
                 }
                 JointParams {
                     name: joint.name.clone(),

@@ -1061,9 +1061,10 @@ impl Columns {
     }
 }
 
-/// `[Ia, Fv, Fc, F0]` of joint `j` in a solution of `10n + 4n` entries.
+/// `[Ia, Fv, Fc, F0]` of joint `j` of `n` in a solution of the bodies' parameters then
+/// `4n` joint terms.
 fn joint_linear(x: &[f64], n: usize, j: usize) -> [f64; PER_JOINT] {
-    let at = 10 * n + PER_JOINT * j;
+    let at = x.len() - PER_JOINT * (n - j);
     [x[at], x[at + 1], x[at + 2], x[at + 3]]
 }
 
@@ -1222,8 +1223,8 @@ fn rigid_torques(dynamics: &dyn Dynamics, traj: &Trajectory, params: &[f64]) -> 
     out
 }
 
-/// The sum of squared torque residuals of the whole model (rigid bodies
-/// `x[..10n]`, linear joint terms `x[10n..]`, the Stribeck terms), and the rigid-body
+/// The sum of squared torque residuals of the whole model (rigid bodies' parameters
+/// `x[..10 bodies]`, linear joint terms after them, the Stribeck terms), and the rigid-body
 /// torques (row-major, samples × joints).
 fn total_cost(
     dynamics: &dyn Dynamics,
@@ -1233,8 +1234,8 @@ fn total_cost(
     coulomb: Coulomb,
 ) -> (f64, Vec<f64>) {
     let n = dynamics.nv();
-    let rigid = rigid_torques(dynamics, traj, &x[..10 * n]);
-    let joints = &x[10 * n..];
+    let (bodies, joints) = x.split_at(dynamics.nparams());
+    let rigid = rigid_torques(dynamics, traj, bodies);
     let mut cost = 0.0;
     for k in 0..traj.len() {
         let (v, a, tau) = (traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]), traj.tau(k));

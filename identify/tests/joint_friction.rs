@@ -115,7 +115,7 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
     let loaded = read_log(&logger.write(&rec), Some("14,13,12,9,8.5,8"));
     let traj = &loaded;
     let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign);
-    let p = regressor.columns(6);
+    let p = regressor.columns(robot.model());
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(6)).unwrap();
     let mut y = vec![0.0; 6 * p];
     // Skip the filter's edges.

@@ -31,7 +31,7 @@ fn load(name: &str) -> Trajectory {
 }
 
 fn fit(robot: &Reference, traj: &Trajectory, regressor: TorqueRegressor) -> Estimate {
-    let p = regressor.columns(6);
+    let p = regressor.columns(robot.model());
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(6)).unwrap();
     let mut y = vec![0.0; 6 * p];
     for s in traj.samples() {
@@ -43,7 +43,7 @@ fn fit(robot: &Reference, traj: &Trajectory, regressor: TorqueRegressor) -> Esti
 }
 
 fn validate(robot: &Reference, traj: &Trajectory, regressor: TorqueRegressor, est: &Estimate) -> Validation {
-    let p = regressor.columns(6);
+    let p = regressor.columns(robot.model());
     let mut y = vec![0.0; 6 * p];
     let predicted: Vec<Vec<f64>> = traj
         .samples()

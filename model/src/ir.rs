@@ -316,6 +316,13 @@ impl Model {
         own(&self.joints[..j - 1]).map(|j| j.kind.nv()).sum()
     }
 
+    /// The joints with coordinates of their own (every joint but those that follow
+    /// another), in the order of their coordinates in `q` and `v`: with joints of one
+    /// coordinate each, joint `own_joints()[d]` moves velocity coordinate `d`.
+    pub fn own_joints(&self) -> impl Iterator<Item = &Joint> {
+        own(&self.joints)
+    }
+
     /// The first joint that follows another (`<mimic>`), if any: what the layers that
     /// take one coordinate per joint refuse by name.
     pub fn mimic_joint(&self) -> Option<&Joint> {

@@ -285,7 +285,8 @@ fn read_recipe(function: &str, path: Option<&Path>) -> PyResult<Recipe> {
     }
 }
 
-/// The robot at `robot_path`, with joints of one degree of freedom each.
+/// The robot at `robot_path`, with joints of one degree of freedom each (joints that
+/// follow others, `<mimic>`, have none and are taken).
 fn load_robot(robot_path: &Path) -> PyResult<Model> {
     let model = dyngen_model::load_robot_options(robot_path, LoadOptions::default())
         .map_err(|e| LoadError::new_err(e.to_string()))?;
@@ -293,14 +294,6 @@ fn load_robot(robot_path: &Path) -> PyResult<Model> {
         return Err(LoadError::new_err(format!(
             "{}: the robot has no moving joints",
             robot_path.display()
-        )));
-    }
-    if let Some(j) = model.mimic_joint() {
-        return Err(LoadError::new_err(format!(
-            "{}: joint `{}` follows another (a URDF <mimic> or an MJCF <equality><joint>); identification \
-             runs on robots whose joints each have a coordinate of their own",
-            robot_path.display(),
-            j.name
         )));
     }
     if let Some(j) = model.multi_dof_joint() {

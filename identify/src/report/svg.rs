@@ -97,7 +97,7 @@ pub fn trajectory_report(
     param_errors: Option<&[(String, Option<f64>)]>,
 ) -> Result<String, ReportError> {
     let measured: Vec<Vec<f64>> = (0..traj.len()).map(|k| traj.tau(k).to_vec()).collect();
-    let joint_names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let joint_names: Vec<&str> = model.own_joints().map(|j| j.name.as_str()).collect();
     svg_report(title, traj.t(), &measured, predicted, &joint_names, param_errors)
 }
 

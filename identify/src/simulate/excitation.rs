@@ -66,8 +66,7 @@ impl JointLimits {
     /// [`JointLimits::ACCELERATION_PER_VELOCITY`] times the speed.
     pub fn from_model(model: &Model) -> Vec<JointLimits> {
         model
-            .joints
-            .iter()
+            .own_joints()
             .map(|j| {
                 let (reach, speed) = if j.kind == JointKind::Prismatic {
                     (0.5, 0.5)
@@ -191,7 +190,7 @@ impl ExcitationDesign {
             duration: 10.0,
             samples: ExcitationDesign::default_samples(5),
             limits: JointLimits::from_model(model),
-            max_evaluations: ExcitationDesign::default_evaluations(model.dof()),
+            max_evaluations: ExcitationDesign::default_evaluations(model.nv()),
             restarts: 3,
             start_at_rest: false,
             seed: 1,

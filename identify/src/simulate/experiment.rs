@@ -152,13 +152,14 @@ pub fn record_trajectory(
     );
     assert_eq!(
         params.len(),
-        10 * n,
+        dynamics.nparams(),
         "`params` has length {}, the model needs {}",
         params.len(),
-        10 * n
+        dynamics.nparams()
     );
     let frames = Frames::of(model);
-    let mut poses = vec![Pose::default(); n];
+    let nb = model.dof();
+    let mut poses = vec![Pose::default(); nb];
     let rest = SpatialMotion {
         linear: Vector3::zeros(),
         angular: Vector3::zeros(),
@@ -168,16 +169,16 @@ pub fn record_trajectory(
             velocity: rest,
             acceleration: rest,
         };
-        n
+        nb
     ];
-    let mut resultants = vec![Wrench::default(); n];
+    let mut resultants = vec![Wrench::default(); nb];
     let mut samples: Vec<Sample> = Vec::with_capacity(times.len());
     for &t in times {
         let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         trajectory.eval(t, &mut q, &mut v, &mut a);
         let mut tau = vec![0.0; n];
         dynamics.rnea(&q, &v, &a, params, &mut tau);
-        let mut joint_wrenches = vec![Wrench::default(); n];
+        let mut joint_wrenches = vec![Wrench::default(); nb];
         dynamics.joint_wrenches(&q, &v, &a, params, &mut joint_wrenches);
         dynamics.forward_kinematics(&q, &mut poses);
         dynamics.body_motions(&q, &v, &a, &mut motions);
@@ -195,7 +196,7 @@ pub fn record_trajectory(
     }
     Recording {
         gravity: vector3(&model.gravity),
-        joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+        joint_names: model.own_joints().map(|j| j.name.clone()).collect(),
         body_names: model.bodies.iter().map(|b| b.name.clone()).collect(),
         samples,
     }
@@ -265,7 +266,7 @@ impl Recording {
     /// no joint wrench columns, or a number of joints other than `robot`'s.
     pub fn from_measurements(robot: &Reference, data: &crate::data::Trajectory) -> Result<Recording, DataError> {
         let model = robot.model();
-        let n = model.dof();
+        let n = model.nv();
         if data.dof() != n {
             return Err(DataError::LengthMismatch {
                 what: "joints of the data",
@@ -311,7 +312,7 @@ impl Recording {
         }
         Ok(Recording {
             gravity: vector3(&model.gravity),
-            joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+            joint_names: model.own_joints().map(|j| j.name.clone()).collect(),
             body_names: model.bodies.iter().map(|b| b.name.clone()).collect(),
             samples,
         })
@@ -328,15 +329,20 @@ impl Recording {
         let flat = |f: fn(&Sample) -> &Vec<f64>| -> Vec<f64> {
             self.samples.iter().flat_map(|s| f(s).iter().copied()).collect()
         };
-        crate::data::Trajectory::new(n, t, flat(|s| &s.q), flat(|s| &s.tau))?
+        let trajectory = crate::data::Trajectory::new(n, t, flat(|s| &s.q), flat(|s| &s.tau))?
             .with_velocities(flat(|s| &s.v))?
-            .with_accelerations(flat(|s| &s.a))?
-            .with_wrenches(
-                self.samples
-                    .iter()
-                    .flat_map(|s| s.joint_wrenches.iter().copied())
-                    .collect(),
-            )
+            .with_accelerations(flat(|s| &s.a))?;
+        // A trajectory holds a wrench per joint with a coordinate: with joints that
+        // follow others (`<mimic>`, more joints than coordinates) it holds none.
+        if self.body_names.len() != n {
+            return Ok(trajectory);
+        }
+        trajectory.with_wrenches(
+            self.samples
+                .iter()
+                .flat_map(|s| s.joint_wrenches.iter().copied())
+                .collect(),
+        )
     }
 
     pub fn len(&self) -> usize {
@@ -347,7 +353,8 @@ impl Recording {
         self.samples.is_empty()
     }
 
-    /// Number of joints (= moving bodies).
+    /// Number of joints with a coordinate of their own (= moving bodies, unless joints
+    /// follow others).
     pub fn nv(&self) -> usize {
         self.joint_names.len()
     }

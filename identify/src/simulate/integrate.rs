@@ -38,14 +38,13 @@ pub fn simulate_rk4(
     dt: f64,
     steps: usize,
 ) -> Simulation {
-    let n = dynamics.nv();
+    let (n, np) = (dynamics.nv(), dynamics.nparams());
     assert!(
-        q0.len() == n && v0.len() == n && params.len() == 10 * n,
-        "`q0`, `v0`, `params` have lengths {}, {}, {}; the model needs {n}, {n}, {}",
+        q0.len() == n && v0.len() == n && params.len() == np,
+        "`q0`, `v0`, `params` have lengths {}, {}, {}; the model needs {n}, {n}, {np}",
         q0.len(),
         v0.len(),
         params.len(),
-        10 * n
     );
     let mut tau = vec![0.0; n];
     // f(t, q, v) → acceleration, also returning the torque used.

@@ -1,7 +1,7 @@
 //! `dyngen info`: what dyngen sees in a URDF.
 
 use crate::common::{load_model, out, with_spinner, ModelArgs, Progress, Result};
-use dyngen_codegen::{analyse_model, generate, Options};
+use dyngen_codegen::{analyse_model, analyse_rigid, generate, Options};
 use dyngen_model::graph::{incidence, path_matrix};
 use dyngen_model::Model;
 use std::fmt::Write as _;
@@ -49,9 +49,18 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
         out!("{out}");
         return Ok(());
     }
-    let bases = with_spinner(progress, "finding the base parameters", || analyse_model(&model));
-    let base = &bases.standard;
-    let pbase = &bases.principal;
+    // Generation (the operation counts) needs the joint parameters' base too; what is
+    // printed does not.
+    let (base, pbase, bases) = with_spinner(progress, "finding the base parameters", || {
+        if args.no_ops {
+            let (standard, principal) = analyse_rigid(&model);
+            (standard, principal, None)
+        } else {
+            let bases = analyse_model(&model);
+            (bases.standard.clone(), bases.principal.clone(), Some(bases))
+        }
+    });
+    let (base, pbase) = (&base, &pbase);
     writeln!(
         out,
         "  base (identifiable from joint torques):                    {}",
@@ -79,10 +88,11 @@ pub fn run(args: &InfoArgs, progress: &Progress) -> Result<()> {
             writeln!(out, "  {:>3}  {g}", k + 1).ok();
         }
     }
-    if args.no_ops {
+    let Some(bases) = bases else {
+        // --no-ops
         out!("{out}");
         return Ok(());
-    }
+    };
     if let Some(why) = dyngen_codegen::unsupported(&model) {
         writeln!(out).ok();
         writeln!(out, "Generated functions: none ({why})").ok();

@@ -27,14 +27,29 @@ pub struct Bases {
 pub fn analyse_model(model: &Model) -> Bases {
     std::thread::scope(|s| {
         let joints = s.spawn(|| analyse(model, Parameterisation::StandardAndJoints));
-        let standard = analyse(model, Parameterisation::Standard);
-        let principal = analyse(model, Parameterisation::Principal);
+        let (standard, principal) = analyse_rigid(model);
         Bases {
             standard,
             principal,
             // A panic in the analysis is a bug; it is carried over as it was.
             joints: joints.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
         }
+    })
+}
+
+/// The base parameters of the standard and of the principal parameterisation, each on
+/// a thread of its own: what `dyngen info` prints, without the larger analysis of the
+/// standard and joint parameters together that only generation needs (on a
+/// 200-joint chain it is more than half of [`analyse_model`]'s time).
+pub fn analyse_rigid(model: &Model) -> (BaseParams, BaseParams) {
+    std::thread::scope(|s| {
+        let principal = s.spawn(|| analyse(model, Parameterisation::Principal));
+        let standard = analyse(model, Parameterisation::Standard);
+        // A panic in the analysis is a bug; it is carried over as it was.
+        (
+            standard,
+            principal.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
+        )
     })
 }
 

@@ -25,7 +25,7 @@ mod joints;
 mod mimic;
 pub mod sym;
 
-pub use base::{analyse_model, BaseParams, Bases};
+pub use base::{analyse_model, analyse_rigid, BaseParams, Bases};
 pub use build::{compile_urdf, write_if_changed, Config, Error};
 pub use capability::{Capability, Selection, UnknownCapability};
 pub use generate::{generate, is_type_name, GeneratedCode, Options, DEFAULT_COMPOSE_ABOVE_NV};

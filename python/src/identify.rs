@@ -200,7 +200,7 @@ pub fn identify<'py>(
         |path: &Path, e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", path.display()));
     let robot = Reference::new(&model);
     let (identified, validation) = py.detach(|| {
-        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(|e| failed(&data_path, e))?;
+        let loaded = pipeline::load(&data_path, &recipe, model.nv(), &options).map_err(|e| failed(&data_path, e))?;
         let mut identified =
             pipeline::identify(&robot, &loaded.trajectory, &options).map_err(|e| failed(&data_path, e))?;
         // What `--params-json` records of the preprocessing, for `dyngen validate`.
@@ -229,11 +229,11 @@ pub fn identify<'py>(
             None => None,
             Some(path) => {
                 let other =
-                    pipeline::load(path, &validation_recipe, model.dof(), &options).map_err(|e| failed(path, e))?;
+                    pipeline::load(path, &validation_recipe, model.nv(), &options).map_err(|e| failed(path, e))?;
                 let predicted = identified
                     .predict(&robot, &other.trajectory)
                     .map_err(|e| failed(path, e))?;
-                let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+                let names: Vec<String> = model.own_joints().map(|j| j.name.clone()).collect();
                 let t = &other.trajectory;
                 let v = Validation::new(&names, (0..t.len()).map(|k| t.tau(k)), predicted.iter().map(|p| &p[..]))
                     .map_err(|e| PyValueError::new_err(format!("identify: validation {}: {e}", path.display())))?;
@@ -585,7 +585,7 @@ pub fn identify_partial(
     let recipe = read_recipe("identify_partial", recipe.as_deref())?;
     let model = load_robot(&robot_path)?;
     let inner = py.detach(|| {
-        let loaded = pipeline::load(&data_path, &recipe, model.dof(), &options).map_err(failed)?;
+        let loaded = pipeline::load(&data_path, &recipe, model.nv(), &options).map_err(failed)?;
         let span = DataSpan::of(&data_path, &loaded.trajectory);
         Partial::from_trajectory(&Reference::new(&model), &loaded.trajectory, &options, &recipe, span).map_err(failed)
     })?;

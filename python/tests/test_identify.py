@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import dyngen
-from conftest import ROBOTS, dyngen_command
+from conftest import ROBOTS, ROOT, dyngen_command
 
 
 @pytest.fixture(scope="module")
@@ -119,3 +119,31 @@ def test_svg_report(recording, tmp_path):
     svg.write_text("kept?")
     dyngen.identify(ROBOTS[0][1], path, raw_states=True, report=svg, overwrite=True)
     assert svg.read_text().startswith("<svg")
+
+
+def test_identifies_a_robot_with_mimic_joints(tmp_path):
+    """An arm with a linkage gripper (five joints follow one driven finger joint): the
+    recording has one column per coordinate, the leaders', and the base parameters of
+    the simulated parameters come back."""
+    urdf = ROOT / "tests" / "fixtures" / "mimic" / "arm_linkage_gripper.urdf"
+    robot = dyngen.load(urdf)
+    assert (robot.nv, robot.nbodies) == (7, 12)
+    rng = np.random.default_rng(4)
+    truth = robot.params * np.repeat(rng.uniform(0.8, 1.3, robot.nbodies), 10)
+    t = np.arange(1500) * 0.01
+    n = robot.nv
+    amplitude, frequency = rng.uniform(0.2, 0.6, (n, 3)), rng.uniform(0.1, 0.6, (n, 3)) * 2 * np.pi
+    phase = rng.uniform(0, 2 * np.pi, (n, 3))
+    arg = frequency[None] * t[:, None, None] + phase[None]
+    q = np.sum(amplitude[None] * np.sin(arg), axis=2)
+    v = np.sum(amplitude[None] * frequency[None] * np.cos(arg), axis=2)
+    a = -np.sum(amplitude[None] * frequency[None] ** 2 * np.sin(arg), axis=2)
+    tau = robot.rnea(q, v, a, params=truth)
+    path = tmp_path / "gripper.csv"
+    header = ["t"] + [f"{x}{j + 1}" for x in ("q", "v", "a", "tau") for j in range(n)]
+    np.savetxt(path, np.column_stack([t, q, v, a, tau]), delimiter=",", header=",".join(header), comments="",
+               fmt="%.17g")
+    result = dyngen.identify(urdf, path, raw_states=True)
+    assert len(result["names"]) == 10 * robot.nbodies
+    k = result["combination_matrix"]
+    np.testing.assert_allclose(result["combination_values"], k @ truth, rtol=1e-7, atol=1e-9)

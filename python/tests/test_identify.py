@@ -18,21 +18,27 @@ def recording(tmp_path_factory):
     robot = dyngen.load(ROBOTS[0][1])
     rng = np.random.default_rng(1)
     truth = robot.params * np.repeat(rng.uniform(0.7, 1.4, robot.nbodies), 10)
-    t = np.arange(2000) * 0.01
+    path = tmp_path_factory.mktemp("identify") / "ur5.csv"
+    write_sines(robot, truth, 2000, (0.3, 0.8), rng, path)
+    return robot, truth, path
+
+
+def write_sines(robot, params, samples, amplitudes, rng, path):
+    """Every coordinate along a sum of three sines (100 Hz), with the torques of
+    `params`, written to `path` in dyngen's CSV schema."""
+    t = np.arange(samples) * 0.01
     n = robot.nv
-    amplitude = rng.uniform(0.3, 0.8, (n, 3))
+    amplitude = rng.uniform(*amplitudes, (n, 3))
     frequency = rng.uniform(0.1, 0.6, (n, 3)) * 2 * np.pi
     phase = rng.uniform(0, 2 * np.pi, (n, 3))
     arg = frequency[None] * t[:, None, None] + phase[None]
     q = np.sum(amplitude[None] * np.sin(arg), axis=2)
     v = np.sum(amplitude[None] * frequency[None] * np.cos(arg), axis=2)
     a = -np.sum(amplitude[None] * frequency[None] ** 2 * np.sin(arg), axis=2)
-    tau = robot.rnea(q, v, a, params=truth)
-    path = tmp_path_factory.mktemp("identify") / "ur5.csv"
+    tau = robot.rnea(q, v, a, params=params)
     header = ["t"] + [f"{x}{j + 1}" for x in ("q", "v", "a", "tau") for j in range(n)]
     np.savetxt(path, np.column_stack([t, q, v, a, tau]), delimiter=",", header=",".join(header), comments="",
                fmt="%.17g")
-    return robot, truth, path
 
 
 def test_identifies_what_the_data_determines(recording):
@@ -130,19 +136,8 @@ def test_identifies_a_robot_with_mimic_joints(tmp_path):
     assert (robot.nv, robot.nbodies) == (7, 12)
     rng = np.random.default_rng(4)
     truth = robot.params * np.repeat(rng.uniform(0.8, 1.3, robot.nbodies), 10)
-    t = np.arange(1500) * 0.01
-    n = robot.nv
-    amplitude, frequency = rng.uniform(0.2, 0.6, (n, 3)), rng.uniform(0.1, 0.6, (n, 3)) * 2 * np.pi
-    phase = rng.uniform(0, 2 * np.pi, (n, 3))
-    arg = frequency[None] * t[:, None, None] + phase[None]
-    q = np.sum(amplitude[None] * np.sin(arg), axis=2)
-    v = np.sum(amplitude[None] * frequency[None] * np.cos(arg), axis=2)
-    a = -np.sum(amplitude[None] * frequency[None] ** 2 * np.sin(arg), axis=2)
-    tau = robot.rnea(q, v, a, params=truth)
     path = tmp_path / "gripper.csv"
-    header = ["t"] + [f"{x}{j + 1}" for x in ("q", "v", "a", "tau") for j in range(n)]
-    np.savetxt(path, np.column_stack([t, q, v, a, tau]), delimiter=",", header=",".join(header), comments="",
-               fmt="%.17g")
+    write_sines(robot, truth, 1500, (0.2, 0.6), rng, path)
     result = dyngen.identify(urdf, path, raw_states=True)
     assert len(result["names"]) == 10 * robot.nbodies
     k = result["combination_matrix"]

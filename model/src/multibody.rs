@@ -8,7 +8,7 @@ use dyngen_algo::{JointSpec, Multibody, Se3, TreeError};
 impl Model {
     /// This model as the algorithms' [`Multibody`]: the same numbering, placements,
     /// axes, gravity and nominal standard parameters ([`Model::standard_params`]), and
-    /// the joints that follow others ([`crate::Mimic`]) as [`dyngen_algo::Mimic`]s.
+    /// the joints that follow others ([`crate::JointMimic`]) as [`dyngen_algo::Mimic`]s.
     ///
     /// ```
     /// let model = dyngen_model::parse_urdf(r#"<robot name="r"><link name="base"/>

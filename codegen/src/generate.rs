@@ -863,9 +863,10 @@ impl Algorithm {
 /// `nonlinear_effects` is `rnea` at zero acceleration, the principal regressor is the
 /// standard one times each body's constant `P_i` (`π_i = P_i θ_i`), and the base
 /// regressors are the independent columns of the full ones (which is what their graphs
-/// compute). `aba`
-/// always has its own graph: without rotor inertias the articulated inertia passed to
-/// the parent has zero rows along the joint axes, which the one with them lacks.
+/// compute). On a tree `aba` always has its own graph: without rotor inertias the
+/// articulated inertia passed to the parent has zero rows along the joint axes, which
+/// the one with them lacks. With joints that follow others (any size) `aba` is
+/// composed of `crba` and `nonlinear_effects`, solved densely (`crate::mimic`).
 fn composed(algorithm: &Algorithm, model: &Model, sizes: &Sizes, above: usize) -> Option<TokenStream> {
     let followers = crate::mimic::has_followers(model);
     if sizes.nv <= above && !(followers && algorithm.name == "aba") {

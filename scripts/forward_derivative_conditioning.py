@@ -13,7 +13,7 @@ metric `‖x − y‖∞ / ‖y‖∞`. `∂τ/∂q` at `a = q̈` comes from Pin
 
 With `--write`, also writes the extended-precision `M⁻¹` and `∂q̈/∂q` of each sample,
 rounded to double, beside the fixture (`humanoid31.json` → `humanoid31_extended.json`),
-for `tests/tests/floating.rs` to measure dyngen against.
+for `tests/tests/integration/floating.rs` to measure dyngen against.
 """
 
 import json

@@ -17,7 +17,7 @@ The URDFs are written here, from the dimensions below, into `tests/fixtures/mimi
   leaders', one at the tip. (Pinocchio needs a leader before its followers in its
   numbering, a leader that follows no other, and the two of one configuration size, so
   not a continuous joint, nq = 2 there, after a revolute one; dyngen needs none of
-  these, which `tests/tests/mimic.rs` checks against the tree without followers.)
+  these, which `tests/tests/integration/mimic.rs` checks against the tree without followers.)
 
 Per sample, in Pinocchio's coordinates (`q = [p; x, y, z, w]` for the free flyer):
 `tau = rnea(q, v, a)`, `nle`, `gravity`, `M` (crba, mirrored), the centre of mass, its

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the MJCF census: the DeepMind control suite models (`dm_control/suite/*.xml`,
 Apache-2.0) with MuJoCo's mass matrices and bias forces, for
-`tests/tests/census_mjcf.rs`.
+`tests/tests/integration/census_mjcf.rs`.
 
 Needs `pip install dm_control` (which installs `mujoco`; written against
 dm_control 1.0.50 and MuJoCo 4.0.0). From the project root:

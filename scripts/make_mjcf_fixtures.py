@@ -21,7 +21,7 @@ For each of `robots/ur5/ur5.urdf` and `robots/panda/panda.urdf`:
 
 For `robots/quadruped12/quadruped12.urdf`, (a) with the root link put on a URDF
 `floating` joint from a `world` link first: `quadruped12.xml`, with MuJoCo's free
-joint; `model/tests/mjcf.rs` reads it and checks it against the URDF loaded with a
+joint; `model/tests/integration/mjcf.rs` reads it and checks it against the URDF loaded with a
 free flyer (the same robot in both formats).
 
 (c) For the hand-written `small.xml` (not written by this script), MuJoCo's values as
@@ -233,7 +233,7 @@ def main():
             continue
         xml = os.path.join(args.out_dir, name + ".xml")
         urdf_to_mjcf(urdf, xml, floating=True)
-        print(f"{name}: {xml} (floating; compared with the URDF on a free flyer by model/tests/mjcf.rs)")
+        print(f"{name}: {xml} (floating; compared with the URDF on a free flyer by model/tests/integration/mjcf.rs)")
     for name, urdf in ROBOTS.items():
         if not wanted(name):
             continue

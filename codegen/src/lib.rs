@@ -144,7 +144,7 @@ mod tests {
     use super::*;
 
     /// The followers' rules are in the generated `MODEL` (the numbers are checked in
-    /// `tests/tests/census.rs`, `generated_mimic_robots_match_pinocchio`).
+    /// `tests/tests/integration/census.rs`, `generated_mimic_robots_match_pinocchio`).
     #[test]
     fn the_macro_generates_mimic_joints() {
         let input = quote! { name: Gripper, urdf: "../tests/fixtures/mimic/arm_linkage_gripper.urdf" };

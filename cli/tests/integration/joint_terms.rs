@@ -4,9 +4,8 @@
 //! `--urdf-out` writing every identified joint term (in the URDF's `<dynamics>`
 //! what it can hold, the rest in a JSON file beside it).
 
-mod common;
-
-use common::{assert_error, assert_exit, assert_ok, run, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_error, assert_exit, assert_ok, run, stdout, temp_dir, ur5};
 use dyngen_identify::report::{JointParamsFile, ParamReport, ParamStatus, ParameterReport, JOINT_PARAMS_SCHEMA};
 use std::path::PathBuf;
 

@@ -1,8 +1,6 @@
 //! Each kind of failure has its own exit code (documented in `dyngen --help`).
 
-mod common;
-
-use common::{assert_exit, run, simulate_ur5, stdout, temp_dir, ur5};
+use crate::common::{assert_exit, run, simulate_ur5, stdout, temp_dir, ur5};
 
 #[test]
 fn exit_codes_say_what_kind_of_failure_it_was() {

@@ -3,25 +3,14 @@
 //! the Pinocchio + numpy/scipy pipeline with per-joint friction (3.58 % overall on the
 //! same files, `scripts/identify_pinocchio_scipy.py`).
 
-mod common;
-
-use common::{assert_exit, assert_ok, run, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_exit, assert_ok, overall, run, stdout, temp_dir, ur5};
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/fixtures/mujoco")
         .join(name)
-}
-
-/// The overall relative error `validate` prints, as a fraction.
-fn overall(out: &str) -> f64 {
-    out.lines()
-        .find_map(|l| l.strip_prefix("overall relative error "))
-        .and_then(|l| l.split_whitespace().next())
-        .and_then(|x| x.parse::<f64>().ok())
-        .map(|p| p / 100.0)
-        .unwrap_or_else(|| panic!("no overall error in:\n{out}"))
 }
 
 #[test]

@@ -327,7 +327,7 @@ fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
     println!("validation: OLS {e_ols:.5}, consistent {e_cons:.5}");
     assert!(e_cons <= 1.01 * e_ols, "consistent {e_cons} vs OLS {e_ols}");
     // Every joint's friction goes to the URDF, those at a bound included.
-    let urdf = include_str!("../../robots/ur5/ur5.urdf");
+    let urdf = include_str!("../../../robots/ur5/ur5.urdf");
     let rewrite = consistent.rewrite_urdf(urdf, robot.model(), MergedLinks::Lump).unwrap();
     assert_eq!(rewrite.dynamics.len(), 6, "{:?}", rewrite.dynamics_kept);
     assert!(rewrite.dynamics.iter().all(|(_, fv, fc)| *fv >= 0.0 && *fc >= 0.0));
@@ -480,7 +480,7 @@ fn rotor_inertia_is_fitted_or_left_out_on_its_own() {
         }
     }
     // The friction terms left out of the model are not friction to write.
-    let urdf = include_str!("../../robots/ur5/ur5.urdf");
+    let urdf = include_str!("../../../robots/ur5/ur5.urdf");
     let rewrite = id.rewrite_urdf(urdf, robot.model(), MergedLinks::Lump).unwrap();
     assert!(rewrite.dynamics.is_empty());
     assert!(rewrite

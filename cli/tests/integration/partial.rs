@@ -2,9 +2,8 @@
 //! recording merged give the one-file identification; every refusal names the
 //! option or the files.
 
-mod common;
-
-use common::{assert_error, assert_ok, pendulum, run, simulate_ur5, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_error, assert_ok, pendulum, run, simulate_ur5, stdout, temp_dir, ur5};
 use dyngen_identify::report::ParameterReport;
 use std::path::{Path, PathBuf};
 

@@ -11,8 +11,8 @@ use dyngen_identify::report::{
 use dyngen_identify::{self as identify, faer::Mat, Status};
 use dyngen_model::{parse_urdf, Inertial};
 
-const UR5: &str = include_str!("../../robots/ur5/ur5.urdf");
-const GRIPPER_ARM: &str = include_str!("../../robots/gripper_arm/gripper_arm.urdf");
+const UR5: &str = include_str!("../../../robots/ur5/ur5.urdf");
+const GRIPPER_ARM: &str = include_str!("../../../robots/gripper_arm/gripper_arm.urdf");
 
 /// A fresh path in cargo's per-test scratch directory (removed first if present).
 fn scratch(name: &str) -> PathBuf {

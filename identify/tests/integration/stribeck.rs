@@ -6,9 +6,7 @@
 //! term does not predict held-out time blocks), so it is no worse; its JSON
 //! predicts the same.
 
-mod common;
-
-use common::{add_torque_noise, joint_truth, motion, overall_error, ur5, FC};
+use crate::common::{add_torque_noise, joint_truth, motion, overall_error, ur5, FC};
 use dyngen_identify::data::Trajectory;
 use dyngen_identify::pipeline::{self, Identification, IdentifyOptions, JointTerms, PipelineError};
 use dyngen_identify::report::{ParamStatus, ParameterReport};

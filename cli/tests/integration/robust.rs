@@ -1,9 +1,8 @@
 //! Damaged and unusual inputs through the command line: each is refused with a
 //! message naming the culprit, never a crash or a silent wrong result.
 
-mod common;
-
-use common::{assert_exit, assert_ok, pendulum, run, stderr, temp_dir};
+use crate::common;
+use crate::common::{assert_exit, assert_ok, pendulum, run, stderr, temp_dir};
 
 #[test]
 fn deeply_nested_xml_is_refused_not_a_stack_overflow() {

@@ -17,7 +17,7 @@ use nalgebra::{DMatrix, Matrix3, Rotation3, Vector3, Vector4};
 
 const URDF: &str = include_str!("simulate_arm.urdf");
 
-dyngen::robot!(name: SimulateArm, urdf: "tests/simulate_arm.urdf");
+dyngen::robot!(name: SimulateArm, urdf: "tests/integration/simulate_arm.urdf");
 
 fn model() -> Model {
     dyngen_model::parse_urdf(URDF).expect("test URDF is valid")
@@ -31,7 +31,7 @@ fn reference() -> (Model, Reference) {
 
 /// The shipped UR5.
 fn ur5() -> (Model, Reference) {
-    let m = dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap();
+    let m = dyngen_model::parse_urdf(include_str!("../../../robots/ur5/ur5.urdf")).unwrap();
     let r = Reference::new(&m);
     (m, r)
 }

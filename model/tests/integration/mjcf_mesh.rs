@@ -6,9 +6,8 @@
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, parse_mjcf, Model};
-mod common;
 
-use common::{load_error, TempDir};
+use crate::common::{load_error, TempDir};
 use serde_json::Value;
 use std::path::PathBuf;
 

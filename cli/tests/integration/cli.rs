@@ -1,8 +1,7 @@
 //! The `dyngen` binary end to end, on robots/ur5/ur5.urdf and broken inputs.
 
-mod common;
-
-use common::{assert_error, assert_exit, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_error, assert_exit, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
 
 #[test]
 fn help_has_examples() {

@@ -3,9 +3,8 @@
 //! robot, absurd flag values, a byte order mark. Each is a clear error with its exit
 //! code (or, for the byte order mark, accepted), never a crash or a silent result.
 
-mod common;
-
-use common::{assert_exit, assert_ok, pendulum, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_exit, assert_ok, pendulum, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
 use std::process::{Command, Stdio};
 
 /// Rows of a pendulum recording `t, q1, tau1` (header included).

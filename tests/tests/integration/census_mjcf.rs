@@ -16,7 +16,7 @@
 //! read as mimic joints, against MuJoCo's dynamics reduced to the leaders'
 //! coordinates.
 //!
-//! `cargo test -p dyngen-tests --test census_mjcf -- --nocapture` prints the table.
+//! `cargo test -p dyngen-tests --test integration census_mjcf -- --nocapture` prints the table.
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, Model};

@@ -54,6 +54,16 @@ macro_rules! run {
 }
 pub(crate) use run;
 
+/// The overall relative error `validate` prints, as a fraction.
+pub fn overall(out: &str) -> f64 {
+    out.lines()
+        .find_map(|l| l.strip_prefix("overall relative error "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|x| x.parse::<f64>().ok())
+        .map(|p| p / 100.0)
+        .unwrap_or_else(|| panic!("no overall error in:\n{out}"))
+}
+
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }

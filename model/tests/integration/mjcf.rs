@@ -16,9 +16,8 @@
 
 use dyngen_model::regressor::{inverse_dynamics, mass_matrix};
 use dyngen_model::{load_mjcf, load_robot, load_urdf, parse_mjcf, Element, ErrorKind, JointKind, Model, ModelErrors};
-mod common;
 
-use common::{load_error, TempDir};
+use crate::common::{load_error, TempDir};
 use serde_json::Value;
 use std::path::PathBuf;
 

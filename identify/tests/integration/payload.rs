@@ -2,9 +2,7 @@
 //! last link, with rotor inertia and friction in its drives and 1 % torque noise; the
 //! load's mass, centre of mass and inertia from `τ − τ_known = Y_6 · π_L`.
 
-mod common;
-
-use common::{joint_truth, motion, ur5};
+use crate::common::{joint_truth, motion, ur5};
 use dyngen_identify::payload::{self, KnownRobot, Payload};
 use dyngen_identify::simulate::{add_joint_terms, record_trajectory, Gaussian};
 use dyngen_identify::{IdentifyError, Options};

@@ -3,9 +3,7 @@
 //! records every preprocessing choice and `validate` applies them, non-physical
 //! joint parameters are flagged, and `--friction auto` says which ε it chose.
 
-mod common;
-
-use common::{assert_exit, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
+use crate::common::{assert_exit, assert_ok, run, simulate_ur5, stderr, stdout, temp_dir, ur5};
 use dyngen_identify::report::{CoulombReport, ParameterReport};
 use std::path::{Path, PathBuf};
 

@@ -1,9 +1,8 @@
 //! `dyngen identify` with --params-json, --svg and --urdf-out on robots/ur5/ur5.urdf.
 
 use dyngen_identify::report::{ParamStatus, ParameterReport};
-mod common;
 
-use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
+use crate::common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
 use std::path::{Path, PathBuf};
 
 const JOINTS: [&str; 6] = [

@@ -2,9 +2,7 @@
 //! training budget: these test the command, the accuracy is tested in the tests
 //! crate).
 
-mod common;
-
-use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
+use crate::common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5, without_wrenches};
 use dyngen_identify::report::{ParamStatus, ParameterReport};
 use std::path::{Path, PathBuf};
 

@@ -55,7 +55,7 @@ fn validate(robot: &Reference, traj: &Trajectory, regressor: TorqueRegressor, es
 
 #[test]
 fn mujoco_recordings_are_predicted_better_than_the_baseline() {
-    let robot = Reference::new(&dyngen_model::parse_urdf(include_str!("../../robots/ur5/ur5.urdf")).unwrap());
+    let robot = Reference::new(&dyngen_model::parse_urdf(include_str!("../../../robots/ur5/ur5.urdf")).unwrap());
     let (identify, check) = (load("ur5_identify.csv"), load("ur5_validate.csv"));
     let mut results = Vec::new();
     for (label, regressor) in [

@@ -1,8 +1,7 @@
 //! `dyngen identify` on recordings in other layouts: recipes and their flags.
 
-mod common;
-
-use common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5};
+use crate::common;
+use crate::common::{assert_error, assert_ok, run, simulate_ur5, stdout, temp_dir, ur5};
 use std::fmt::Write;
 use std::path::Path;
 

@@ -1,0 +1,17 @@
+//! Integration tests of the `dyngen` command: each runs the built binary.
+//!
+//! One test binary: it links once, and its tests share the cores.
+
+mod common;
+
+mod cli;
+mod exit_codes;
+mod hostile;
+mod identify_outputs;
+mod joint_terms;
+mod logs;
+mod nim;
+mod partial;
+mod preprocessing;
+mod robust;
+mod validate;

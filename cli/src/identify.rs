@@ -64,6 +64,13 @@ measured and what estimated:
   dyngen identify robots/ur5/ur5.urdf robot.log --recipe docs/example.recipe
   dyngen identify robots/ur5/ur5.urdf log.csv --no-header --delimiter semicolon \\
       --degrees --gains 0.11,0.11,0.11,0.05,0.05,0.05 --window 5:65 --resample 0.01
+Unknown torque constants: --drive-gains identifies them with the dynamics (Gautier
+and Briot) from two logs of motor currents, the second recorded with a known payload
+fixed to --payload-frame; the parameters then come from DATA read with the identified
+gains, which --params-json records for `dyngen validate`:
+  dyngen identify robots/ur5/ur5.urdf currents.csv --friction sign \
+      --drive-gains loaded.csv --payload-frame wrist_3_link --payload-mass 5 \
+      --payload-com 0.1,0,0.05 --payload-inertia 0.0044,0.0044,0.0063
 --mode mim also needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, … (what
 `dyngen simulate` writes).
 
@@ -289,6 +296,9 @@ pub struct IdentifyArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
+
+    #[command(flatten)]
+    pub drive: crate::gains::DriveGainArgs,
 }
 
 /// The robot's gravity and how to read and differentiate a recording: shared by the
@@ -542,6 +552,11 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     // another has none).
     let n = model.nv();
     let recipe = args.recording.recipe.recipe()?;
+    // Drive gains first: the recordings are then read as torques, with them.
+    let recipe = match &args.drive.drive_gains {
+        Some(loaded) => crate::gains::identify(args, &model, data, loaded, &recipe)?,
+        None => recipe,
+    };
     // The validation recording's recipe, checked before any work.
     let validation_recipe = match &args.validate_recipe {
         Some(path) => Recipe::from_file(path).map_err(|e| CliError::input(path, e))?,

@@ -17,6 +17,7 @@
 mod common;
 mod demo;
 mod error;
+mod gains;
 mod generate;
 mod identify;
 mod info;

@@ -40,6 +40,12 @@ pub struct GainEstimate {
     pub initial: Estimate,
     /// `k_j` per joint.
     pub gains: Vec<f64>,
+    /// The standard deviation of each `k_j`, to first order at the solution: the
+    /// residuals in current units, one noise level for every joint's current, the
+    /// covariance of `w = 1/k` from the normal matrix of all unknowns `[π; φ; w]`
+    /// (the parameters the data cannot determine left out, as a pseudo-inverse
+    /// does), then `σ(k) = σ(w)/w²`.
+    pub gain_sigma: Vec<f64>,
     /// `[π; φ]` (`14n`) at the end: a minimum-norm solution (use it to predict; the
     /// identifiable combinations are those of [`GainEstimate::initial`]).
     pub solution: Vec<f64>,
@@ -73,6 +79,7 @@ pub fn identify_gains(
     let mut y = vec![0.0; n * pa];
     let mut row = Mat::<f64>::zeros(n, p);
     let mut rhs = vec![0.0; n];
+    let mut samples = 0;
     for (traj, with_load) in [(unloaded, false), (loaded, true)] {
         if traj.dof() != n {
             return Err(IdentifyError::DimensionMismatch {
@@ -104,6 +111,7 @@ pub fn identify_gains(
                 rhs[j] = -l;
             }
             acc.push_rows(row.as_ref(), &rhs)?;
+            samples += 1;
         }
     }
     // The stacked solution, without the payload column (it is known: 0 there).
@@ -142,16 +150,38 @@ pub fn identify_gains(
     // (column pa + j holds −i_j); the sum of squares in current units is then
     // Σ_j (Σ i² − 2 w_j Σ i f + w_j² Σ f²) with f = A_j x + l_j.
     let ata: Vec<Mat<f64>> = grams.iter().map(|g| block(g, 0, 0, pa, pa)).collect();
+    // Its matrix is singular where the data leave parameters undetermined, and its
+    // range (the sum of the joints' ranges) is the same for every nonzero w: so the
+    // minimum-norm solution is U z with U an orthonormal basis of that range, found
+    // once, and z from the positive definite Uᵀ(Σ_j w_j² A_jᵀA_j)U by Cholesky, at
+    // every step of the searches below.
+    let basis = {
+        let total = ata.iter().fold(Mat::<f64>::zeros(pa, pa), |s, a| s + a);
+        let (values, vectors) = eigen(total.as_ref())?;
+        let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let kept: Vec<usize> = (0..pa).filter(|&i| values[i] > 1e-12 * largest).collect();
+        Mat::from_fn(pa, kept.len(), |r, k| vectors[(r, kept[k])])
+    };
+    let projected: Vec<Mat<f64>> = ata.iter().map(|a| basis.transpose() * a * &basis).collect();
     let solve = |w: &[f64]| -> Result<Vec<f64>, IdentifyError> {
-        let mut lhs = Mat::<f64>::zeros(pa, pa);
-        let mut b = vec![0.0; pa];
+        let r = basis.ncols();
+        let mut lhs = Mat::<f64>::zeros(r, r);
+        let mut b = Mat::<f64>::zeros(pa, 1);
         for (j, g) in grams.iter().enumerate() {
-            lhs += &ata[j] * (w[j] * w[j]);
+            lhs += &projected[j] * (w[j] * w[j]);
             for c in 0..pa {
-                b[c] += w[j] * (-g[(c, pa + j)] - w[j] * g[(c, p - 1)]);
+                b[(c, 0)] += w[j] * (-g[(c, pa + j)] - w[j] * g[(c, p - 1)]);
             }
         }
-        min_norm_solve(lhs.as_ref(), &b)
+        use faer::prelude::Solve;
+        let z = lhs
+            .llt(faer::Side::Lower)
+            .map_err(|_| IdentifyError::DecompositionFailed {
+                what: "normal equations of the drive-gain problem",
+            })?
+            .solve(basis.transpose() * &b);
+        let x = &basis * &z;
+        Ok((0..pa).map(|i| x[(i, 0)]).collect())
     };
     // Per joint: (Σ i f, Σ f²) at x.
     let sums = |x: &[f64]| -> Vec<(f64, f64)> {
@@ -219,13 +249,87 @@ pub fn identify_gains(
     w = to_w(&best.x);
     iterations += best.evaluations;
     let x = solve(&w)?;
+    let ff: Vec<f64> = sums(&x).into_iter().map(|(_, ff)| ff).collect();
+    let gain_sigma = gain_sigma(&grams, &ata, &w, &x, &ff, objective(&w, &x), samples)?;
     Ok(GainEstimate {
         initial,
         gains: w.iter().map(|w| 1.0 / w).collect(),
+        gain_sigma,
         solution: x,
         iterations,
         last_change,
     })
+}
+
+/// `σ(k_j)` at the solution `(x, w)` of the problem in current units, whose residual
+/// of joint `j` is `i_j − w_j·f_j` with `f_j = A_j x + l_j`: the Jacobian's columns
+/// are `−w_j A_j` for `x` and `−f_j` for `w_j`, so the normal matrix has the blocks
+/// `N_xx = Σ_j w_j² A_jᵀA_j`, `N_x,w_j = w_j (A_jᵀA_j x + A_jᵀ l_j)` and
+/// `N_w_j,w_j = f_jᵀf_j` (`ff`), all from the per-joint Gram matrices of `[A, −i, l]`. The
+/// covariance of `w` is `s²·S⁻¹` with the Schur complement
+/// `S = N_ww − N_wx N_xx⁺ N_xw` and `s²` the residual sum of squares over the rows
+/// left after the unknowns the data determine.
+fn gain_sigma(
+    grams: &[Mat<f64>],
+    ata: &[Mat<f64>],
+    w: &[f64],
+    x: &[f64],
+    ff: &[f64],
+    sum_of_squares: f64,
+    samples: usize,
+) -> Result<Vec<f64>, IdentifyError> {
+    let n = w.len();
+    let pa = x.len();
+    let p = pa + n + 1;
+    let mut nxx = Mat::<f64>::zeros(pa, pa);
+    for (j, a) in ata.iter().enumerate() {
+        nxx += a * (w[j] * w[j]);
+    }
+    let (values, _) = eigen(nxx.as_ref())?;
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let rank_x = values.iter().filter(|&&v| v > 1e-12 * largest).count();
+    let b: Vec<Vec<f64>> = (0..n)
+        .map(|j| {
+            (0..pa)
+                .map(|r| w[j] * ((0..pa).map(|c| ata[j][(r, c)] * x[c]).sum::<f64>() + grams[j][(r, p - 1)]))
+                .collect()
+        })
+        .collect();
+    let solved: Vec<Vec<f64>> = b
+        .iter()
+        .map(|bj| min_norm_solve(nxx.as_ref(), bj))
+        .collect::<Result<_, _>>()?;
+    let schur = Mat::from_fn(n, n, |r, c| {
+        let diagonal = if r == c { ff[r] } else { 0.0 };
+        diagonal - b[r].iter().zip(&solved[c]).map(|(u, v)| u * v).sum::<f64>()
+    });
+    let dof = (samples * n).saturating_sub(rank_x + n);
+    let undetermined = || IdentifyError::InvalidArgument {
+        what: "recordings",
+        reason: "they do not determine the drive gains apart from the dynamic parameters".into(),
+    };
+    if dof == 0 {
+        return Err(undetermined());
+    }
+    let s2 = sum_of_squares / dof as f64;
+    let (values, vectors) = eigen(schur.as_ref())?;
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if values.iter().any(|&v| v <= 1e-12 * largest) {
+        return Err(undetermined());
+    }
+    let sigma: Vec<f64> = (0..n)
+        .map(|j| {
+            let variance: f64 = (0..n)
+                .map(|i| vectors[(j, i)] * vectors[(j, i)] / values[i])
+                .sum::<f64>()
+                * s2;
+            variance.sqrt() / (w[j] * w[j])
+        })
+        .collect();
+    if sigma.iter().any(|s| !s.is_finite()) {
+        return Err(undetermined());
+    }
+    Ok(sigma)
 }
 
 /// The eigenvalues and eigenvectors (columns) of a symmetric `G`.

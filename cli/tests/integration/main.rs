@@ -5,6 +5,7 @@
 mod common;
 
 mod cli;
+mod drive_gains;
 mod exit_codes;
 mod hostile;
 mod identify_outputs;

@@ -4,9 +4,7 @@
 //! stamps, duplicate rows, motor currents, 1 % torque noise), validated on a second
 //! recording it was not identified on.
 
-mod common;
-
-use common::{add_torque_noise, joint_truth, motion, overall_error, ur5, F0, FC, FV, IA};
+use crate::common::{add_torque_noise, joint_truth, motion, overall_error, ur5, F0, FC, FV, IA};
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
@@ -232,9 +230,10 @@ fn drive_gains_from_a_known_payload() {
     let est = identify_gains(&robot, &unloaded, &loaded, &payload, Coulomb::Sign, &Options::default()).unwrap();
     for j in 0..6 {
         println!(
-            "k{} = {:.4} (stacked least squares {:.4}; truth {})",
+            "k{} = {:.4} ± {:.4} (stacked least squares {:.4}; truth {})",
             j + 1,
             est.gains[j],
+            est.gain_sigma[j],
             est.initial.solution[84 + j],
             GAINS[j]
         );
@@ -248,6 +247,15 @@ fn drive_gains_from_a_known_payload() {
         assert!(
             (k - GAINS[j]).abs() < 0.01 * GAINS[j],
             "k{}: {k} vs {}",
+            j + 1,
+            GAINS[j]
+        );
+        // The standard deviation accounts for the error, and is not so wide as to
+        // say nothing.
+        let sigma = est.gain_sigma[j];
+        assert!(
+            sigma > 0.0 && (k - GAINS[j]).abs() <= 4.0 * sigma && sigma < 0.005 * k,
+            "k{}: {k} ± {sigma} vs {}",
             j + 1,
             GAINS[j]
         );

@@ -70,7 +70,10 @@ pub enum Estimator {
     /// Physically consistent least squares: principal form with `m > 0`, `J > 0`
     /// and the triangle inequalities, or standard form with a positive-definite
     /// pseudo-inertia per body and, with [`JointTerms`], every joint's rotor
-    /// inertia and viscous and Coulomb friction `≥ 0` (the offset free).
+    /// inertia and viscous and Coulomb friction `≥ 0` (the offset free). The
+    /// directions the data do not determine are pulled toward the model's own
+    /// parameters (the `prior` of [`StandardOptions`] and [`PrincipalOptions`]),
+    /// as far as the constraints allow.
     Consistent,
 }
 
@@ -554,11 +557,21 @@ impl<'a> TorqueFit<'a> {
             Estimator::Tls { column_scaling: true } => acc.tls(opts),
             Estimator::Tls { column_scaling: false } => acc.tls_unscaled(opts),
             Estimator::Ridge { lambda } => acc.ridge(&self.nominal, lambda, opts),
+            // What the data leave undetermined is taken from the model, as far as
+            // physical consistency allows (not from 0, which no physical body has).
             Estimator::Consistent if matches!(self.regressor, TorqueRegressor::Principal) => {
-                acc.principal_consistent(&PrincipalOptions::default(), opts)
+                let popts = PrincipalOptions {
+                    prior: Some(self.nominal.clone()),
+                    ..PrincipalOptions::default()
+                };
+                acc.principal_consistent(&popts, opts)
             }
             Estimator::Consistent => {
-                acc.standard_consistent(&consistent_options(self.regressor, self.model, self.fitted), opts)
+                let sopts = StandardOptions {
+                    prior: Some(self.nominal.clone()),
+                    ..consistent_options(self.regressor, self.model, self.fitted)
+                };
+                acc.standard_consistent(&sopts, opts)
             }
         }?;
         // The columns held at 0 are no parameters of the model.

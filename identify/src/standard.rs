@@ -99,6 +99,19 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
+    /// The value of parameter `i` that would explain the data alone,
+    /// `‖z‖ / ‖column i‖`, in its units (1 when either norm is zero): the scale of
+    /// a nonnegative parameter.
+    fn explaining(&self, i: usize) -> f64 {
+        let z_norm = dot(self.z, self.z).sqrt();
+        let column = (0..self.r.nrows()).map(|k| self.r[(k, i)].powi(2)).sum::<f64>().sqrt();
+        if column > 0.0 && z_norm > 0.0 {
+            z_norm / column
+        } else {
+            1.0
+        }
+    }
+
     fn body(&self, b: usize) -> std::ops::Range<usize> {
         let o = self.layout.first + 10 * b;
         o..o + 10
@@ -280,6 +293,36 @@ impl Accumulator {
     }
 }
 
+/// The Newton step `−H⁻¹ g` by Cholesky. `H` is positive definite in exact
+/// arithmetic, but where the data determine some directions to a singular value
+/// near the regularisation's and the barrier's weight `μ` has become small, its
+/// condition number reaches `1/ε` and the factorisation fails on rounding: then
+/// `H + τ·max(diag H)·E` with `τ` from `1e-14` up by factors of 100 (a Hessian
+/// modification, Nocedal and Wright §3.4), which still gives a descent direction.
+fn newton_step(h: &Mat<f64>, g: &[f64]) -> Result<Vec<f64>, IdentifyError> {
+    let p = g.len();
+    let rhs = Mat::from_fn(p, 1, |i, _| -g[i]);
+    let largest = (0..p).fold(0.0f64, |m, i| m.max(h[(i, i)].abs()));
+    let mut shift = 0.0;
+    loop {
+        let mut shifted = h.clone();
+        for i in 0..p {
+            shifted[(i, i)] += shift * largest;
+        }
+        if let Ok(llt) = shifted.llt(Side::Lower) {
+            let step = llt.solve(&rhs);
+            let d: Vec<f64> = (0..p).map(|i| step[(i, 0)]).collect();
+            if d.iter().all(|v| v.is_finite()) {
+                return Ok(d);
+            }
+        }
+        shift = if shift == 0.0 { 1e-14 } else { shift * 100.0 };
+        if shift > 1.0 {
+            return Err(IdentifyError::DecompositionFailed { what: "Newton system" });
+        }
+    }
+}
+
 /// The result of [`solve_barrier`].
 struct BarrierSolution {
     x: Vec<f64>,
@@ -315,18 +358,8 @@ fn solve_barrier(
     }
     // Nonnegative parameters start well inside: at least 10⁻³ of the value that
     // would explain the data alone (`‖z‖ / ‖column‖`, in the parameter's units).
-    let z_norm = dot(problem.z, problem.z).sqrt();
     for &i in &problem.nonnegative {
-        let column = (0..problem.r.nrows())
-            .map(|k| problem.r[(k, i)].powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let floor = if column > 0.0 && z_norm > 0.0 {
-            1e-3 * z_norm / column
-        } else {
-            1e-3
-        };
-        x[i] = x[i].max(floor);
+        x[i] = x[i].max(1e-3 * problem.explaining(i));
     }
     let (f0, _) = problem.fit(&x);
     let mut mu = f0.max(f64::MIN_POSITIVE) / nu;
@@ -368,12 +401,7 @@ fn solve_barrier(
                 g[i] -= mu / x[i];
                 h[(i, i)] += mu / (x[i] * x[i]);
             }
-            let llt = h
-                .llt(Side::Lower)
-                .map_err(|_| IdentifyError::DecompositionFailed { what: "Newton system" })?;
-            let rhs = Mat::from_fn(p, 1, |i, _| -g[i]);
-            let step = llt.solve(&rhs);
-            let d: Vec<f64> = (0..p).map(|i| step[(i, 0)]).collect();
+            let d = newton_step(&h, &g)?;
             let decrement = -dot(&g, &d);
             if decrement <= 0.0 || 0.5 * decrement <= 1e-14 * (f + mu * nu).max(f64::MIN_POSITIVE) {
                 break;
@@ -417,7 +445,10 @@ fn solve_barrier(
         .nonnegative
         .iter()
         .copied()
-        .filter(|&i| mu / x[i] > 1e-6 * scale)
+        // Held by its multiplier, or at the bound itself: a value of a millionth of
+        // what would explain the data alone (a multiplier that vanishes with the
+        // barrier's weight means a constraint that is weakly active, not inactive).
+        .filter(|&i| mu / x[i] > 1e-6 * scale || x[i] < 1e-6 * problem.explaining(i))
         .collect();
     Ok(BarrierSolution {
         x,

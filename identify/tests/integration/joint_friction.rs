@@ -309,8 +309,8 @@ fn consistent_estimation_keeps_friction_and_rotor_inertia_nonnegative() {
             assert!(est.solution[i] >= 0.0, "joint {} [{k}]: {}", j + 1, est.solution[i]);
         }
     }
-    // Truly zero, estimated near it: the bodies held at their bounds move it off
-    // zero a little (7e-4 here).
+    // Truly zero, estimated at it (2.8e-12 here, held by the bound; 7e-4 when the
+    // directions the data leave open were pulled toward 0 instead of the URDF).
     assert!(est.solution[fv4] < 0.01, "{}", est.solution[fv4]);
     let Method::StandardConsistent { params_at_bound, .. } = &est.method else {
         panic!("{}", est.method)

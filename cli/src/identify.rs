@@ -31,6 +31,7 @@ Examples:
       --exclude-below 0.05 --validate run2.csv
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv \
       --urdf-out ur5-identified.urdf
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction best --validate run2.csv
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --rotor-inertia no
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --partial run1.part
   dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --method wls \
@@ -48,7 +49,10 @@ squares from the linear fit, vs between 0.005 and 0.5 times the joint's speed ra
 the joint's error on held-out data of the recording (4 time blocks, each predicted
 by the fit on the others) by 1 % and stays physical (Fc, Fv not negative, Fs and vs
 determined); otherwise it falls back to sign friction, and one line per joint says
-which was kept and why. --validate predicts a second recording with the result.
+which was kept and why. --friction best fits none, sign (without and with Ia),
+auto and stribeck on three of four time blocks of the recording, scores each on the
+block left out, prints the errors and identifies with the best. --validate predicts
+a second recording with the result.
 --method consistent keeps every body physical and (with friction) Ia, Fv, Fc >= 0,
 with --friction stribeck too; --exclude-below SPEED leaves out a joint's rows where
 it moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
@@ -138,6 +142,12 @@ pub enum Friction {
     Stribeck,
     /// Stribeck with the Coulomb term Fc·tanh(q̇/ε), ε from --epsilon.
     StribeckSmooth,
+    /// The model the data choose: none, sign without and with rotor inertia, auto
+    /// and stribeck are each fitted on three of four time blocks of the recording
+    /// and predict the fourth, every block in turn; the lowest error on the
+    /// held-out blocks wins (printed for each), and the recording is identified
+    /// with it.
+    Best,
 }
 
 /// Whether a term is in the model.
@@ -515,6 +525,8 @@ impl IdentifyArgs {
                 Friction::Auto => JointTerms::FrictionAuto,
                 Friction::Stribeck => JointTerms::Stribeck(Coulomb::Sign),
                 Friction::StribeckSmooth => JointTerms::Stribeck(Coulomb::Smooth { epsilon: self.epsilon }),
+                // Replaced by the choice (`dyngen_identify::choice`) once the recording is read.
+                Friction::Best => JointTerms::Friction(Coulomb::Sign),
             },
             rotor_inertia: self.rotor_inertia.map(|r| r == YesNo::Yes),
             exclude_below: self.exclude_below,
@@ -536,6 +548,20 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         return Err(CliError::usage(
             "--accumulation applies to --mode standard and principal; MIM accumulates by QR",
         ));
+    }
+    if args.friction == Friction::Best {
+        if args.partial.is_some() || !args.merge.is_empty() {
+            return Err(CliError::usage(
+                "--friction best cannot be written as or solved from partial factors: it fits every candidate \
+                 model on time blocks of the recording's rows; choose on one recording, then use the model it \
+                 printed",
+            ));
+        }
+        if args.rotor_inertia.is_some() {
+            return Err(CliError::usage(
+                "--friction best chooses the rotor inertia too (with and without); drop --rotor-inertia",
+            ));
+        }
     }
     if args.partial.is_some() || !args.merge.is_empty() {
         return crate::partial::run(args, progress);
@@ -586,6 +612,16 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         outln!("training: {}", describe_span(&training));
     }
     let robot = Reference::new(&model);
+    let options = if args.friction == Friction::Best {
+        let choice = with_spinner(progress, "choosing the joint model", || {
+            dyngen_identify::choice::choose(&robot, &traj, &options)
+        })
+        .map_err(|e| pipeline_error(data, e))?;
+        out!("{choice}");
+        choice.apply(&options)
+    } else {
+        options
+    };
     let identified = with_spinner(progress, "identifying", || pipeline::identify(&robot, &traj, &options))
         .map_err(|e| pipeline_error(data, e))?;
     for w in &identified.warnings {
@@ -601,7 +637,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         }
     }
     let identified = identified;
-    if args.friction == Friction::Auto {
+    if options.joints == JointTerms::FrictionAuto {
         if let Some(epsilon) = identified
             .report
             .prediction

@@ -28,6 +28,7 @@
 //! println!("{}", est.table(&["offset", "a", "b"]));
 //! ```
 
+pub mod choice;
 pub mod data;
 pub mod floating;
 pub mod friction;

@@ -1070,14 +1070,7 @@ fn joint_linear(x: &[f64], n: usize, j: usize) -> [f64; PER_JOINT] {
 
 /// Every `stride`-th sample of `traj`.
 fn every(traj: &Trajectory, stride: usize) -> Option<Trajectory> {
-    let n = traj.dof();
-    let keep: Vec<usize> = (0..traj.len()).step_by(stride).collect();
-    let rows = |data: &[f64]| -> Vec<f64> { keep.iter().flat_map(|&k| data[k * n..(k + 1) * n].to_vec()).collect() };
-    let t = keep.iter().map(|&k| traj.t()[k]).collect();
-    Trajectory::new(n, t, rows(traj.positions()), rows(traj.torques()))
-        .and_then(|p| p.with_velocities(rows(traj.velocities().unwrap_or(&[]))))
-        .and_then(|p| p.with_accelerations(rows(traj.accelerations().unwrap_or(&[]))))
-        .ok()
+    traj.select(|k| k % stride == 0).ok()
 }
 
 /// The linear fit of `traj` with each joint's Stribeck term `excess[j]·g(q̇; vs)·s(q̇)`

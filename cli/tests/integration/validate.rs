@@ -491,3 +491,79 @@ fn simulated_stribeck_friction_needs_a_positive_velocity() {
     assert_ok(&o);
     assert!(csv.exists());
 }
+
+/// `--friction best` on the MuJoCo recording: every candidate's held-out error is
+/// printed, the choice is one of the nonlinear Coulomb models (which predict the
+/// other recording best, table in the README), it is recorded for `validate`, and
+/// the prediction is at least as good as sign friction's.
+#[test]
+fn the_best_joint_model_is_chosen_on_held_out_blocks() {
+    let dir = temp_dir("dyngen-validate", "best");
+    let params = dir.join("ur5.json");
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "best",
+        "--cutoff",
+        "5",
+        "--validate",
+        fixture("ur5_validate.csv"),
+        "--params-json",
+        &params
+    );
+    assert_ok(&o);
+    let out = stdout(&o);
+    let table: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("joint model chosen by the error on held-out data"))
+        .skip(1)
+        .take(5)
+        .collect();
+    let names: Vec<&str> = table.iter().filter_map(|l| l.split_whitespace().next()).collect();
+    assert_eq!(
+        names,
+        ["none", "sign-no-rotor-inertia", "sign", "auto", "stribeck"],
+        "{out}"
+    );
+    let errors: Vec<f64> = table
+        .iter()
+        .map(|l| l.split_whitespace().nth(1).and_then(|x| x.parse().ok()).unwrap())
+        .collect();
+    let chosen = table.iter().position(|l| l.ends_with("<- chosen")).expect("a choice");
+    assert!(errors.iter().all(|&e| e >= errors[chosen]), "{out}");
+    assert!(["auto", "stribeck"].contains(&names[chosen]), "{out}");
+    // Sign friction predicts this recording at 3.52 % (README).
+    let best = overall(&out);
+    assert!(best < 0.0352, "{out}");
+    let o = run!("validate", ur5(), &params, fixture("ur5_validate.csv"), "--cutoff", "5");
+    assert_ok(&o);
+    assert_eq!(overall(&stdout(&o)), best);
+    // What it cannot combine with.
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "best",
+        "--rotor-inertia",
+        "yes"
+    );
+    assert_exit(&o, 2, "--friction best chooses the rotor inertia too");
+    let part = dir.join("run.part");
+    let o = run!(
+        "identify",
+        ur5(),
+        fixture("ur5_identify.csv"),
+        "--friction",
+        "best",
+        "--partial",
+        &part
+    );
+    assert_exit(
+        &o,
+        2,
+        "--friction best cannot be written as or solved from partial factors",
+    );
+}

@@ -118,6 +118,33 @@ impl Trajectory {
         Ok(self)
     }
 
+    /// The samples whose index `keep` accepts, in order, with everything they carry
+    /// (velocities, accelerations, wrenches, file lines). Errors as
+    /// [`Trajectory::new`]: fewer than 2 samples kept.
+    pub fn select(&self, keep: impl Fn(usize) -> bool) -> Result<Trajectory, DataError> {
+        let kept: Vec<usize> = (0..self.len()).filter(|&k| keep(k)).collect();
+        let rows = |data: &[f64], width: usize| -> Vec<f64> {
+            kept.iter()
+                .flat_map(|&k| data[k * width..(k + 1) * width].iter().copied())
+                .collect()
+        };
+        let dof = self.dof;
+        Trajectory::from_checked_parts(
+            dof,
+            kept.iter().map(|&k| self.t[k]).collect(),
+            rows(&self.q, dof),
+            self.v.as_ref().map(|v| rows(v, dof)),
+            self.a.as_ref().map(|a| rows(a, dof)),
+            rows(&self.tau, dof),
+            self.wrenches.as_ref().map(|w| {
+                kept.iter()
+                    .flat_map(|&k| w[k * dof..(k + 1) * dof].iter().copied())
+                    .collect()
+            }),
+            self.lines.as_ref().map(|l| kept.iter().map(|&k| l[k]).collect()),
+        )
+    }
+
     /// Used by the readers, which have already checked every value and know each
     /// sample's line (none for resampled data).
     #[allow(clippy::too_many_arguments)]

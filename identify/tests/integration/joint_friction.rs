@@ -521,3 +521,44 @@ fn rotor_inertia_is_fitted_or_left_out_on_its_own() {
         assert!(e.to_string().starts_with("rotor-inertia "), "{e}");
     }
 }
+
+/// The joint model chosen on held-out time blocks of a recording whose joints have
+/// rotor inertia and sign friction (1 % torque noise): a model with both, never
+/// rigid bodies alone or friction without rotor inertia, and no worse held out
+/// than sign friction.
+#[test]
+fn the_chosen_joint_model_has_what_the_joints_have() {
+    use dyngen_identify::choice::{choose, BLOCKS};
+    let robot = ur5();
+    // 15 s of the 30 s recording: enough for the choice, half the time.
+    let traj = noisy_trajectory(&robot, &joint_truth(), 1, 5)
+        .select(|k| k < 1500)
+        .unwrap();
+    let choice = choose(&robot, &traj, &IdentifyOptions::default()).unwrap();
+    println!("{choice}");
+    let error = |name: &str| {
+        let s = choice.scores.iter().find(|s| s.candidate.name == name).unwrap();
+        s.held_out.as_ref().unwrap().overall
+    };
+    let chosen = choice.chosen().name;
+    assert!(["sign", "auto", "stribeck"].contains(&chosen), "{choice}");
+    assert!(error(chosen) <= error("sign"), "{choice}");
+    assert!(error("none") > 5.0 * error("sign"), "{choice}");
+    assert!(error("sign-no-rotor-inertia") > error("sign"), "{choice}");
+    let applied = choice.apply(&IdentifyOptions::default());
+    assert_eq!(applied.joints, choice.chosen().joints);
+    // Too short a recording for the blocks, and another mode.
+    let short = traj.select(|k| k < 2 * BLOCKS - 1).unwrap();
+    let e = choose(&robot, &short, &IdentifyOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("at least 2 samples in each of its 4 time blocks"),
+        "{e}"
+    );
+    let principal = IdentifyOptions {
+        mode: pipeline::Mode::Principal,
+        ..IdentifyOptions::default()
+    };
+    let e = choose(&robot, &traj, &principal).unwrap_err();
+    assert!(e.to_string().contains("standard mode"), "{e}");
+}

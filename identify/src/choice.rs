@@ -27,6 +27,17 @@ pub struct Candidate {
     pub rotor_inertia: Option<bool>,
 }
 
+impl Candidate {
+    /// `base` with this joint model.
+    pub fn options(&self, base: &IdentifyOptions) -> IdentifyOptions {
+        IdentifyOptions {
+            joints: self.joints,
+            rotor_inertia: self.rotor_inertia,
+            ..base.clone()
+        }
+    }
+}
+
 /// The candidates, simplest first (a tie goes to the simpler).
 pub const CANDIDATES: [Candidate; 5] = [
     Candidate {
@@ -75,12 +86,7 @@ pub struct ModelChoice {
 impl ModelChoice {
     /// `options` with the chosen joint model.
     pub fn apply(&self, options: &IdentifyOptions) -> IdentifyOptions {
-        let c = self.scores[self.chosen].candidate;
-        IdentifyOptions {
-            joints: c.joints,
-            rotor_inertia: c.rotor_inertia,
-            ..options.clone()
-        }
+        self.chosen().options(options)
     }
 
     pub fn chosen(&self) -> &Candidate {
@@ -143,12 +149,7 @@ pub fn choose(
     let predictions = in_parallel(CANDIDATES.len() * BLOCKS, |job| {
         let candidate = CANDIDATES[job / BLOCKS];
         let (training, held) = &folds[job % BLOCKS];
-        let opts = IdentifyOptions {
-            joints: candidate.joints,
-            rotor_inertia: candidate.rotor_inertia,
-            ..options.clone()
-        };
-        let fit = pipeline::identify(dynamics, training, &opts).map_err(|e| e.to_string())?;
+        let fit = pipeline::identify(dynamics, training, &candidate.options(options)).map_err(|e| e.to_string())?;
         fit.predict(dynamics, held).map_err(|e| e.to_string())
     });
     let scores: Vec<Score> = CANDIDATES

@@ -44,12 +44,14 @@ def identify(
     identify`` does: ``mode`` ``"standard"``, ``"principal"`` or ``"mim"``; ``method``
     ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
     ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
-    ``"stribeck-smooth"``. ``report``: write ``dyngen identify --report``'s SVG there
+    ``"stribeck-smooth"``, ``"best"`` (the model that predicts held-out time blocks
+    of the recording best; the errors in ``model_choice``). ``report``: write ``dyngen identify --report``'s SVG there
     (measured against predicted efforts per joint); an existing file raises
     ``FileExistsError`` unless ``overwrite``. Returns ``names``, ``values``, ``sigma``,
     ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,
     ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
-    ``warnings``. Raises :class:`LoadError` or ``ValueError``."""
+    ``warnings``, and with ``friction="best"`` ``model_choice`` (``chosen``,
+    ``held_out``). Raises :class:`LoadError` or ``ValueError``."""
 
 def identify_partial(
     robot_path: Union[str, "os.PathLike[str]"],

@@ -70,13 +70,18 @@ impl Choices<'_> {
             "auto" => JointTerms::FrictionAuto,
             "stribeck" => JointTerms::Stribeck(Coulomb::Sign),
             "stribeck-smooth" => JointTerms::Stribeck(smooth),
+            // Replaced by the model the data choose (`dyngen_identify::choice`) once
+            // the recording is read.
+            "best" if self.function == "identify" => JointTerms::Friction(Coulomb::Sign),
             other => {
-                return Err(invalid(
-                    self.function,
-                    "friction",
-                    other,
-                    &["none", "sign", "smooth", "auto", "stribeck", "stribeck-smooth"],
-                ))
+                let valid = ["none", "sign", "smooth", "auto", "stribeck", "stribeck-smooth", "best"];
+                // A partial factor holds rows of one model: no choice among several.
+                let valid = if self.function == "identify" {
+                    &valid[..]
+                } else {
+                    &valid[..6]
+                };
+                return Err(invalid(self.function, "friction", other, valid));
             }
         };
         let options = IdentifyOptions {
@@ -109,7 +114,10 @@ impl Choices<'_> {
 ///         `"wls"`, `"tls"`, `"tls-unscaled"`, `"ridge"` (with `ridge_lambda`),
 ///         `"consistent"`.
 ///     friction: joint terms of the standard mode: `"none"` (default), `"sign"`,
-///         `"smooth"` (`tanh(v/epsilon)`), `"auto"`, `"stribeck"`, `"stribeck-smooth"`.
+///         `"smooth"` (`tanh(v/epsilon)`), `"auto"`, `"stribeck"`, `"stribeck-smooth"`,
+///         `"best"` (the one of `"none"`, `"sign"` without and with rotor inertia,
+///         `"auto"` and `"stribeck"` that predicts held-out time blocks of the
+///         recording best; each candidate's error is in `model_choice`).
 ///     epsilon: the Coulomb smoothing of `"smooth"` friction, rad/s.
 ///     ridge_lambda: the scale-free weight of `"ridge"`.
 ///     cutoff: low-pass cutoff (Hz) of the velocities and accelerations estimated
@@ -132,7 +140,10 @@ impl Choices<'_> {
 ///     preprocessing, for `dyngen validate`; None for `mode="mim"`), and with
 ///     `validate` a dict `validation`: `samples`, `joint_names`, per joint `rms`
 ///     (of the prediction error), `measured_rms`, `relative` (‖τ̂ − τ‖ / ‖τ‖), and
-///     `overall` (over every joint and sample).
+///     `overall` (over every joint and sample); with `friction="best"` a dict
+///     `model_choice`: `chosen` (the candidate's name) and `held_out` (each
+///     candidate's overall relative error on the held-out blocks, None where it
+///     could not be fitted).
 ///
 /// Raises:
 ///     LoadError: the robot does not load.
@@ -199,8 +210,15 @@ pub fn identify<'py>(
     let failed =
         |path: &Path, e: pipeline::PipelineError| PyValueError::new_err(format!("identify: {}: {e}", path.display()));
     let robot = Reference::new(&model);
-    let (identified, validation) = py.detach(|| {
+    let (identified, validation, choice) = py.detach(|| {
         let loaded = pipeline::load(&data_path, &recipe, model.nv(), &options).map_err(|e| failed(&data_path, e))?;
+        let (options, choice) = if friction == "best" {
+            let choice = dyngen_identify::choice::choose(&robot, &loaded.trajectory, &options)
+                .map_err(|e| failed(&data_path, e))?;
+            (choice.apply(&options), Some(choice))
+        } else {
+            (options, None)
+        };
         let mut identified =
             pipeline::identify(&robot, &loaded.trajectory, &options).map_err(|e| failed(&data_path, e))?;
         // What `--params-json` records of the preprocessing, for `dyngen validate`.
@@ -240,9 +258,19 @@ pub fn identify<'py>(
                 Some(v)
             }
         };
-        Ok::<_, PyErr>((identified, validation))
+        Ok::<_, PyErr>((identified, validation, choice))
     })?;
     let out = to_dict(py, &identified)?;
+    if let Some(choice) = choice {
+        let held_out = PyDict::new(py);
+        for score in &choice.scores {
+            held_out.set_item(score.candidate.name, score.held_out.as_ref().ok().map(|v| v.overall))?;
+        }
+        let d = PyDict::new(py);
+        d.set_item("chosen", choice.chosen().name)?;
+        d.set_item("held_out", held_out)?;
+        out.set_item("model_choice", d)?;
+    }
     let json = match identified.mim {
         Some(_) => None,
         None => Some(

@@ -142,3 +142,28 @@ def test_identifies_a_robot_with_mimic_joints(tmp_path):
     assert len(result["names"]) == 10 * robot.nbodies
     k = result["combination_matrix"]
     np.testing.assert_allclose(result["combination_values"], k @ truth, rtol=1e-7, atol=1e-9)
+
+
+def test_best_friction_is_chosen_on_held_out_blocks(tmp_path):
+    """Joints with viscous and Coulomb friction and 1 % torque noise: the model chosen
+    has friction, and each candidate's held-out error is returned."""
+    robot = dyngen.load(ROBOTS[0][1])
+    rng = np.random.default_rng(7)
+    path = tmp_path / "friction.csv"
+    write_sines(robot, robot.params, 1200, (0.3, 0.8), rng, path)
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    n = robot.nv
+    v, tau = data[:, 1 + n:1 + 2 * n], data[:, 1 + 3 * n:]
+    tau += 0.5 * v + 2.0 * np.sign(v)
+    tau += 0.01 * rng.standard_normal(tau.shape) * np.sqrt(np.mean(tau**2, axis=0))
+    header = open(path).readline().strip()
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.17g")
+    result = dyngen.identify(ROBOTS[0][1], path, friction="best", raw_states=True)
+    choice = result["model_choice"]
+    assert set(choice["held_out"]) == {"none", "sign-no-rotor-inertia", "sign", "auto", "stribeck"}
+    assert choice["chosen"] in ("sign-no-rotor-inertia", "sign", "auto", "stribeck"), choice
+    errors = choice["held_out"]
+    assert errors[choice["chosen"]] == min(e for e in errors.values() if e is not None)
+    assert errors["none"] > 3 * errors["sign"], choice
+    with pytest.raises(ValueError, match=re.escape("unknown friction `best`")):
+        dyngen.identify_partial(ROBOTS[0][1], path, friction="best")

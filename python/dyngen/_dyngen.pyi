@@ -134,7 +134,8 @@ class Model:
         """Number of moving bodies (= joints)."""
     @property
     def joint_names(self) -> List[str]:
-        """The joints' names, in the order of ``q`` and ``v``."""
+        """The joints' names, one per body, in the order of ``q`` and ``v`` (a joint
+        that follows another by ``<mimic>`` is listed but has no coordinate)."""
     @property
     def body_names(self) -> List[str]:
         """The moving bodies' names, body 1 first."""

@@ -623,8 +623,9 @@ impl PyModel {
         self.body.bodies()
     }
 
-    /// The joints' names in the model's order (the order of `q` and `v`; a free flyer
-    /// is `root_joint`).
+    /// The joints' names in the model's order, one per body (a free flyer is
+    /// `root_joint`): the order of `q` and `v`, where a joint that follows another
+    /// (`<mimic>`) is listed but has no coordinate of its own.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
         self.model.joints.iter().map(|j| j.name.clone()).collect()

@@ -25,16 +25,16 @@ Examples:
       --truth-from-urdf --urdf-out ur5-identified.urdf --force
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode principal
   dyngen identify robots/ur5/ur5.urdf ur5.csv --mode mim --urdf-out ur5-mim.urdf
-  dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto --params-json ur5.json \\
       --validate run2.csv
-  dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --method consistent \
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --method consistent \\
       --exclude-below 0.05 --validate run2.csv
-  dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv \
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv \\
       --urdf-out ur5-identified.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction best --validate run2.csv
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --rotor-inertia no
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --partial run1.part
-  dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --method wls \
+  dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --method wls \\
       --params-json fleet.json
   dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --partial both.part
 
@@ -72,9 +72,9 @@ Unknown torque constants: --drive-gains identifies them with the dynamics (Gauti
 and Briot) from two logs of motor currents, the second recorded with a known payload
 fixed to --payload-frame; the parameters then come from DATA read with the identified
 gains, which --params-json records for `dyngen validate`:
-  dyngen identify robots/ur5/ur5.urdf currents.csv --friction sign \
-      --drive-gains loaded.csv --payload-frame wrist_3_link --payload-mass 5 \
-      --payload-com 0.1,0,0.05 --payload-inertia 0.0044,0.0044,0.0063
+  dyngen identify robots/ur5/ur5.urdf currents.csv --friction sign \\
+      --drive-gains loaded.csv --payload-frame tool0 --payload-mass 5 \\
+      --payload-com 0.1,0,0.05 --payload-inertia 0.0073,0.0073,0.0063
 --mode mim also needs the joint wrench columns fx1, fy1, fz1, mx1, my1, mz1, … (what
 `dyngen simulate` writes).
 

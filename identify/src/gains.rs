@@ -24,7 +24,7 @@
 //! sums come from one pass over the data (the Gram matrices of the accumulator).
 
 use crate::data::Trajectory;
-use crate::faer::Mat;
+use crate::faer::{Mat, MatRef};
 use crate::mim::TorqueRegressor;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options};
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
@@ -163,24 +163,18 @@ pub fn identify_gains(
         Mat::from_fn(pa, kept.len(), |r, k| vectors[(r, kept[k])])
     };
     let projected: Vec<Mat<f64>> = ata.iter().map(|a| basis.transpose() * a * &basis).collect();
+    let subspace = Subspace {
+        basis: &basis,
+        projected: &projected,
+    };
     let solve = |w: &[f64]| -> Result<Vec<f64>, IdentifyError> {
-        let r = basis.ncols();
-        let mut lhs = Mat::<f64>::zeros(r, r);
         let mut b = Mat::<f64>::zeros(pa, 1);
         for (j, g) in grams.iter().enumerate() {
-            lhs += &projected[j] * (w[j] * w[j]);
             for c in 0..pa {
                 b[(c, 0)] += w[j] * (-g[(c, pa + j)] - w[j] * g[(c, p - 1)]);
             }
         }
-        use faer::prelude::Solve;
-        let z = lhs
-            .llt(faer::Side::Lower)
-            .map_err(|_| IdentifyError::DecompositionFailed {
-                what: "normal equations of the drive-gain problem",
-            })?
-            .solve(basis.transpose() * &b);
-        let x = &basis * &z;
+        let x = subspace.solve(w, b.as_ref())?;
         Ok((0..pa).map(|i| x[(i, 0)]).collect())
     };
     // Per joint: (Σ i f, Σ f²) at x.
@@ -250,7 +244,7 @@ pub fn identify_gains(
     iterations += best.evaluations;
     let x = solve(&w)?;
     let ff: Vec<f64> = sums(&x).into_iter().map(|(_, ff)| ff).collect();
-    let gain_sigma = gain_sigma(&grams, &ata, &w, &x, &ff, objective(&w, &x), samples)?;
+    let gain_sigma = gain_sigma(&grams, &ata, &subspace, &w, &x, &ff, objective(&w, &x), samples)?;
     Ok(GainEstimate {
         initial,
         gains: w.iter().map(|w| 1.0 / w).collect(),
@@ -261,17 +255,47 @@ pub fn identify_gains(
     })
 }
 
+/// The identifiable subspace of `[π; φ]`: an orthonormal basis `U` of the range of
+/// `Σ_j A_jᵀA_j` (the same for every nonzero `w`) and each joint's `UᵀA_jᵀA_jU`.
+struct Subspace<'a> {
+    basis: &'a Mat<f64>,
+    projected: &'a [Mat<f64>],
+}
+
+impl Subspace<'_> {
+    /// The minimum-norm solutions `x` (columns) of `(Σ_j w_j² A_jᵀA_j) x = b` for
+    /// the columns of `b` in that range: `U z` with `z` by Cholesky of
+    /// `Uᵀ(Σ_j w_j² A_jᵀA_j)U`, which is positive definite.
+    fn solve(&self, w: &[f64], b: MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
+        use faer::prelude::Solve;
+        let r = self.basis.ncols();
+        let mut lhs = Mat::<f64>::zeros(r, r);
+        for (j, p) in self.projected.iter().enumerate() {
+            lhs += p * (w[j] * w[j]);
+        }
+        let z = lhs
+            .llt(faer::Side::Lower)
+            .map_err(|_| IdentifyError::DecompositionFailed {
+                what: "normal equations of the drive-gain problem",
+            })?
+            .solve(self.basis.transpose() * b);
+        Ok(self.basis * &z)
+    }
+}
+
 /// `σ(k_j)` at the solution `(x, w)` of the problem in current units, whose residual
 /// of joint `j` is `i_j − w_j·f_j` with `f_j = A_j x + l_j`: the Jacobian's columns
 /// are `−w_j A_j` for `x` and `−f_j` for `w_j`, so the normal matrix has the blocks
 /// `N_xx = Σ_j w_j² A_jᵀA_j`, `N_x,w_j = w_j (A_jᵀA_j x + A_jᵀ l_j)` and
-/// `N_w_j,w_j = f_jᵀf_j` (`ff`), all from the per-joint Gram matrices of `[A, −i, l]`. The
-/// covariance of `w` is `s²·S⁻¹` with the Schur complement
-/// `S = N_ww − N_wx N_xx⁺ N_xw` and `s²` the residual sum of squares over the rows
-/// left after the unknowns the data determine.
+/// `N_w_j,w_j = f_jᵀf_j` (`ff`), all from the per-joint Gram matrices of
+/// `[A, −i, l]`. The covariance of `w` is `s²·S⁻¹` with the Schur complement
+/// `S = N_ww − N_wx N_xx⁺ N_xw` (`N_xx⁺` on the identifiable subspace) and `s²` the
+/// residual sum of squares over the rows left after the unknowns the data determine.
+#[allow(clippy::too_many_arguments)]
 fn gain_sigma(
     grams: &[Mat<f64>],
     ata: &[Mat<f64>],
+    subspace: &Subspace<'_>,
     w: &[f64],
     x: &[f64],
     ff: &[f64],
@@ -281,29 +305,17 @@ fn gain_sigma(
     let n = w.len();
     let pa = x.len();
     let p = pa + n + 1;
-    let mut nxx = Mat::<f64>::zeros(pa, pa);
-    for (j, a) in ata.iter().enumerate() {
-        nxx += a * (w[j] * w[j]);
-    }
-    let (values, _) = eigen(nxx.as_ref())?;
-    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let rank_x = values.iter().filter(|&&v| v > 1e-12 * largest).count();
-    let b: Vec<Vec<f64>> = (0..n)
-        .map(|j| {
-            (0..pa)
-                .map(|r| w[j] * ((0..pa).map(|c| ata[j][(r, c)] * x[c]).sum::<f64>() + grams[j][(r, p - 1)]))
-                .collect()
-        })
-        .collect();
-    let solved: Vec<Vec<f64>> = b
-        .iter()
-        .map(|bj| min_norm_solve(nxx.as_ref(), bj))
-        .collect::<Result<_, _>>()?;
+    // N_xw, one column per joint.
+    let b = Mat::from_fn(pa, n, |r, j| {
+        w[j] * ((0..pa).map(|c| ata[j][(r, c)] * x[c]).sum::<f64>() + grams[j][(r, p - 1)])
+    });
+    let solved = subspace.solve(w, b.as_ref())?;
+    let coupling = b.transpose() * &solved;
     let schur = Mat::from_fn(n, n, |r, c| {
         let diagonal = if r == c { ff[r] } else { 0.0 };
-        diagonal - b[r].iter().zip(&solved[c]).map(|(u, v)| u * v).sum::<f64>()
+        diagonal - coupling[(r, c)]
     });
-    let dof = (samples * n).saturating_sub(rank_x + n);
+    let dof = (samples * n).saturating_sub(subspace.basis.ncols() + n);
     let undetermined = || IdentifyError::InvalidArgument {
         what: "recordings",
         reason: "they do not determine the drive gains apart from the dynamic parameters".into(),
@@ -348,22 +360,4 @@ fn gram_root(g: faer::MatRef<'_, f64>) -> Result<Mat<f64>, IdentifyError> {
     let n = g.nrows();
     let (values, vectors) = eigen(g)?;
     Ok(Mat::from_fn(n, n, |i, j| values[i].max(0.0).sqrt() * vectors[(j, i)]))
-}
-
-/// The minimum-norm solution of the symmetric system `G x = b`, eigenvalues below
-/// `1e-12` of the largest counted as zero.
-fn min_norm_solve(g: faer::MatRef<'_, f64>, b: &[f64]) -> Result<Vec<f64>, IdentifyError> {
-    let n = g.nrows();
-    let (values, vectors) = eigen(g)?;
-    let largest = (0..n).map(|i| values[i].abs()).fold(0.0, f64::max);
-    let mut x = vec![0.0; n];
-    for i in 0..n {
-        if values[i] > 1e-12 * largest {
-            let proj: f64 = (0..n).map(|r| vectors[(r, i)] * b[r]).sum::<f64>() / values[i];
-            for r in 0..n {
-                x[r] += proj * vectors[(r, i)];
-            }
-        }
-    }
-    Ok(x)
 }

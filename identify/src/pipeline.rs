@@ -798,39 +798,36 @@ pub fn fitted_joint_terms(options: &IdentifyOptions) -> [bool; PER_JOINT] {
     }
 }
 
-/// The columns of the joint terms held at 0 for `regressor` on `n` joints.
-fn excluded_columns(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> Vec<usize> {
-    let (bodies, n) = (model.dof(), model.nv());
-    match regressor {
-        TorqueRegressor::StandardAndJoints(_) => (0..n)
-            .flat_map(|j| {
-                (0..PER_JOINT)
-                    .filter(move |&k| !fitted[k])
-                    .map(move |k| 10 * bodies + PER_JOINT * j + k)
-            })
-            .collect(),
-        _ => Vec::new(),
+/// The columns of the joint terms `[Ia, Fv, Fc, F0]` (term `k` of each velocity
+/// coordinate) for which `pick(k)` holds, for `regressor`: after the 10 standard
+/// parameters per body, 4 per coordinate; none without joint terms.
+fn joint_term_columns(regressor: TorqueRegressor, model: &Model, pick: impl Fn(usize) -> bool) -> Vec<usize> {
+    if !matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+        return Vec::new();
     }
+    let rigid = 10 * model.dof();
+    (0..model.nv())
+        .flat_map(|j| (0..PER_JOINT).map(move |k| (j, k)))
+        .filter(|&(_, k)| pick(k))
+        .map(|(j, k)| rigid + PER_JOINT * j + k)
+        .collect()
 }
 
-/// The standard-form consistent estimator's options for `regressor` on `n` joints:
-/// `n` body blocks first, then per joint `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0`
-/// (those fitted).
+/// The columns of the joint terms held at 0 for `regressor`.
+fn excluded_columns(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> Vec<usize> {
+    joint_term_columns(regressor, model, |k| !fitted[k])
+}
+
+/// The standard-form consistent estimator's options for `regressor`: the body
+/// blocks first, then per coordinate `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0` (those
+/// fitted).
 fn consistent_options(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> StandardOptions {
-    let (bodies, n) = (model.dof(), model.nv());
-    let nonnegative = match regressor {
-        TorqueRegressor::StandardAndJoints(_) => (0..n)
-            .flat_map(|j| {
-                (0..3)
-                    .filter(move |&k| fitted[k])
-                    .map(move |k| 10 * bodies + PER_JOINT * j + k)
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
     StandardOptions {
-        layout: Some(Layout { first: 0, bodies }),
-        nonnegative,
+        layout: Some(Layout {
+            first: 0,
+            bodies: model.dof(),
+        }),
+        nonnegative: joint_term_columns(regressor, model, |k| k < 3 && fitted[k]),
         ..StandardOptions::default()
     }
 }

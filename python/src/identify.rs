@@ -74,14 +74,12 @@ impl Choices<'_> {
             // the recording is read.
             "best" if self.function == "identify" => JointTerms::Friction(Coulomb::Sign),
             other => {
-                let valid = ["none", "sign", "smooth", "auto", "stribeck", "stribeck-smooth", "best"];
-                // A partial factor holds rows of one model: no choice among several.
-                let valid = if self.function == "identify" {
-                    &valid[..]
-                } else {
-                    &valid[..6]
-                };
-                return Err(invalid(self.function, "friction", other, valid));
+                // A partial factor holds the rows of one model: no choice among several.
+                let valid: Vec<&str> = ["none", "sign", "smooth", "auto", "stribeck", "stribeck-smooth", "best"]
+                    .into_iter()
+                    .filter(|&f| f != "best" || self.function == "identify")
+                    .collect();
+                return Err(invalid(self.function, "friction", other, &valid));
             }
         };
         let options = IdentifyOptions {

@@ -4,7 +4,9 @@
 
 use crate::common::{check_overwrite, load_moving_model, out, outln, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
+use dyngen_identify::choice::DEFAULT_EXTRAS;
 use dyngen_identify::data::{Recipe, Trajectory};
+use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::pipeline::{
     self, Estimator, Identification, IdentifyOptions, JointTerms, PipelineError, Prediction,
 };
@@ -239,6 +241,15 @@ pub struct IdentifyArgs {
     /// --friction (Ia alone, no friction terms). Default: with the friction terms.
     #[arg(long, value_enum, value_name = "yes|no")]
     pub rotor_inertia: Option<YesNo>,
+
+    /// Joint terms past viscous and Coulomb friction, with --friction sign, smooth
+    /// or auto: a comma-separated list of `asymmetric` (direction-dependent viscous
+    /// friction Fva·|q̇|), `ripple=H` (H harmonics of the joint angle: torque ripple
+    /// and position-dependent Coulomb friction) and `load` (Coulomb friction growing
+    /// with the transmitted torque, Fcl·|τ|·s(q̇)). With --friction best: the terms
+    /// it may add (default asymmetric,ripple=2,load; `none` for none).
+    #[arg(long, value_name = "LIST", value_parser = parse_extra_terms)]
+    pub extra_terms: Option<ExtraTerms>,
 
     /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
     /// prismatic joints), 0 < ε ≤ 1000.
@@ -529,6 +540,11 @@ impl IdentifyArgs {
                 Friction::Best => JointTerms::Friction(Coulomb::Sign),
             },
             rotor_inertia: self.rotor_inertia.map(|r| r == YesNo::Yes),
+            // With best, the terms the choice may add (`run`).
+            extras: match self.friction {
+                Friction::Best => ExtraTerms::NONE,
+                _ => self.extra_terms.unwrap_or(ExtraTerms::NONE),
+            },
             exclude_below: self.exclude_below,
             cutoff_hz: self.recording.cutoff(),
             low_pass_states: !self.recording.raw_states,
@@ -614,7 +630,8 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     let robot = Reference::new(&model);
     let options = if args.friction == Friction::Best {
         let choice = with_spinner(progress, "choosing the joint model", || {
-            dyngen_identify::choice::choose(&robot, &traj, &options)
+            let allowed = args.extra_terms.unwrap_or(DEFAULT_EXTRAS);
+            dyngen_identify::choice::choose(&robot, &traj, &options, allowed)
         })
         .map_err(|e| pipeline_error(data, e))?;
         out!("{choice}");
@@ -979,4 +996,9 @@ fn print_fit(estimate: &Estimate) -> Result<()> {
         estimate.n_params()
     );
     Ok(())
+}
+
+/// `--extra-terms`: the list [`ExtraTerms`] parses.
+fn parse_extra_terms(text: &str) -> std::result::Result<ExtraTerms, String> {
+    text.parse()
 }

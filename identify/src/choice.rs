@@ -5,9 +5,18 @@
 //! the held-out blocks wins: a model that only fits the noise of its own data does
 //! not. Sign friction is a candidate, so the choice is never worse than it on the
 //! held-out blocks.
+//!
+//! Then the extra joint terms ([`crate::extras`]) are added to the best linear
+//! friction model (sign, with or without rotor inertia, or the fitted smoothing)
+//! one at a time, forward selection: each round tries every term not yet in
+//! (direction-dependent viscous friction, one more ripple harmonic, load-dependent
+//! friction) and keeps the one that lowers the held-out error most, if it lowers it
+//! by at least [`MIN_GAIN`]. The fitted smoothing's ε is then each block's own, from
+//! the friction model's fit on the other blocks, so no held-out sample chooses it.
 
 use crate::accumulate::in_parallel;
 use crate::data::Trajectory;
+use crate::extras::ExtraTerms;
 use crate::pipeline::{self, IdentifyOptions, JointTerms, Mode, PipelineError};
 use crate::validate::Validation;
 use dyngen_model::joint_params::Coulomb;
@@ -17,14 +26,27 @@ use std::fmt;
 /// Time blocks of the cross-validation.
 pub const BLOCKS: usize = 4;
 
+/// The relative drop of the held-out error an extra term must bring to be kept.
+pub const MIN_GAIN: f64 = 0.01;
+
+/// The extra terms `--friction best` tries when none are given: direction-dependent
+/// viscous friction, up to two ripple harmonics, load-dependent friction.
+pub const DEFAULT_EXTRAS: ExtraTerms = ExtraTerms {
+    asymmetric: true,
+    harmonics: 2,
+    load: true,
+};
+
 /// One joint model the choice tries.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Candidate {
-    /// What the command line calls it (`--friction NAME`, with `--rotor-inertia no`
-    /// for `sign-no-rotor-inertia`).
+    /// The friction model as the command line calls it (`--friction NAME`, with
+    /// `--rotor-inertia no` for `sign-no-rotor-inertia`).
     pub name: &'static str,
     pub joints: JointTerms,
     pub rotor_inertia: Option<bool>,
+    /// The extra terms on top (`--extra-terms`).
+    pub extras: ExtraTerms,
 }
 
 impl Candidate {
@@ -33,37 +55,58 @@ impl Candidate {
         IdentifyOptions {
             joints: self.joints,
             rotor_inertia: self.rotor_inertia,
+            extras: self.extras,
             ..base.clone()
         }
     }
+
+    /// The name and the extra terms: `auto + asymmetric,load`.
+    pub fn label(&self) -> String {
+        if self.extras.is_empty() {
+            self.name.to_string()
+        } else {
+            format!("{} + {}", self.name, self.extras)
+        }
+    }
+
+    /// Whether the friction model is linear in its parameters (extra terms can
+    /// join it).
+    fn linear(&self) -> bool {
+        matches!(self.joints, JointTerms::Friction(_) | JointTerms::FrictionAuto)
+    }
 }
 
-/// The candidates, simplest first (a tie goes to the simpler).
+/// The friction models, simplest first (a tie goes to the simpler).
 pub const CANDIDATES: [Candidate; 5] = [
     Candidate {
         name: "none",
         joints: JointTerms::None,
         rotor_inertia: None,
+        extras: ExtraTerms::NONE,
     },
     Candidate {
         name: "sign-no-rotor-inertia",
         joints: JointTerms::Friction(Coulomb::Sign),
         rotor_inertia: Some(false),
+        extras: ExtraTerms::NONE,
     },
     Candidate {
         name: "sign",
         joints: JointTerms::Friction(Coulomb::Sign),
         rotor_inertia: None,
+        extras: ExtraTerms::NONE,
     },
     Candidate {
         name: "auto",
         joints: JointTerms::FrictionAuto,
         rotor_inertia: None,
+        extras: ExtraTerms::NONE,
     },
     Candidate {
         name: "stribeck",
         joints: JointTerms::Stribeck(Coulomb::Sign),
         rotor_inertia: None,
+        extras: ExtraTerms::NONE,
     },
 ];
 
@@ -78,6 +121,8 @@ pub struct Score {
 /// The outcome: every candidate's score and the one chosen.
 #[derive(Clone, Debug)]
 pub struct ModelChoice {
+    /// The friction models first ([`CANDIDATES`]), then the extra terms' trials in
+    /// the order they were tried.
     pub scores: Vec<Score>,
     /// Index into `scores`.
     pub chosen: usize,
@@ -92,6 +137,12 @@ impl ModelChoice {
     pub fn chosen(&self) -> &Candidate {
         &self.scores[self.chosen].candidate
     }
+
+    /// The held-out error of the candidate labelled `label`, if it was fitted.
+    pub fn error(&self, label: &str) -> Option<f64> {
+        let score = self.scores.iter().find(|s| s.candidate.label() == label)?;
+        score.held_out.as_ref().ok().map(|v| v.overall)
+    }
 }
 
 impl fmt::Display for ModelChoice {
@@ -99,26 +150,34 @@ impl fmt::Display for ModelChoice {
         writeln!(
             f,
             "joint model chosen by the error on held-out data ({BLOCKS} time blocks, each predicted by the fit on \
-             the others):"
+             the others; an extra term is kept where it lowers the error by {:.0} %):",
+            100.0 * MIN_GAIN
         )?;
         for (i, s) in self.scores.iter().enumerate() {
             let mark = if i == self.chosen { "  <- chosen" } else { "" };
+            let label = s.candidate.label();
             match &s.held_out {
-                Ok(v) => writeln!(f, "  {:<22} {:>7.3} %{mark}", s.candidate.name, 100.0 * v.overall)?,
-                Err(e) => writeln!(f, "  {:<22} not fitted: {e}", s.candidate.name)?,
+                Ok(v) => writeln!(f, "  {label:<34} {:>7.3} %{mark}", 100.0 * v.overall)?,
+                Err(e) => writeln!(f, "  {label:<34} not fitted: {e}")?,
             }
         }
         Ok(())
     }
 }
 
-/// Scores every candidate on `traj` with the rest of `options` (standard mode) and
-/// chooses the one with the lowest held-out error. Errors: another mode, too few
+/// The training and held-out parts of every block.
+type Folds = Vec<(Trajectory, Trajectory)>;
+
+/// Scores every candidate on `traj` with the rest of `options` (standard mode;
+/// its joint model is ignored) and chooses the one with the lowest held-out error,
+/// then adds those of the extra terms `allowed` ([`DEFAULT_EXTRAS`], say) that the
+/// held-out blocks support, as the module says. Errors: another mode, too few
 /// samples for the blocks, or no candidate that could be fitted.
 pub fn choose(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
     options: &IdentifyOptions,
+    allowed: ExtraTerms,
 ) -> Result<ModelChoice, PipelineError> {
     if options.mode != Mode::Standard {
         return Err(PipelineError::InvalidOption {
@@ -128,7 +187,7 @@ pub fn choose(
     }
     let len = traj.len();
     let block = |k: usize| k * BLOCKS / len;
-    let folds: Vec<(Trajectory, Trajectory)> = (0..BLOCKS)
+    let folds: Folds = (0..BLOCKS)
         .map(|b| {
             let training = traj.select(|k| block(k) != b);
             let held = traj.select(|k| block(k) == b);
@@ -143,50 +202,138 @@ pub fn choose(
             }
         })
         .collect::<Result<_, _>>()?;
-    let names: Vec<String> = (1..=traj.dof()).map(|j| format!("joint {j}")).collect();
-    // Every (candidate, block) fit on its own core: the blocks of one candidate
-    // alternate between cores, so that the slow candidates are shared.
-    let predictions = in_parallel(CANDIDATES.len() * BLOCKS, |job| {
-        let candidate = CANDIDATES[job / BLOCKS];
-        let (training, held) = &folds[job % BLOCKS];
-        let fit = pipeline::identify(dynamics, training, &candidate.options(options)).map_err(|e| e.to_string())?;
-        fit.predict(dynamics, held).map_err(|e| e.to_string())
-    });
-    let scores: Vec<Score> = CANDIDATES
-        .iter()
-        .zip(predictions.chunks(BLOCKS))
-        .map(|(&candidate, blocks)| {
-            let held_out = blocks
-                .iter()
-                .cloned()
-                .collect::<Result<Vec<_>, String>>()
-                .and_then(|blocks| {
-                    let predicted: Vec<Vec<f64>> = blocks.into_iter().flatten().collect();
-                    let measured = folds.iter().flat_map(|(_, held)| held.samples().map(|s| s.tau));
-                    Validation::new(&names, measured, predicted.iter().map(Vec::as_slice)).map_err(|e| e.to_string())
-                });
-            Score { candidate, held_out }
-        })
-        .collect();
-    let chosen = scores
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| s.held_out.as_ref().ok().map(|v| (i, v.overall)))
-        .fold(None, |best: Option<(usize, f64)>, (i, e)| match best {
-            Some((_, b)) if b <= e => best,
-            _ => Some((i, e)),
-        })
-        .map(|(i, _)| i)
-        .ok_or_else(|| PipelineError::InvalidOption {
+    let base = IdentifyOptions {
+        extras: ExtraTerms::NONE,
+        ..options.clone()
+    };
+    let jobs: Vec<Vec<IdentifyOptions>> = CANDIDATES.iter().map(|c| vec![c.options(&base); BLOCKS]).collect();
+    let (mut scores, epsilons): (Vec<Score>, Vec<Vec<Option<f64>>>) =
+        score(dynamics, &folds, &CANDIDATES, &jobs).into_iter().unzip();
+    let best = |scores: &[Score], among: &dyn Fn(&Candidate) -> bool| {
+        scores
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| among(&s.candidate))
+            .filter_map(|(i, s)| s.held_out.as_ref().ok().map(|v| (i, v.overall)))
+            .fold(None, |best: Option<(usize, f64)>, (i, e)| match best {
+                Some((_, b)) if b <= e => best,
+                _ => Some((i, e)),
+            })
+    };
+    let Some((overall, overall_error)) = best(&scores, &|_| true) else {
+        return Err(PipelineError::InvalidOption {
             option: "friction",
             reason: format!(
                 "no joint model could be fitted on the time blocks: {}",
                 scores
                     .iter()
-                    .filter_map(|s| s.held_out.as_ref().err().map(|e| format!("{}: {e}", s.candidate.name)))
+                    .filter_map(|s| s
+                        .held_out
+                        .as_ref()
+                        .err()
+                        .map(|e| format!("{}: {e}", s.candidate.label())))
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-        })?;
+        });
+    };
+    // Forward selection of the extra terms on the best linear friction model.
+    let mut chosen = overall;
+    if let Some((start, mut error)) = best(&scores, &|c| c.linear()) {
+        let friction = scores[start].candidate;
+        // Each block's fit: the friction model's smoothing from that block's fit.
+        let fold_options = |extras: ExtraTerms| -> Vec<IdentifyOptions> {
+            (0..BLOCKS)
+                .map(|b| {
+                    let joints = match (friction.joints, epsilons[start][b]) {
+                        (JointTerms::FrictionAuto, Some(epsilon)) => JointTerms::Friction(Coulomb::Smooth { epsilon }),
+                        (joints, _) => joints,
+                    };
+                    IdentifyOptions {
+                        joints,
+                        rotor_inertia: friction.rotor_inertia,
+                        extras,
+                        ..base.clone()
+                    }
+                })
+                .collect()
+        };
+        let mut current = ExtraTerms::NONE;
+        let mut kept = start;
+        loop {
+            let trials: Vec<ExtraTerms> = [
+                (allowed.asymmetric && !current.asymmetric).then_some(ExtraTerms {
+                    asymmetric: true,
+                    ..current
+                }),
+                (current.harmonics < allowed.harmonics).then_some(ExtraTerms {
+                    harmonics: current.harmonics + 1,
+                    ..current
+                }),
+                (allowed.load && !current.load).then_some(ExtraTerms { load: true, ..current }),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if trials.is_empty() {
+                break;
+            }
+            let candidates: Vec<Candidate> = trials.iter().map(|&extras| Candidate { extras, ..friction }).collect();
+            let jobs: Vec<Vec<IdentifyOptions>> = trials.iter().map(|&e| fold_options(e)).collect();
+            let first = scores.len();
+            scores.extend(score(dynamics, &folds, &candidates, &jobs).into_iter().map(|(s, _)| s));
+            match best(&scores[first..], &|_| true) {
+                Some((i, e)) if e <= (1.0 - MIN_GAIN) * error => {
+                    (kept, error, current) = (first + i, e, trials[i]);
+                }
+                _ => break,
+            }
+        }
+        if error < overall_error {
+            chosen = kept;
+        }
+    }
     Ok(ModelChoice { scores, chosen })
+}
+
+/// Each candidate's held-out score from its per-block options (`jobs[c][b]`), with
+/// the smoothing ε each block's fit chose (`None` where it chose none). Every
+/// (candidate, block) fit runs on its own core: the blocks of one candidate
+/// alternate between cores, so that the slow candidates are shared.
+fn score(
+    dynamics: &dyn Dynamics,
+    folds: &Folds,
+    candidates: &[Candidate],
+    jobs: &[Vec<IdentifyOptions>],
+) -> Vec<(Score, Vec<Option<f64>>)> {
+    let names: Vec<String> = (1..=dynamics.nv()).map(|j| format!("joint {j}")).collect();
+    let predictions = in_parallel(candidates.len() * BLOCKS, |job| {
+        let (c, b) = (job / BLOCKS, job % BLOCKS);
+        let (training, held) = &folds[b];
+        let fit = pipeline::identify(dynamics, training, &jobs[c][b]).map_err(|e| e.to_string())?;
+        let epsilon = fit
+            .report
+            .prediction
+            .as_ref()
+            .and_then(|p| p.preprocessing.as_ref())
+            .and_then(|p| p.coulomb_epsilon);
+        Ok((fit.predict(dynamics, held).map_err(|e| e.to_string())?, epsilon))
+    });
+    candidates
+        .iter()
+        .zip(predictions.chunks(BLOCKS))
+        .map(|(&candidate, blocks)| {
+            let epsilons = blocks.iter().map(|b| b.as_ref().ok().and_then(|(_, e)| *e)).collect();
+            let held_out = blocks
+                .iter()
+                .cloned()
+                .collect::<Result<Vec<_>, String>>()
+                .and_then(|blocks| {
+                    let predicted: Vec<Vec<f64>> = blocks.into_iter().flat_map(|(p, _)| p).collect();
+                    let measured = folds.iter().flat_map(|(_, held)| held.samples().map(|s| s.tau));
+                    Validation::new(&names, measured, predicted.iter().map(Vec::as_slice)).map_err(|e| e.to_string())
+                });
+            (Score { candidate, held_out }, epsilons)
+        })
+        .collect()
 }

@@ -30,6 +30,7 @@
 
 pub mod choice;
 pub mod data;
+pub mod extras;
 pub mod floating;
 pub mod friction;
 pub mod gains;

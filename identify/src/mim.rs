@@ -47,6 +47,7 @@
 //! println!("{est}");
 //! ```
 
+use crate::extras::ExtraTerms;
 use crate::faer::Mat;
 use crate::simulate::Recording;
 use crate::{Accumulator, Channels, Estimate, IdentifyError, Options, ParamEstimate, Status};
@@ -531,10 +532,12 @@ pub enum TorqueRegressor {
     Principal,
     /// A generated robot's principal base regressor (`n × NBASE_PRINCIPAL`).
     PrincipalBase { columns: usize, regressor: RegressorFn },
-    /// `[Y | J]` (`n × 14n`): the standard parameters, then per joint rotor inertia,
-    /// viscous and Coulomb friction and an offset `[Ia, Fv, Fc, F0]`
-    /// ([`dyngen_model::joint_params`]): the model of a real robot's joint torques.
-    StandardAndJoints(Coulomb),
+    /// `[Y | J | E]` (`n × (14 + e)n`): the standard parameters, then per joint rotor
+    /// inertia, viscous and Coulomb friction and an offset `[Ia, Fv, Fc, F0]`
+    /// ([`dyngen_model::joint_params`]): the model of a real robot's joint torques;
+    /// then per joint the `e` columns of the extra terms ([`crate::extras`]), none
+    /// with [`ExtraTerms::NONE`].
+    StandardAndJoints(Coulomb, ExtraTerms),
 }
 
 impl fmt::Debug for TorqueRegressor {
@@ -543,22 +546,24 @@ impl fmt::Debug for TorqueRegressor {
             TorqueRegressor::Standard => write!(f, "Standard"),
             TorqueRegressor::Principal => write!(f, "Principal"),
             TorqueRegressor::PrincipalBase { columns, .. } => write!(f, "PrincipalBase({columns})"),
-            TorqueRegressor::StandardAndJoints(c) => write!(f, "StandardAndJoints({c:?})"),
+            TorqueRegressor::StandardAndJoints(c, e) if e.is_empty() => write!(f, "StandardAndJoints({c:?})"),
+            TorqueRegressor::StandardAndJoints(c, e) => write!(f, "StandardAndJoints({c:?}, {e})"),
         }
     }
 }
 
 impl TorqueRegressor {
     /// Number of columns for `model`: 10 (standard) or 4 (principal) per body, and
-    /// with the joint terms 4 per velocity coordinate (a joint that follows another,
-    /// `<mimic>`, has none: its rotor and friction act on its leader's).
+    /// with the joint terms 4 per velocity coordinate and the extra terms' (a joint
+    /// that follows another, `<mimic>`, has none: its rotor and friction act on its
+    /// leader's).
     pub fn columns(&self, model: &Model) -> usize {
         let (bodies, nv) = (model.dof(), model.nv());
         match self {
             TorqueRegressor::Standard => 10 * bodies,
             TorqueRegressor::Principal => 4 * bodies,
             TorqueRegressor::PrincipalBase { columns, .. } => *columns,
-            TorqueRegressor::StandardAndJoints(_) => 10 * bodies + PER_JOINT * nv,
+            TorqueRegressor::StandardAndJoints(_, e) => 10 * bodies + (PER_JOINT + e.per_joint()) * nv,
         }
     }
 
@@ -570,16 +575,18 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => standard_param_names(bodies),
             TorqueRegressor::Principal => principal_param_names(bodies),
             TorqueRegressor::PrincipalBase { columns, .. } => (1..=*columns).map(|k| format!("β{k}")).collect(),
-            TorqueRegressor::StandardAndJoints(_) => {
+            TorqueRegressor::StandardAndJoints(_, e) => {
                 let mut names = standard_param_names(bodies);
                 names.extend(dyngen_model::joint_params::joint_param_names(nv));
+                names.extend(e.names(nv));
                 names
             }
         }
     }
 
     /// The joint torques `Y(q, v, a) x` of the parameters `x` (`columns(n)`), with
-    /// `y` (`n × columns`) as room for the regressor.
+    /// `y` (`n × columns`) as room for the regressor; the load-dependent friction's
+    /// load is the rigid-body torque of `x`'s own parameters.
     pub fn predict(
         &self,
         dynamics: &dyn Dynamics,
@@ -591,6 +598,7 @@ impl TorqueRegressor {
     ) -> Vec<f64> {
         let p = x.len();
         self.eval(dynamics, q, v, a, y);
+        self.fill_load(dynamics.model(), v, &x[..dynamics.nparams().min(p)], y);
         y.chunks_exact(p).map(|row| crate::dense::dot(row, x)).collect()
     }
 
@@ -601,7 +609,7 @@ impl TorqueRegressor {
     pub fn row_support(&self, model: &Model) -> Option<Vec<Vec<usize>>> {
         let n = model.dof();
         let per_body = match self {
-            TorqueRegressor::Standard | TorqueRegressor::StandardAndJoints(_) => 10,
+            TorqueRegressor::Standard | TorqueRegressor::StandardAndJoints(..) => 10,
             TorqueRegressor::Principal => 4,
             TorqueRegressor::PrincipalBase { .. } => return None,
         };
@@ -616,9 +624,11 @@ impl TorqueRegressor {
                         .filter(|&i| model.supports(j, i))
                         .flat_map(|i| per_body * (i - 1)..per_body * i)
                         .collect();
-                    if matches!(self, TorqueRegressor::StandardAndJoints(_)) {
+                    if let TorqueRegressor::StandardAndJoints(_, e) = self {
                         let at = 10 * n + PER_JOINT * (j - 1);
                         cols.extend(at..at + PER_JOINT);
+                        let (e, at) = (e.per_joint(), 10 * n + PER_JOINT * n + e.per_joint() * (j - 1));
+                        cols.extend(at..at + e);
                     }
                     cols
                 })
@@ -626,15 +636,16 @@ impl TorqueRegressor {
         )
     }
 
-    /// The regressor at `(q, v, a)`, row-major into `y` (`n × columns`).
+    /// The regressor at `(q, v, a)`, row-major into `y` (`n × columns`); the
+    /// load-dependent friction's column is 0 until [`TorqueRegressor::fill_load`].
     pub fn eval(&self, dynamics: &dyn Dynamics, q: &[f64], v: &[f64], a: &[f64], y: &mut [f64]) {
         match self {
             TorqueRegressor::Standard => dynamics.joint_torque_regressor(q, v, a, y),
             TorqueRegressor::Principal => dynamics.principal_regressor(q, v, a, y),
             TorqueRegressor::PrincipalBase { regressor, .. } => regressor(q, v, a, y),
-            TorqueRegressor::StandardAndJoints(coulomb) => {
-                let (n, rigid) = (v.len(), dynamics.nparams());
-                let p = rigid + PER_JOINT * n;
+            TorqueRegressor::StandardAndJoints(coulomb, extras) => {
+                let (n, rigid, e) = (v.len(), dynamics.nparams(), extras.per_joint());
+                let p = rigid + (PER_JOINT + e) * n;
                 // The rigid-body rows land packed at the front of `y`; each is then
                 // moved to its place in the wider layout, last row first so that no
                 // row is overwritten before it is moved (no buffer on this hot path).
@@ -644,8 +655,29 @@ impl TorqueRegressor {
                     y[j * p + rigid..(j + 1) * p].fill(0.0);
                     let at = j * p + rigid + PER_JOINT * j;
                     y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], *coulomb));
+                    if e > 0 {
+                        let at = j * p + rigid + PER_JOINT * n + e * j;
+                        extras.row(q[j], v[j], 0.0, *coulomb, &mut y[at..at + e]);
+                    }
                 }
             }
+        }
+    }
+
+    /// Fills the load-dependent friction's column of the rows `y` (from
+    /// [`TorqueRegressor::eval`]) with the links' load of the rigid-body parameters
+    /// `rigid` (`10` per body): `|Y_j π|·s(q̇_j)` in row `j`. Nothing to do without
+    /// that term.
+    pub fn fill_load(&self, model: &Model, v: &[f64], rigid: &[f64], y: &mut [f64]) {
+        let TorqueRegressor::StandardAndJoints(coulomb, extras) = self else {
+            return;
+        };
+        let Some(c) = extras.load_column() else { return };
+        let (n, p, e, r) = (v.len(), self.columns(model), extras.per_joint(), 10 * model.dof());
+        let first = r + PER_JOINT * n;
+        for j in 0..n {
+            let load = crate::dense::dot(&y[j * p..j * p + r], rigid);
+            y[j * p + first + e * j + c] = ExtraTerms::load_entry(load, v[j], *coulomb);
         }
     }
 }
@@ -820,8 +852,11 @@ fn torque_estimate(
         acc = acc.with_column_support(support)?;
     }
     let mut y = vec![0.0; n * p];
+    // The load of load-dependent friction: the model's own rigid-body parameters.
+    let nominal = dynamics.model().standard_params();
     for s in &recording.samples[range] {
         regressor.eval(dynamics, &s.q, &s.v, &s.a, &mut y);
+        regressor.fill_load(dynamics.model(), &s.v, &nominal, &mut y);
         acc.push_rows(crate::faer::MatRef::from_row_major_slice(&y, n, p), &s.tau)?;
     }
     let estimate = match &weighting {
@@ -844,8 +879,9 @@ fn torque_estimate(
 /// effect. [`TorqueRegressor::Standard`]: `τ = Y π`, the combinations are the base
 /// parameters; [`TorqueRegressor::Principal`]: the paper's MIM from joint torques
 /// alone, `τ = Y_θ θ`; [`TorqueRegressor::StandardAndJoints`]: a real robot's
-/// torques, with rotor inertia and friction per joint. `truth`: in the regressor's
-/// parameters ([`TorqueRegressor::names`]).
+/// torques, with rotor inertia and friction per joint (and a load-dependent
+/// friction's load from the model's own rigid-body parameters). `truth`: in the
+/// regressor's parameters ([`TorqueRegressor::names`]).
 pub fn torque(
     dynamics: &dyn Dynamics,
     recording: &Recording,

@@ -23,6 +23,7 @@
 //! bit for bit.
 
 use crate::data::{Recipe, Trajectory};
+use crate::extras::ExtraTerms;
 use crate::mim::TorqueRegressor;
 use crate::pipeline::{self, Identification, IdentifyOptions, JointTerms, Mode, PipelineError};
 use crate::report::DataSpan;
@@ -77,6 +78,9 @@ pub struct RowOptions {
     pub epsilon: Option<f64>,
     /// [`IdentifyOptions::rotor_inertia`].
     pub rotor_inertia: Option<bool>,
+    /// [`IdentifyOptions::extras`] (absent: none).
+    #[serde(default, skip_serializing_if = "ExtraTerms::is_empty")]
+    pub extras: ExtraTerms,
     pub accumulation: Accumulation,
     /// [`IdentifyOptions::exclude_below`].
     pub exclude_below: Option<f64>,
@@ -258,6 +262,7 @@ impl RowOptions {
             friction: friction.into(),
             epsilon,
             rotor_inertia: options.rotor_inertia,
+            extras: options.extras,
             accumulation: options.accumulation,
             exclude_below: options.exclude_below,
             cutoff_hz: options.cutoff_hz,
@@ -281,6 +286,7 @@ impl RowOptions {
             (other, _) => return Err(invalid("friction (none, sign, or smooth with an epsilon)", other)),
         };
         options.rotor_inertia = self.rotor_inertia;
+        options.extras = self.extras;
         options.accumulation = self.accumulation;
         options.exclude_below = self.exclude_below;
         options.cutoff_hz = self.cutoff_hz;
@@ -289,7 +295,7 @@ impl RowOptions {
     }
 
     /// Each row option by its command-line name, as text.
-    fn shown(&self) -> [(&'static str, String); 9] {
+    fn shown(&self) -> [(&'static str, String); 10] {
         let or_none = |x: Option<f64>| x.map_or_else(|| "none".to_string(), |x| x.to_string());
         [
             ("mode", self.mode.clone()),
@@ -304,6 +310,7 @@ impl RowOptions {
                 }
                 .to_string(),
             ),
+            ("extra-terms", self.extras.to_string()),
             (
                 "accumulation",
                 match self.accumulation {
@@ -441,6 +448,9 @@ impl Partial {
         }
         if given.rotor_inertia != default.rotor_inertia {
             asked.rotor_inertia = theirs.rotor_inertia;
+        }
+        if given.extras != default.extras {
+            asked.extras = theirs.extras;
         }
         if given.accumulation != default.accumulation {
             asked.accumulation = theirs.accumulation;

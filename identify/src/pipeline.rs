@@ -23,6 +23,7 @@
 //! ```
 
 use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
+use crate::extras::ExtraTerms;
 use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
 use crate::report::{
     self, CoulombReport, JointParams, JointParamsFile, MergedLinks, NonPhysical, ParamReport, ParamStatus,
@@ -110,6 +111,11 @@ pub enum JointTerms {
     Stribeck(Coulomb),
 }
 
+/// Refits of the load-dependent friction's alternation, at most.
+pub const LOAD_ROUNDS: usize = 8;
+/// The alternation stops when no parameter changes by more than this fraction.
+pub const LOAD_TOLERANCE: f64 = 1e-6;
+
 /// Samples the search for the Coulomb smoothing fits on, at most.
 pub const SMOOTHING_SAMPLES: usize = 20_000;
 
@@ -128,6 +134,9 @@ pub struct IdentifyOptions {
     /// and `F0` columns held at 0). Terms left out are reported
     /// [`ParamStatus::Excluded`].
     pub rotor_inertia: Option<bool>,
+    /// Joint terms past viscous and Coulomb friction ([`crate::extras`]): with
+    /// [`JointTerms::Friction`] or [`JointTerms::FrictionAuto`] only.
+    pub extras: ExtraTerms,
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
     /// Leave a joint's torque rows out of its equations at the samples where its
@@ -156,6 +165,7 @@ impl Default for IdentifyOptions {
             estimator: Estimator::Ols,
             joints: JointTerms::None,
             rotor_inertia: None,
+            extras: ExtraTerms::NONE,
             accumulation: Accumulation::Qr,
             exclude_below: None,
             cutoff_hz: 10.0,
@@ -213,6 +223,28 @@ impl IdentifyOptions {
         {
             if !(epsilon.is_finite() && epsilon > 0.0) {
                 return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
+            }
+        }
+        if !self.extras.is_empty() {
+            match self.joints {
+                JointTerms::Friction(_) | JointTerms::FrictionAuto => {}
+                JointTerms::None => {
+                    return invalid(
+                        "extra-terms",
+                        format!(
+                            "{} extends the friction model: give --friction sign, smooth or auto as well",
+                            self.extras
+                        ),
+                    )
+                }
+                JointTerms::Stribeck(_) => {
+                    return invalid(
+                        "extra-terms",
+                        "do not combine with Stribeck friction (its joint fits model the friction alone); use \
+                         --friction sign, smooth or auto with them"
+                            .into(),
+                    )
+                }
             }
         }
         if let Some(speed) = self.exclude_below {
@@ -401,6 +433,19 @@ pub fn identify(
         });
     }
     need_derivatives(trajectory)?;
+    let model = dynamics.model();
+    if options.extras.harmonics > 0 && model.nq() != model.nv() {
+        return Err(PipelineError::InvalidOption {
+            option: "extra-terms",
+            reason: format!(
+                "ripple harmonics are of each joint's one angle; `{}` has {} position and {} velocity coordinates \
+                 (a ball or free joint)",
+                model.name,
+                model.nq(),
+                model.nv()
+            ),
+        });
+    }
     match options.mode {
         Mode::Standard | Mode::Principal => from_torques(dynamics, trajectory, options),
         Mode::Mim => {
@@ -431,8 +476,10 @@ fn from_torques(
             let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
             let mut failure = None;
             let (epsilon, _) = crate::friction::best_epsilon(|epsilon| {
-                let r = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon });
-                match accumulate(dynamics, traj, r, stride, options).and_then(|acc| Ok(acc.ols(&options.tolerances)?)) {
+                let r = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, options.extras);
+                match accumulate(dynamics, traj, r, stride, None, options)
+                    .and_then(|acc| Ok(acc.ols(&options.tolerances)?))
+                {
                     Ok(e) => e.residuals.rms,
                     Err(e) => {
                         failure.get_or_insert(e);
@@ -444,13 +491,32 @@ fn from_torques(
                 return Err(e);
             }
             chosen_epsilon = Some(epsilon);
-            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon })
+            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, options.extras)
         }
         _ => torque_regressor(options),
     };
-    let acc = accumulate(dynamics, traj, regressor, 1, options)?;
+    let mut acc = accumulate(dynamics, traj, regressor, 1, None, options)?;
     let fit = TorqueFit::new(dynamics.model(), regressor, options);
-    let (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
+    let (mut estimate, mut warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
+    if options.extras.load {
+        // The load of each row from the rigid-body parameters of the fit before
+        // (the first fit has no load term), until the load coefficients settle.
+        let rigid = 10 * dynamics.model().dof();
+        for _ in 0..LOAD_ROUNDS {
+            let previous = estimate.solution.clone();
+            acc = accumulate(dynamics, traj, regressor, 1, Some(&previous[..rigid]), options)?;
+            (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
+            let change = estimate
+                .solution
+                .iter()
+                .zip(&previous)
+                .map(|(a, b)| (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max);
+            if change < LOAD_TOLERANCE {
+                break;
+            }
+        }
+    }
     let (estimate, stribeck) = match options.joints {
         JointTerms::Stribeck(coulomb) if options.mode == Mode::Standard => {
             let constraints = crate::stribeck::JointConstraints {
@@ -458,7 +524,7 @@ fn from_torques(
                 nonnegative: options.estimator == Estimator::Consistent,
             };
             let (estimate, stribeck) = crate::stribeck::refine(dynamics, traj, coulomb, constraints, estimate, |t| {
-                let acc = accumulate(dynamics, t, regressor, 1, options)?;
+                let acc = accumulate(dynamics, t, regressor, 1, None, options)?;
                 Ok::<_, PipelineError>(fit.solve(&acc)?)
             })?;
             let finite = estimate.solution.iter().all(|x| x.is_finite())
@@ -487,13 +553,13 @@ pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
     match (options.mode, options.joints) {
         (Mode::Principal | Mode::Mim, _) => TorqueRegressor::Principal,
         (Mode::Standard, JointTerms::None) if options.rotor_inertia == Some(true) => {
-            TorqueRegressor::StandardAndJoints(Coulomb::Sign)
+            TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE)
         }
         (Mode::Standard, JointTerms::None) => TorqueRegressor::Standard,
         (Mode::Standard, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
-            TorqueRegressor::StandardAndJoints(coulomb)
+            TorqueRegressor::StandardAndJoints(coulomb, options.extras)
         }
-        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(Coulomb::Sign),
+        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(Coulomb::Sign, options.extras),
     }
 }
 
@@ -529,8 +595,10 @@ struct TorqueFit<'a> {
 impl<'a> TorqueFit<'a> {
     fn new(model: &'a Model, regressor: TorqueRegressor, options: &'a IdentifyOptions) -> Self {
         let mut nominal = nominal(model, options.mode);
-        if matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+        if matches!(regressor, TorqueRegressor::StandardAndJoints(..)) {
             nominal.extend(dyngen_model::joint_params::nominal_joint_params(model));
+            // A robot description has no extra term: 0.
+            nominal.resize(regressor.columns(model), 0.0);
         }
         let fitted = fitted_joint_terms(options);
         let excluded = excluded_columns(regressor, model, fitted);
@@ -650,9 +718,13 @@ impl<'a> TorqueFit<'a> {
         let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
         // One joint per velocity coordinate (a joint that follows another has none).
         let joint_names: Vec<&str> = model.own_joints().map(|j| j.name.as_str()).collect();
+        let extras = match regressor {
+            TorqueRegressor::StandardAndJoints(_, e) => e,
+            _ => ExtraTerms::NONE,
+        };
         let (parameterisation, coulomb) = match regressor {
             TorqueRegressor::Principal => (Parameterisation::Principal, None),
-            TorqueRegressor::StandardAndJoints(c) => (
+            TorqueRegressor::StandardAndJoints(c, _) => (
                 Parameterisation::StandardAndJoints,
                 Some(match c {
                     Coulomb::Sign => CoulombReport::Sign,
@@ -664,7 +736,7 @@ impl<'a> TorqueFit<'a> {
         let mut report =
             ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
         let nonphysical = match regressor {
-            TorqueRegressor::StandardAndJoints(_) => {
+            TorqueRegressor::StandardAndJoints(..) => {
                 let values: Vec<Option<f64>> = report.parameters[10 * bodies..10 * bodies + PER_JOINT * n]
                     .iter()
                     .map(|p| match p.status {
@@ -705,6 +777,7 @@ impl<'a> TorqueFit<'a> {
         report.prediction = Some(PredictionModel {
             regressor: parameterisation,
             coulomb,
+            extras,
             solution: estimate.solution.clone(),
             stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
             preprocessing: Some(Preprocessing {
@@ -714,7 +787,7 @@ impl<'a> TorqueFit<'a> {
                 coulomb_epsilon,
                 epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
                 exclude_below: options.exclude_below,
-                rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(_)).then_some(self.fitted[0]),
+                rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(..)).then_some(self.fitted[0]),
                 ..Preprocessing::default()
             }),
             nonphysical,
@@ -802,7 +875,7 @@ pub fn fitted_joint_terms(options: &IdentifyOptions) -> [bool; PER_JOINT] {
 /// coordinate) for which `pick(k)` holds, for `regressor`: after the 10 standard
 /// parameters per body, 4 per coordinate; none without joint terms.
 fn joint_term_columns(regressor: TorqueRegressor, model: &Model, pick: impl Fn(usize) -> bool) -> Vec<usize> {
-    if !matches!(regressor, TorqueRegressor::StandardAndJoints(_)) {
+    if !matches!(regressor, TorqueRegressor::StandardAndJoints(..)) {
         return Vec::new();
     }
     let rigid = 10 * model.dof();
@@ -848,16 +921,18 @@ pub(crate) fn accumulate_recording(
         });
     }
     need_derivatives(traj)?;
-    accumulate(dynamics, traj, regressor, 1, options)
+    accumulate(dynamics, traj, regressor, 1, None, options)
 }
 
 /// The rows of `regressor` over every `stride`-th sample of `traj`, accumulated
-/// as `options` say (compression, rows left out below a speed).
+/// as `options` say (compression, rows left out below a speed); a load-dependent
+/// friction's load from the rigid-body parameters `load` (its column 0 without).
 fn accumulate(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
     regressor: TorqueRegressor,
     stride: usize,
+    load: Option<&[f64]>,
     options: &IdentifyOptions,
 ) -> Result<Accumulator, PipelineError> {
     let n = dynamics.nv();
@@ -887,6 +962,9 @@ fn accumulate(
         for &k in part {
             let (q, v, a) = state(traj, k);
             regressor.eval(dynamics, q, v, a, &mut y);
+            if let Some(rigid) = load {
+                regressor.fill_load(dynamics.model(), v, rigid, &mut y);
+            }
             for row in y.chunks_exact_mut(p) {
                 for &c in &excluded {
                     row[c] = 0.0;
@@ -1021,16 +1099,19 @@ pub fn predict_with(
     let regressor = match (prediction.regressor, prediction.coulomb) {
         (Parameterisation::Standard, None) => TorqueRegressor::Standard,
         (Parameterisation::Principal, None) => TorqueRegressor::Principal,
-        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(match c {
-            CoulombReport::Sign => Coulomb::Sign,
-            CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
-            CoulombReport::Tanh { epsilon } => {
-                return Err(PipelineError::InvalidOption {
-                    option: "prediction",
-                    reason: format!("the Coulomb smoothing must be positive, got {epsilon}"),
-                })
-            }
-        }),
+        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(
+            match c {
+                CoulombReport::Sign => Coulomb::Sign,
+                CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
+                CoulombReport::Tanh { epsilon } => {
+                    return Err(PipelineError::InvalidOption {
+                        option: "prediction",
+                        reason: format!("the Coulomb smoothing must be positive, got {epsilon}"),
+                    })
+                }
+            },
+            prediction.extras,
+        ),
         (r, c) => {
             return Err(PipelineError::InvalidOption {
                 option: "prediction",
@@ -1055,9 +1136,17 @@ pub fn predict_with(
             reason: format!("entry {k} of the solution is not finite"),
         });
     }
+    if !prediction.extras.is_empty()
+        && (!matches!(regressor, TorqueRegressor::StandardAndJoints(..)) || prediction.stribeck.is_some())
+    {
+        return Err(PipelineError::InvalidOption {
+            option: "prediction",
+            reason: "extra joint terms need the standard_and_joints regressor without Stribeck terms".into(),
+        });
+    }
     let stribeck = match (&prediction.stribeck, regressor) {
         (None, _) => None,
-        (Some(s), TorqueRegressor::StandardAndJoints(coulomb)) => {
+        (Some(s), TorqueRegressor::StandardAndJoints(coulomb, _)) => {
             crate::stribeck::check(s, n).map_err(|e| PipelineError::InvalidOption {
                 option: "prediction",
                 reason: format!("stribeck: {e}"),
@@ -1297,6 +1386,7 @@ impl Identification {
         let (rigid, n) = (10 * model.dof(), model.nv());
         let params = &self.report.parameters;
         let stribeck = self.stribeck.is_some() && params.len() >= rigid + 6 * n;
+        let extras = prediction.extras.per_joint();
         let joints = model
             .own_joints()
             .enumerate()
@@ -1307,6 +1397,8 @@ impl Identification {
                     let at = rigid + PER_JOINT * n + 2 * j;
                     parameters.extend_from_slice(&params[at..at + 2]);
                 }
+                let at = rigid + PER_JOINT * n + extras * j;
+                parameters.extend_from_slice(&params[at..at + extras]);
                 JointParams {
                     name: joint.name.clone(),
                     in_urdf: in_urdf.contains(&joint.name.as_str()),

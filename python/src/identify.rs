@@ -2,7 +2,9 @@
 //! pipeline: read a recording, estimate what it does not measure, identify).
 
 use crate::LoadError;
+use dyngen_identify::choice::DEFAULT_EXTRAS;
 use dyngen_identify::data::Recipe;
+use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::partial::{self, Partial, PartialError};
 use dyngen_identify::pipeline::{self, Estimator, Identification, IdentifyOptions, JointTerms, Mode};
 use dyngen_identify::report::DataSpan;
@@ -27,6 +29,8 @@ struct Choices<'a> {
     ridge_lambda: f64,
     cutoff: f64,
     raw_states: bool,
+    /// `extra_terms` as given (`None`: not given).
+    extra_terms: Option<&'a str>,
 }
 
 fn invalid(function: &str, option: &str, value: &str, valid: &[&str]) -> PyErr {
@@ -82,10 +86,16 @@ impl Choices<'_> {
                 return Err(invalid(self.function, "friction", other, &valid));
             }
         };
+        let extras = match (self.friction, self.extra_terms) {
+            // With best, the terms the choice may add (`Choices::allowed_extras`).
+            ("best", _) | (_, None) => ExtraTerms::NONE,
+            (_, Some(text)) => self.extras(text)?,
+        };
         let options = IdentifyOptions {
             mode,
             estimator,
             joints,
+            extras,
             cutoff_hz: self.cutoff,
             low_pass_states: !self.raw_states,
             ..IdentifyOptions::default()
@@ -94,6 +104,17 @@ impl Choices<'_> {
             .check()
             .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.function)))?;
         Ok(options)
+    }
+
+    fn extras(&self, text: &str) -> PyResult<ExtraTerms> {
+        text.parse()
+            .map_err(|e| PyValueError::new_err(format!("{}: extra_terms `{text}`: {e}", self.function)))
+    }
+
+    /// The extra terms `friction="best"` may add: those given, else
+    /// [`DEFAULT_EXTRAS`].
+    fn allowed_extras(&self) -> PyResult<ExtraTerms> {
+        self.extra_terms.map_or(Ok(DEFAULT_EXTRAS), |text| self.extras(text))
     }
 }
 
@@ -117,6 +138,12 @@ impl Choices<'_> {
 ///         `"auto"` and `"stribeck"` that predicts held-out time blocks of the
 ///         recording best; each candidate's error is in `model_choice`).
 ///     epsilon: the Coulomb smoothing of `"smooth"` friction, rad/s.
+///     extra_terms: joint terms past friction, with `"sign"`, `"smooth"` or
+///         `"auto"`: a comma-separated list of `"asymmetric"` (direction-dependent
+///         viscous friction), `"ripple=H"` (`H` harmonics of the joint angle: torque
+///         ripple and position-dependent Coulomb friction) and `"load"` (Coulomb
+///         friction growing with the transmitted torque). With `"best"`: the terms
+///         it may add (default `"asymmetric,ripple=2,load"`; `"none"` for none).
 ///     ridge_lambda: the scale-free weight of `"ridge"`.
 ///     cutoff: low-pass cutoff (Hz) of the velocities and accelerations estimated
 ///         from positions, and of the measured states.
@@ -139,7 +166,7 @@ impl Choices<'_> {
 ///     `validate` a dict `validation`: `samples`, `joint_names`, per joint `rms`
 ///     (of the prediction error), `measured_rms`, `relative` (‖τ̂ − τ‖ / ‖τ‖), and
 ///     `overall` (over every joint and sample); with `friction="best"` a dict
-///     `model_choice`: `chosen` (the candidate's name) and `held_out` (each
+///     `model_choice`: `chosen` (the candidate's label: `"auto + asymmetric,load"`, say) and `held_out` (each
 ///     candidate's overall relative error on the held-out blocks, None where it
 ///     could not be fitted).
 ///
@@ -156,6 +183,7 @@ impl Choices<'_> {
     method = "ols",
     friction = "none",
     epsilon = 0.01,
+    extra_terms = None,
     ridge_lambda = 1e-6,
     cutoff = 10.0,
     raw_states = false,
@@ -174,6 +202,7 @@ pub fn identify<'py>(
     method: &str,
     friction: &str,
     epsilon: f64,
+    extra_terms: Option<&str>,
     ridge_lambda: f64,
     cutoff: f64,
     raw_states: bool,
@@ -188,7 +217,7 @@ pub fn identify<'py>(
             "identify: `validate_recipe` is the recipe of the `validate` recording; give `validate` too",
         ));
     }
-    let options = Choices {
+    let choices = Choices {
         function: "identify",
         mode,
         method,
@@ -197,8 +226,10 @@ pub fn identify<'py>(
         ridge_lambda,
         cutoff,
         raw_states,
-    }
-    .options()?;
+        extra_terms,
+    };
+    let options = choices.options()?;
+    let allowed_extras = choices.allowed_extras()?;
     let recipe = read_recipe("identify", recipe.as_deref())?;
     let validation_recipe = match &validate_recipe {
         Some(_) => read_recipe("identify", validate_recipe.as_deref())?,
@@ -211,7 +242,7 @@ pub fn identify<'py>(
     let (identified, validation, choice) = py.detach(|| {
         let loaded = pipeline::load(&data_path, &recipe, model.nv(), &options).map_err(|e| failed(&data_path, e))?;
         let (options, choice) = if friction == "best" {
-            let choice = dyngen_identify::choice::choose(&robot, &loaded.trajectory, &options)
+            let choice = dyngen_identify::choice::choose(&robot, &loaded.trajectory, &options, allowed_extras)
                 .map_err(|e| failed(&data_path, e))?;
             (choice.apply(&options), Some(choice))
         } else {
@@ -262,10 +293,10 @@ pub fn identify<'py>(
     if let Some(choice) = choice {
         let held_out = PyDict::new(py);
         for score in &choice.scores {
-            held_out.set_item(score.candidate.name, score.held_out.as_ref().ok().map(|v| v.overall))?;
+            held_out.set_item(score.candidate.label(), score.held_out.as_ref().ok().map(|v| v.overall))?;
         }
         let d = PyDict::new(py);
-        d.set_item("chosen", choice.chosen().name)?;
+        d.set_item("chosen", choice.chosen().label())?;
         d.set_item("held_out", held_out)?;
         out.set_item("model_choice", d)?;
     }
@@ -501,6 +532,7 @@ impl PyPartial {
             ridge_lambda,
             cutoff: 10.0,
             raw_states: false,
+            extra_terms: None,
         }
         .options()?;
         let model = load_robot(&robot_path)?;
@@ -603,6 +635,7 @@ pub fn identify_partial(
         ridge_lambda: 1e-6,
         cutoff,
         raw_states,
+        extra_terms: None,
     }
     .options()?;
     let failed =

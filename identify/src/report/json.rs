@@ -45,6 +45,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{write_new, ReportError};
+use crate::extras::ExtraTerms;
 use crate::mim::{MimEstimate, Verdict};
 use crate::{Estimate, Status};
 use dyngen_model::names::principal_param_names;
@@ -91,6 +92,11 @@ pub struct PredictionModel {
     /// For `standard_and_joints`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coulomb: Option<CoulombReport>,
+    /// For `standard_and_joints`: the joint terms past friction, whose parameters
+    /// follow the `[Ia, Fv, Fc, F0]` of every joint in the solution
+    /// ([`crate::extras`]).
+    #[serde(default, skip_serializing_if = "ExtraTerms::is_empty")]
+    pub extras: ExtraTerms,
     pub solution: Vec<f64>,
     /// For `standard_and_joints` with Stribeck friction: per joint the static
     /// friction `fs` and Stribeck velocity `vs`; row `j` of the prediction gains

@@ -6,6 +6,7 @@
 //! ([`Logger::write`]). Everything is seeded.
 
 use super::experiment::Recording;
+use crate::extras::ExtraTerms;
 use crate::stribeck::{Stribeck, StribeckError};
 use dyngen_model::joint_params::{joint_torque, Coulomb, PER_JOINT};
 use dyngen_model::sample::SplitMix64;
@@ -30,6 +31,41 @@ pub fn add_joint_terms(recording: &mut Recording, joint_params: &[f64], coulomb:
             s.tau[j] += joint_torque(p, s.v[j], s.a[j], coulomb);
         }
     }
+}
+
+/// Adds the extra joint terms `extras` with parameters `params` (`per_joint()` per
+/// joint, [`crate::extras`]) to the recorded joint torques. The load-dependent
+/// friction's load is the rigid-body torque, which the recording holds as
+/// [`record_trajectory`](super::record_trajectory) made it: call this before
+/// [`add_joint_terms`] and any other torque. Refuses a length other than one set
+/// per joint.
+pub fn add_extra_terms(
+    recording: &mut Recording,
+    extras: ExtraTerms,
+    params: &[f64],
+    coulomb: Coulomb,
+) -> Result<(), String> {
+    let (n, e) = (recording.joint_names.len(), extras.per_joint());
+    if params.len() != e * n {
+        return Err(format!(
+            "`params` has length {}; {n} joints with `{extras}` need {}",
+            params.len(),
+            e * n
+        ));
+    }
+    let mut row = vec![0.0; e];
+    for s in &mut recording.samples {
+        for j in 0..n {
+            let load = ExtraTerms::load_entry(s.tau[j], s.v[j], coulomb);
+            extras.row(s.q[j], s.v[j], load, coulomb, &mut row);
+            s.tau[j] += row
+                .iter()
+                .zip(&params[e * j..e * (j + 1)])
+                .map(|(y, p)| y * p)
+                .sum::<f64>();
+        }
+    }
+    Ok(())
 }
 
 /// Adds every joint's Stribeck term `(Fs − Fc)·exp(−(q̇/vs)²)·s(q̇)`

@@ -40,6 +40,6 @@ pub use excitation::{
 };
 pub use experiment::{record, record_trajectory, BodyMeasurement, Experiment, Motion, Recording, Sample};
 pub use integrate::{simulate_rk4, Simulation};
-pub use logger::{add_joint_terms, add_stribeck_terms, Logger};
+pub use logger::{add_extra_terms, add_joint_terms, add_stribeck_terms, Logger};
 pub use motion::{FourierExcitation, JointMotion, RaisedCosine, SampledMotion};
 pub use noise::{Channel, Gaussian, NoiseModel, Sigma};

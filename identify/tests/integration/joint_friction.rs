@@ -6,6 +6,7 @@
 
 use crate::common::{add_torque_noise, joint_truth, motion, overall_error, ur5, F0, FC, FV, IA};
 use dyngen_identify::data::{Recipe, Trajectory};
+use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::{self, TorqueRegressor, Weighting};
 use dyngen_identify::pipeline::{self, Estimator, IdentifyOptions, JointTerms, PipelineError, Prediction};
@@ -52,7 +53,7 @@ fn noise_free_identification_recovers_friction_and_rotor_inertia() {
         &robot,
         &rec,
         0..rec.len(),
-        TorqueRegressor::StandardAndJoints(Coulomb::Sign),
+        TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE),
         None,
         Weighting::Ols,
         &Options::default(),
@@ -112,7 +113,7 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
     let sigma = add_torque_noise(&mut rec, &mut noise);
     let loaded = read_log(&logger.write(&rec), Some("14,13,12,9,8.5,8"));
     let traj = &loaded;
-    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign);
+    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE);
     let p = regressor.columns(robot.model());
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(6)).unwrap();
     let mut y = vec![0.0; 6 * p];
@@ -524,17 +525,17 @@ fn rotor_inertia_is_fitted_or_left_out_on_its_own() {
 
 /// The joint model chosen on held-out time blocks of a recording whose joints have
 /// rotor inertia and sign friction (1 % torque noise): a model with both, never
-/// rigid bodies alone or friction without rotor inertia, and no worse held out
-/// than sign friction.
+/// rigid bodies alone or friction without rotor inertia, no worse held out than
+/// sign friction, and no extra term (the joints have none).
 #[test]
 fn the_chosen_joint_model_has_what_the_joints_have() {
-    use dyngen_identify::choice::{choose, BLOCKS};
+    use dyngen_identify::choice::{choose, BLOCKS, DEFAULT_EXTRAS};
     let robot = ur5();
     // 15 s of the 30 s recording: enough for the choice, half the time.
     let traj = noisy_trajectory(&robot, &joint_truth(), 1, 5)
         .select(|k| k < 1500)
         .unwrap();
-    let choice = choose(&robot, &traj, &IdentifyOptions::default()).unwrap();
+    let choice = choose(&robot, &traj, &IdentifyOptions::default(), DEFAULT_EXTRAS).unwrap();
     println!("{choice}");
     let error = |name: &str| {
         let s = choice.scores.iter().find(|s| s.candidate.name == name).unwrap();
@@ -545,11 +546,16 @@ fn the_chosen_joint_model_has_what_the_joints_have() {
     assert!(error(chosen) <= error("sign"), "{choice}");
     assert!(error("none") > 5.0 * error("sign"), "{choice}");
     assert!(error("sign-no-rotor-inertia") > error("sign"), "{choice}");
+    assert!(choice.chosen().extras.is_empty(), "{choice}");
+    assert!(
+        choice.scores.len() > dyngen_identify::choice::CANDIDATES.len(),
+        "the extra terms were tried: {choice}"
+    );
     let applied = choice.apply(&IdentifyOptions::default());
     assert_eq!(applied.joints, choice.chosen().joints);
     // Too short a recording for the blocks, and another mode.
     let short = traj.select(|k| k < 2 * BLOCKS - 1).unwrap();
-    let e = choose(&robot, &short, &IdentifyOptions::default()).unwrap_err();
+    let e = choose(&robot, &short, &IdentifyOptions::default(), ExtraTerms::NONE).unwrap_err();
     assert!(
         e.to_string()
             .contains("at least 2 samples in each of its 4 time blocks"),
@@ -559,6 +565,6 @@ fn the_chosen_joint_model_has_what_the_joints_have() {
         mode: pipeline::Mode::Principal,
         ..IdentifyOptions::default()
     };
-    let e = choose(&robot, &traj, &principal).unwrap_err();
+    let e = choose(&robot, &traj, &principal, ExtraTerms::NONE).unwrap_err();
     assert!(e.to_string().contains("standard mode"), "{e}");
 }

@@ -5,6 +5,7 @@
 mod common;
 
 mod data;
+mod extras;
 mod identify;
 mod joint_friction;
 mod mujoco;

@@ -6,6 +6,7 @@
 //! 3.58 % overall relative torque error on the validation file).
 
 use dyngen_identify::data::{Recipe, Trajectory};
+use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::faer::Mat;
 use dyngen_identify::mim::TorqueRegressor;
 use dyngen_identify::validate::Validation;
@@ -60,7 +61,10 @@ fn mujoco_recordings_are_predicted_better_than_the_baseline() {
     let mut results = Vec::new();
     for (label, regressor) in [
         ("rigid bodies only", TorqueRegressor::Standard),
-        ("with friction, sign", TorqueRegressor::StandardAndJoints(Coulomb::Sign)),
+        (
+            "with friction, sign",
+            TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE),
+        ),
     ] {
         let est = fit(&robot, &identify, regressor);
         let v = validate(&robot, &check, regressor, &est);
@@ -72,12 +76,12 @@ fn mujoco_recordings_are_predicted_better_than_the_baseline() {
         fit(
             &robot,
             &identify,
-            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }),
+            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, ExtraTerms::NONE),
         )
         .residuals
         .rms
     });
-    let chosen = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon: eps });
+    let chosen = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon: eps }, ExtraTerms::NONE);
     let v = validate(&robot, &check, chosen, &fit(&robot, &identify, chosen));
     println!("with friction, tanh(v / ε), ε = {eps:.4} chosen by the fit residual:\n{v}\n");
     results.push(("chosen smoothing", v.overall));

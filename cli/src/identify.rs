@@ -248,7 +248,7 @@ pub struct IdentifyArgs {
     /// and position-dependent Coulomb friction) and `load` (Coulomb friction growing
     /// with the transmitted torque, Fcl·|τ|·s(q̇)). With --friction best: the terms
     /// it may add (default asymmetric,ripple=2,load; `none` for none).
-    #[arg(long, value_name = "LIST", value_parser = parse_extra_terms)]
+    #[arg(long, value_name = "LIST", value_parser = crate::ranges::extra_terms)]
     pub extra_terms: Option<ExtraTerms>,
 
     /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
@@ -996,9 +996,4 @@ fn print_fit(estimate: &Estimate) -> Result<()> {
         estimate.n_params()
     );
     Ok(())
-}
-
-/// `--extra-terms`: the list [`ExtraTerms`] parses.
-fn parse_extra_terms(text: &str) -> std::result::Result<ExtraTerms, String> {
-    text.parse()
 }

@@ -208,6 +208,13 @@ pub const STRIDE: Count = Count { min: 1, max: 1_000_000 };
 /// One value for every joint, or one per joint, comma-separated, each within
 /// ±[`dyngen_identify::data::MAX_ABS_VALUE`] (what a recording may hold).
 pub fn per_joint(flag: &str, text: &str, n: usize) -> Result<Vec<f64>, crate::error::CliError> {
+    per_joint_sets(flag, text, n, 1)
+}
+
+/// One set of `per` values for every joint, or one set per joint (joint by joint),
+/// comma-separated, each within ±[`dyngen_identify::data::MAX_ABS_VALUE`]: `per·n`
+/// values in joint order.
+pub fn per_joint_sets(flag: &str, text: &str, n: usize, per: usize) -> Result<Vec<f64>, crate::error::CliError> {
     use crate::error::CliError;
     let limit = dyngen_identify::data::MAX_ABS_VALUE;
     let values: Vec<f64> = text
@@ -221,12 +228,22 @@ pub fn per_joint(flag: &str, text: &str, n: usize) -> Result<Vec<f64>, crate::er
         .collect::<Option<_>>()
         .ok_or_else(|| CliError::usage(format!("{flag}: `{text}` is not a list of numbers within ±{limit:e}")))?;
     match values.len() {
-        1 => Ok(vec![values[0]; n]),
-        k if k == n => Ok(values),
-        k => Err(CliError::usage(format!(
+        k if k == per => Ok(values.repeat(n)),
+        k if k == per * n => Ok(values),
+        k if per == 1 => Err(CliError::usage(format!(
             "{flag}: {k} values for {n} joints; give one for all joints or one per joint"
         ))),
+        k => Err(CliError::usage(format!(
+            "{flag}: {k} values for {n} joints; give {per} for all joints or {} ({per} per joint, joint by joint)",
+            per * n
+        ))),
     }
+}
+
+/// `--extra-terms`: the list [`ExtraTerms`](dyngen_identify::extras::ExtraTerms)
+/// parses.
+pub fn extra_terms(text: &str) -> Result<dyngen_identify::extras::ExtraTerms, String> {
+    text.parse()
 }
 
 #[cfg(test)]

@@ -4,9 +4,10 @@ use crate::common::{check_overwrite, load_moving_model, with_spinner, ModelArgs,
 use crate::error::CliError;
 use crate::ranges::per_joint;
 use dyngen_identify::data::{overwrite_csv, write_csv, DataError};
+use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::simulate::{
-    add_joint_terms, add_stribeck_terms, record, record_trajectory, regressor_condition, Criterion, ExcitationDesign,
-    Experiment, Logger, Motion, NoiseModel,
+    add_extra_terms, add_joint_terms, add_stribeck_terms, record, record_trajectory, regressor_condition, Criterion,
+    ExcitationDesign, Experiment, Logger, Motion, NoiseModel,
 };
 use dyngen_identify::stribeck::Stribeck;
 use dyngen_model::joint_params::Coulomb;
@@ -107,6 +108,18 @@ pub struct SimulateArgs {
     /// Torque offset F0 per joint: τ += F0.
     #[arg(long, value_name = "F0", allow_hyphen_values = true)]
     pub offset: Option<String>,
+
+    /// Joint terms past friction, with --extra-params: a comma-separated list of
+    /// `asymmetric` (Fva·|q̇|), `ripple=H` (per harmonic k: Ts_k·sin(kq) +
+    /// Tc_k·cos(kq) + (Fcs_k·sin(kq) + Fcc_k·cos(kq))·sign(q̇)) and `load`
+    /// (Fcl·|τ_rigid|·sign(q̇)), as `identify --extra-terms` fits them.
+    #[arg(long, value_name = "LIST", value_parser = crate::ranges::extra_terms, requires = "extra_params")]
+    pub extra_terms: Option<ExtraTerms>,
+
+    /// The --extra-terms' parameters in their order (Fva, Ts1, Tc1, Fcs1, Fcc1, …,
+    /// Fcl): one set for all joints, or one set per joint, joint by joint.
+    #[arg(long, value_name = "VALUES", allow_hyphen_values = true, requires = "extra_terms")]
+    pub extra_params: Option<String>,
 
     /// Write the recording as a robot's logger does: sampled every DT seconds with
     /// jittered steps, some rows duplicated or stale, columns t, q, v and tau (or
@@ -284,6 +297,21 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         column("--offset", &args.offset, 3)?,
     ];
     let joint_params: Vec<f64> = (0..n).flat_map(|j| [ia[j], fv[j], fc[j], f0[j]]).collect();
+    let extras = match (args.extra_terms, &args.extra_params) {
+        (Some(extras), Some(text)) => {
+            if extras.harmonics > 0 && model.nq() != n {
+                return Err(CliError::usage(format!(
+                    "--extra-terms: ripple harmonics are of each joint's one angle; `{}` has {} position and {n} \
+                     velocity coordinates",
+                    model.name,
+                    model.nq()
+                )));
+            }
+            let params = crate::ranges::per_joint_sets("--extra-params", text, n, extras.per_joint())?;
+            Some((extras, params))
+        }
+        _ => None,
+    };
     let stribeck = match (&args.static_friction, &args.stribeck_velocity) {
         (Some(fs), Some(vs)) => {
             let (fs, vs) = (
@@ -329,6 +357,10 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             regressor_condition(&robot, e, &times),
             times.len()
         );
+    }
+    // The load-dependent friction's load is the rigid-body torque: first.
+    if let Some((extras, params)) = &extras {
+        add_extra_terms(&mut clean, *extras, params, Coulomb::Sign).map_err(CliError::failed)?;
     }
     if joint_params.iter().any(|&x| x != 0.0) {
         add_joint_terms(&mut clean, &joint_params, Coulomb::Sign);

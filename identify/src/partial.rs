@@ -257,6 +257,14 @@ impl RowOptions {
                      partial does not keep; use --friction sign or smooth with partial factors",
                 ),
             };
+        if options.extras.load {
+            return refuse(
+                "extra-terms",
+                "load cannot be written as a partial factor: its rows take the load from the rigid-body parameters \
+                 of a fit on the same rows, refitted until they settle, which a partial does not keep; use the \
+                 other extra terms with partial factors",
+            );
+        }
         Ok(RowOptions {
             mode: mode.into(),
             friction: friction.into(),

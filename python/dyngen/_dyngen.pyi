@@ -31,6 +31,7 @@ def identify(
     method: str = "ols",
     friction: str = "none",
     epsilon: float = 0.01,
+    extra_terms: Optional[str] = None,
     ridge_lambda: float = 1e-6,
     cutoff: float = 10.0,
     raw_states: bool = False,
@@ -45,7 +46,10 @@ def identify(
     ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
     ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
     ``"stribeck-smooth"``, ``"best"`` (the model that predicts held-out time blocks
-    of the recording best; the errors in ``model_choice``). ``report``: write ``dyngen identify --report``'s SVG there
+    of the recording best; the errors in ``model_choice``). ``extra_terms``: joint
+    terms past friction (``"asymmetric"``, ``"ripple=H"``, ``"load"``, comma-separated)
+    with ``"sign"``, ``"smooth"`` or ``"auto"``; with ``"best"`` the terms it may add
+    (default ``"asymmetric,ripple=2,load"``, ``"none"`` for none). ``report``: write ``dyngen identify --report``'s SVG there
     (measured against predicted efforts per joint); an existing file raises
     ``FileExistsError`` unless ``overwrite``. Returns ``names``, ``values``, ``sigma``,
     ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,

@@ -145,25 +145,40 @@ def test_identifies_a_robot_with_mimic_joints(tmp_path):
 
 
 def test_best_friction_is_chosen_on_held_out_blocks(tmp_path):
-    """Joints with viscous and Coulomb friction and 1 % torque noise: the model chosen
-    has friction, and each candidate's held-out error is returned."""
+    """Joints with viscous, Coulomb and direction-dependent viscous friction and 1 %
+    torque noise: the model chosen has friction and the direction-dependent term,
+    and each candidate's held-out error is returned."""
     robot = dyngen.load(ROBOTS[0][1])
     rng = np.random.default_rng(7)
     path = tmp_path / "friction.csv"
-    write_sines(robot, robot.params, 1200, (0.3, 0.8), rng, path)
+    write_sines(robot, robot.params, 700, (0.3, 0.8), rng, path)
     data = np.loadtxt(path, delimiter=",", skiprows=1)
     n = robot.nv
     v, tau = data[:, 1 + n:1 + 2 * n], data[:, 1 + 3 * n:]
-    tau += 0.5 * v + 2.0 * np.sign(v)
+    tau += 0.5 * v + 2.0 * np.sign(v) + 0.4 * np.abs(v)
     tau += 0.01 * rng.standard_normal(tau.shape) * np.sqrt(np.mean(tau**2, axis=0))
     header = open(path).readline().strip()
     np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.17g")
-    result = dyngen.identify(ROBOTS[0][1], path, friction="best", raw_states=True)
+    base = {"none", "sign-no-rotor-inertia", "sign", "auto", "stribeck"}
+    # The one extra term the joints have is the one tried (the default tries three).
+    result = dyngen.identify(ROBOTS[0][1], path, friction="best", extra_terms="asymmetric", raw_states=True)
     choice = result["model_choice"]
-    assert set(choice["held_out"]) == {"none", "sign-no-rotor-inertia", "sign", "auto", "stribeck"}
+    assert base < set(choice["held_out"]), choice
+    assert "asymmetric" in choice["chosen"], choice
+    errors = choice["held_out"]
+    assert errors[choice["chosen"]] < min(errors[b] for b in base), choice
+    assert errors["none"] > 3 * errors["sign"], choice
+    # Without extra terms to try, the friction models alone.
+    result = dyngen.identify(ROBOTS[0][1], path, friction="best", extra_terms="none", raw_states=True)
+    choice = result["model_choice"]
+    assert set(choice["held_out"]) == base
     assert choice["chosen"] in ("sign-no-rotor-inertia", "sign", "auto", "stribeck"), choice
     errors = choice["held_out"]
     assert errors[choice["chosen"]] == min(e for e in errors.values() if e is not None)
-    assert errors["none"] > 3 * errors["sign"], choice
+    # The term named, and a list that does not parse.
+    result = dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="asymmetric", raw_states=True)
+    assert [name for name in result["names"] if name.startswith("Fva")] == [f"Fva{j}" for j in range(1, n + 1)]
+    with pytest.raises(ValueError, match=re.escape("identify: extra_terms `bogus`: term 1 `bogus` is unknown")):
+        dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="bogus")
     with pytest.raises(ValueError, match=re.escape("unknown friction `best`")):
         dyngen.identify_partial(ROBOTS[0][1], path, friction="best")

@@ -7,6 +7,7 @@ mod common;
 mod cli;
 mod drive_gains;
 mod exit_codes;
+mod extra_terms;
 mod hostile;
 mod identify_outputs;
 mod joint_terms;

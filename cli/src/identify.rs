@@ -34,6 +34,8 @@ Examples:
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction stribeck --validate run2.csv \\
       --urdf-out ur5-identified.urdf
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction best --validate run2.csv
+  dyngen identify robots/ur5/ur5.urdf run1.csv --friction auto \\
+      --extra-terms asymmetric,ripple=1,load --validate run2.csv
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --rotor-inertia no
   dyngen identify robots/ur5/ur5.urdf run1.csv --friction sign --partial run1.part
   dyngen identify robots/ur5/ur5.urdf --merge run1.part run2.part --method wls \\
@@ -51,10 +53,15 @@ squares from the linear fit, vs between 0.005 and 0.5 times the joint's speed ra
 the joint's error on held-out data of the recording (4 time blocks, each predicted
 by the fit on the others) by 1 % and stays physical (Fc, Fv not negative, Fs and vs
 determined); otherwise it falls back to sign friction, and one line per joint says
-which was kept and why. --friction best fits none, sign (without and with Ia),
-auto and stribeck on three of four time blocks of the recording, scores each on the
-block left out, prints the errors and identifies with the best. --validate predicts
-a second recording with the result.
+which was kept and why. --extra-terms asymmetric,ripple=2,load (any of them) adds
+per joint direction-dependent viscous friction Fva·|q̇|, harmonics of the joint angle
+(torque ripple and position-dependent Coulomb friction) and Coulomb friction growing
+with the links' load Fcl·|τ_rigid|·s(q̇), with --friction sign, smooth or auto.
+--friction best fits none, sign (without and with Ia), auto and stribeck on three of
+four time blocks of the recording, scores each on the block left out, adds extra
+terms to the best linear model one at a time while each lowers the held-out error by
+1 %, prints the errors and identifies with the best. --validate predicts a second
+recording with the result.
 --method consistent keeps every body physical and (with friction) Ia, Fv, Fc >= 0,
 with --friction stribeck too; --exclude-below SPEED leaves out a joint's rows where
 it moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
@@ -113,7 +120,7 @@ them all when that run's preprocessing sees the same rows (measured velocities a
 accelerations with --raw-states). Partials made for another robot or with other row
 options are refused, naming both files and the difference. What needs the rows
 themselves has no partial: --friction auto (use --friction smooth --epsilon E),
-stribeck, --mode mim; --svg and --validate with --merge (use `dyngen validate` on
+stribeck, --extra-terms load, --mode mim; --svg and --validate with --merge (use `dyngen validate` on
 the --params-json).";
 
 /// What is identified, from what.
@@ -201,7 +208,7 @@ pub struct IdentifyArgs {
     /// joint-torque rows, JSON schema dyngen-partial/1) to this file instead of
     /// identifying; with --merge, the merged partial (a reduce tree). Refused with
     /// the options that need the rows themselves: --friction auto, stribeck and
-    /// stribeck-smooth, --mode mim; and with those of the estimate (--method,
+    /// stribeck-smooth, --extra-terms load, --mode mim; and with those of the estimate (--method,
     /// --lambda, --params-json, --urdf-out, --svg, --validate, --truth-from-urdf),
     /// which belong to the run that merges.
     #[arg(long, value_name = "OUT")]
@@ -210,7 +217,7 @@ pub struct IdentifyArgs {
     /// Identify from these partial factors (written by --partial) instead of a
     /// recording: merged exactly, then solved with --method as one run on all
     /// their samples would. They must be of this robot and share the options that
-    /// shape the rows (mode, friction and ε, rotor inertia, accumulation,
+    /// shape the rows (mode, friction and ε, rotor inertia, extra terms, accumulation,
     /// exclude-below, cutoff, raw states, recipe), which are taken from them.
     #[arg(long, value_name = "PART", num_args = 1.., conflicts_with = "data")]
     pub merge: Vec<PathBuf>,

@@ -547,7 +547,7 @@ pub fn merge_all(parts: &[Partial], labels: &[String]) -> Result<Partial, String
         merged.merge(part).map_err(|e| match e {
             PartialError::Mismatch { what, ours, theirs } => format!(
                 "{} and {} were made for different {what}: {ours} against {theirs}; only partials of the same robot \
-                 with the same row options (mode, friction, rotor inertia, accumulation, exclude-below, cutoff, \
+                 with the same row options (mode, friction, rotor inertia, extra terms, accumulation, exclude-below, cutoff, \
                  raw states, recipe) merge",
                 label(0),
                 label(i + 1)

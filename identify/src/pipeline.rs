@@ -473,23 +473,9 @@ fn from_torques(
     let mut chosen_epsilon = None;
     let regressor = match options.joints {
         JointTerms::FrictionAuto if options.mode == Mode::Standard => {
-            let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
-            let mut failure = None;
-            let (epsilon, _) = crate::friction::best_epsilon(|epsilon| {
-                let r = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, options.extras);
-                match accumulate(dynamics, traj, r, stride, None, options)
-                    .and_then(|acc| Ok(acc.ols(&options.tolerances)?))
-                {
-                    Ok(e) => e.residuals.rms,
-                    Err(e) => {
-                        failure.get_or_insert(e);
-                        f64::INFINITY
-                    }
-                }
-            });
-            if let Some(e) = failure {
-                return Err(e);
-            }
+            let search = smoothing_fit(dynamics, traj, options)?;
+            let n = dynamics.nv();
+            let (epsilon, _) = crate::friction::best_epsilon(|epsilon| search.rms(&vec![epsilon; n]));
             chosen_epsilon = Some(epsilon);
             TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, options.extras)
         }
@@ -1011,6 +997,67 @@ fn accumulate(
     }
     Ok(merged)
 }
+
+/// The data of the Coulomb smoothing's search ([`crate::friction::SmoothingFit`]):
+/// the regressor rows of at most [`SMOOTHING_SAMPLES`] samples spread over `traj`
+/// (fewer where their rows would pass [`SMOOTHING_VALUES`] numbers), every Coulomb
+/// column at 0, with the columns held at 0 and the rows left out below a speed as
+/// `options` say. The load-dependent friction's column stays 0 (the search takes
+/// the fit without it).
+fn smoothing_fit(
+    dynamics: &dyn Dynamics,
+    traj: &Trajectory,
+    options: &IdentifyOptions,
+) -> Result<crate::friction::SmoothingFit, PipelineError> {
+    let model = dynamics.model();
+    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign, options.extras);
+    let (n, p) = (dynamics.nv(), regressor.columns(model));
+    let samples = SMOOTHING_SAMPLES.min(SMOOTHING_VALUES / (n * p).max(1)).max(1);
+    let stride = traj.len().div_ceil(samples).max(1);
+    let rigid = 10 * model.dof();
+    let mut zeroed = excluded_columns(regressor, model, fitted_joint_terms(options));
+    zeroed.extend((0..n).map(|j| rigid + PER_JOINT * j + 2));
+    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
+    let mut joints: Vec<crate::friction::JointRows> = (0..n)
+        .map(|_| crate::friction::JointRows {
+            rows: Vec::new(),
+            v: Vec::new(),
+            tau: Vec::new(),
+        })
+        .collect();
+    let mut y = vec![0.0; n * p];
+    let mut keep = vec![true; n];
+    for k in (0..traj.len()).step_by(stride) {
+        let (q, v, a) = state(traj, k);
+        let tau = traj.tau(k);
+        regressor.eval(dynamics, q, v, a, &mut y);
+        for row in y.chunks_exact_mut(p) {
+            for &c in &zeroed {
+                row[c] = 0.0;
+            }
+        }
+        if let Some(speed) = options.exclude_below {
+            for (keep, v) in keep.iter_mut().zip(v) {
+                *keep = v.abs() >= speed;
+            }
+        }
+        acc.push_rows_masked(faer::MatRef::from_row_major_slice(&y, n, p), tau, &keep)
+            .map_err(|error| PipelineError::Identify {
+                at: Some(traj.location(k)),
+                error,
+            })?;
+        for (j, joint) in joints.iter_mut().enumerate().filter(|(j, _)| keep[*j]) {
+            joint.rows.extend_from_slice(&y[j * p..(j + 1) * p]);
+            joint.v.push(v[j]);
+            joint.tau.push(tau[j]);
+        }
+    }
+    Ok(crate::friction::SmoothingFit::new(joints, &acc, &options.tolerances)?)
+}
+
+/// At most this many regressor entries are held for the Coulomb smoothing's search
+/// (16 M: 128 MB).
+const SMOOTHING_VALUES: usize = 1 << 24;
 
 /// Contiguous parts of the samples accumulated independently ([`accumulate`]).
 const PARTS: usize = 8;

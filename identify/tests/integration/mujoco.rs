@@ -81,6 +81,30 @@ fn mujoco_recordings_are_predicted_better_than_the_baseline() {
         .residuals
         .rms
     });
+    // The pipeline's search, which factors the columns that do not depend on ε once
+    // and never evaluates the regressor again, finds the same ε.
+    let auto = dyngen_identify::pipeline::identify(
+        &robot,
+        &identify,
+        &dyngen_identify::pipeline::IdentifyOptions {
+            joints: dyngen_identify::pipeline::JointTerms::FrictionAuto,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let searched = auto
+        .report
+        .prediction
+        .as_ref()
+        .unwrap()
+        .preprocessing
+        .as_ref()
+        .unwrap()
+        .coulomb_epsilon;
+    assert!(
+        (searched.unwrap() / eps - 1.0).abs() < 1e-6,
+        "{searched:?} against {eps}"
+    );
     let chosen = TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon: eps }, ExtraTerms::NONE);
     let v = validate(&robot, &check, chosen, &fit(&robot, &identify, chosen));
     println!("with friction, tanh(v / ε), ε = {eps:.4} chosen by the fit residual:\n{v}\n");

@@ -662,16 +662,18 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     }
     let identified = identified;
     if options.joints == JointTerms::FrictionAuto {
-        if let Some(epsilon) = identified
+        if let Some(epsilons) = identified
             .report
             .prediction
             .as_ref()
             .and_then(|p| p.preprocessing.as_ref())
-            .and_then(|p| p.coulomb_epsilon)
+            .and_then(|p| p.coulomb_epsilons.as_ref())
         {
+            let list: Vec<String> = epsilons.iter().map(|e| format!("{e:.4e}")).collect();
             outln!(
-                "--friction auto: Coulomb smoothing tanh(q̇/ε) with ε = {epsilon:.4e} rad/s (m/s for prismatic \
-                 joints), one ε for all joints, chosen by the fit residual"
+                "--friction auto: Coulomb smoothing tanh(q̇_j/ε_j) with ε per joint {} rad/s (m/s for prismatic \
+                 joints), chosen by the fit residual",
+                list.join(", ")
             );
         }
     }

@@ -200,9 +200,18 @@ fn reading(args: &ValidateArgs, params: &ParameterReport) -> Result<Reading> {
         said.push(format!("its training window ({window}) not applied"));
     }
     if let Some(f) = pre.and_then(|p| p.friction.as_deref()) {
-        let epsilon = match (pre.and_then(|p| p.coulomb_epsilon), pre.and_then(|p| p.epsilon_auto)) {
-            (Some(e), Some(true)) => format!(" (ε = {e:e} chosen by the fit)"),
-            (Some(e), _) => format!(" (ε = {e:e})"),
+        let per_joint = pre.and_then(|p| p.coulomb_epsilons.as_ref());
+        let epsilon = match (
+            pre.and_then(|p| p.coulomb_epsilon),
+            per_joint,
+            pre.and_then(|p| p.epsilon_auto),
+        ) {
+            (_, Some(e), _) => format!(
+                " (ε per joint {} chosen by the fit)",
+                e.iter().map(|e| format!("{e:e}")).collect::<Vec<_>>().join(", ")
+            ),
+            (Some(e), _, Some(true)) => format!(" (ε = {e:e} chosen by the fit)"),
+            (Some(e), _, _) => format!(" (ε = {e:e})"),
             _ => String::new(),
         };
         said.push(format!("friction {f}{epsilon}"));

@@ -11,8 +11,8 @@
 //! one at a time, forward selection: each round tries every term not yet in
 //! (direction-dependent viscous friction, one more ripple harmonic, load-dependent
 //! friction) and keeps the one that lowers the held-out error most, if it lowers it
-//! by at least [`MIN_GAIN`]. The fitted smoothing's ε is then each block's own, from
-//! the friction model's fit on the other blocks, so no held-out sample chooses it.
+//! by at least [`MIN_GAIN`]. The fitted smoothing's ε are searched again with the
+//! extra terms, on the training blocks only.
 
 use crate::accumulate::in_parallel;
 use crate::data::Trajectory;
@@ -206,9 +206,7 @@ pub fn choose(
         extras: ExtraTerms::NONE,
         ..options.clone()
     };
-    let jobs: Vec<Vec<IdentifyOptions>> = CANDIDATES.iter().map(|c| vec![c.options(&base); BLOCKS]).collect();
-    let (mut scores, epsilons): (Vec<Score>, Vec<Vec<Option<f64>>>) =
-        score(dynamics, &folds, &CANDIDATES, &jobs).into_iter().unzip();
+    let mut scores = score(dynamics, &folds, &CANDIDATES, &base);
     let best = |scores: &[Score], among: &dyn Fn(&Candidate) -> bool| {
         scores
             .iter()
@@ -241,23 +239,6 @@ pub fn choose(
     let mut chosen = overall;
     if let Some((start, mut error)) = best(&scores, &|c| c.linear()) {
         let friction = scores[start].candidate;
-        // Each block's fit: the friction model's smoothing from that block's fit.
-        let fold_options = |extras: ExtraTerms| -> Vec<IdentifyOptions> {
-            (0..BLOCKS)
-                .map(|b| {
-                    let joints = match (friction.joints, epsilons[start][b]) {
-                        (JointTerms::FrictionAuto, Some(epsilon)) => JointTerms::Friction(Coulomb::Smooth { epsilon }),
-                        (joints, _) => joints,
-                    };
-                    IdentifyOptions {
-                        joints,
-                        rotor_inertia: friction.rotor_inertia,
-                        extras,
-                        ..base.clone()
-                    }
-                })
-                .collect()
-        };
         let mut current = ExtraTerms::NONE;
         let mut kept = start;
         loop {
@@ -279,9 +260,8 @@ pub fn choose(
                 break;
             }
             let candidates: Vec<Candidate> = trials.iter().map(|&extras| Candidate { extras, ..friction }).collect();
-            let jobs: Vec<Vec<IdentifyOptions>> = trials.iter().map(|&e| fold_options(e)).collect();
             let first = scores.len();
-            scores.extend(score(dynamics, &folds, &candidates, &jobs).into_iter().map(|(s, _)| s));
+            scores.extend(score(dynamics, &folds, &candidates, &base));
             match best(&scores[first..], &|_| true) {
                 Some((i, e)) if e <= (1.0 - MIN_GAIN) * error => {
                     (kept, error, current) = (first + i, e, trials[i]);
@@ -296,44 +276,31 @@ pub fn choose(
     Ok(ModelChoice { scores, chosen })
 }
 
-/// Each candidate's held-out score from its per-block options (`jobs[c][b]`), with
-/// the smoothing ε each block's fit chose (`None` where it chose none). Every
+/// Each candidate's held-out score, the rest of the options `base`'s. Every
 /// (candidate, block) fit runs on its own core: the blocks of one candidate
 /// alternate between cores, so that the slow candidates are shared.
-fn score(
-    dynamics: &dyn Dynamics,
-    folds: &Folds,
-    candidates: &[Candidate],
-    jobs: &[Vec<IdentifyOptions>],
-) -> Vec<(Score, Vec<Option<f64>>)> {
+fn score(dynamics: &dyn Dynamics, folds: &Folds, candidates: &[Candidate], base: &IdentifyOptions) -> Vec<Score> {
     let names: Vec<String> = (1..=dynamics.nv()).map(|j| format!("joint {j}")).collect();
     let predictions = in_parallel(candidates.len() * BLOCKS, |job| {
-        let (c, b) = (job / BLOCKS, job % BLOCKS);
-        let (training, held) = &folds[b];
-        let fit = pipeline::identify(dynamics, training, &jobs[c][b]).map_err(|e| e.to_string())?;
-        let epsilon = fit
-            .report
-            .prediction
-            .as_ref()
-            .and_then(|p| p.preprocessing.as_ref())
-            .and_then(|p| p.coulomb_epsilon);
-        Ok((fit.predict(dynamics, held).map_err(|e| e.to_string())?, epsilon))
+        let (training, held) = &folds[job % BLOCKS];
+        let options = candidates[job / BLOCKS].options(base);
+        let fit = pipeline::identify(dynamics, training, &options).map_err(|e| e.to_string())?;
+        fit.predict(dynamics, held).map_err(|e| e.to_string())
     });
     candidates
         .iter()
         .zip(predictions.chunks(BLOCKS))
         .map(|(&candidate, blocks)| {
-            let epsilons = blocks.iter().map(|b| b.as_ref().ok().and_then(|(_, e)| *e)).collect();
             let held_out = blocks
                 .iter()
                 .cloned()
                 .collect::<Result<Vec<_>, String>>()
                 .and_then(|blocks| {
-                    let predicted: Vec<Vec<f64>> = blocks.into_iter().flat_map(|(p, _)| p).collect();
+                    let predicted: Vec<Vec<f64>> = blocks.into_iter().flatten().collect();
                     let measured = folds.iter().flat_map(|(_, held)| held.samples().map(|s| s.tau));
                     Validation::new(&names, measured, predicted.iter().map(Vec::as_slice)).map_err(|e| e.to_string())
                 });
-            (Score { candidate, held_out }, epsilons)
+            Score { candidate, held_out }
         })
         .collect()
 }

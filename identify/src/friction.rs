@@ -107,44 +107,41 @@ impl SmoothingFit {
         })
     }
 
-    /// The RMS residual of the fit with `Fc_j·tanh(q̇_j/ε_j)` (`epsilon`: one per
-    /// joint).
-    pub(crate) fn rms(&self, epsilon: &[f64]) -> f64 {
-        let (p, n, r) = (self.p, self.joints.len(), self.u.len());
-        let mut w = vec![0.0; r * n];
-        let mut cc = vec![0.0; n];
-        let mut f = vec![0.0; n];
+    /// Joint `j`'s Coulomb column `tanh(q̇_j/ε)` as the residual needs it.
+    fn column(&self, j: usize, epsilon: f64) -> Column {
+        let (p, joint) = (self.p, &self.joints[j]);
         let mut g = vec![0.0; p];
-        for (j, joint) in self.joints.iter().enumerate() {
-            g.fill(0.0);
-            let (mut tt, mut ty) = (0.0, 0.0);
-            for (k, row) in joint.rows.chunks_exact(p).enumerate() {
-                let t = (joint.v[k] / epsilon[j]).tanh();
-                for (g, a) in g.iter_mut().zip(row) {
-                    *g += t * a;
-                }
-                tt += t * t;
-                ty += t * joint.tau[k];
+        let (mut cc, mut f) = (0.0, 0.0);
+        for (k, row) in joint.rows.chunks_exact(p).enumerate() {
+            let t = (joint.v[k] / epsilon).tanh();
+            for (g, a) in g.iter_mut().zip(row) {
+                *g += t * a;
             }
-            cc[j] = tt;
-            f[j] = ty;
-            for k in 0..r {
-                w[k * n + j] = crate::dense::dot(&self.projector[k * p..(k + 1) * p], &g);
-            }
+            cc += t * t;
+            f += t * joint.tau[k];
         }
-        // S = diag(cc) − wᵀw, f −= wᵀu.
+        let w: Vec<f64> = self
+            .projector
+            .chunks_exact(p)
+            .map(|row| crate::dense::dot(row, &g))
+            .collect();
+        Column { w, cc, f }
+    }
+
+    /// The RMS residual with the Coulomb columns `columns` (one per joint).
+    fn rms_of(&self, columns: &[Column]) -> f64 {
+        let n = columns.len();
+        // S = diag(cᵀc) − wᵀw, f − wᵀu.
         let s = faer::Mat::from_fn(n, n, |i, j| {
-            let d = if i == j { cc[i] } else { 0.0 };
-            d - (0..r).map(|k| w[k * n + i] * w[k * n + j]).sum::<f64>()
+            let d = if i == j { columns[i].cc } else { 0.0 };
+            d - crate::dense::dot(&columns[i].w, &columns[j].w)
         });
-        for (j, f) in f.iter_mut().enumerate() {
-            *f -= (0..r).map(|k| w[k * n + j] * self.u[k]).sum::<f64>();
-        }
+        let f: Vec<f64> = columns.iter().map(|c| c.f - crate::dense::dot(&c.w, &self.u)).collect();
         let Ok(eigen) = s.self_adjoint_eigen(faer::Side::Lower) else {
             return f64::INFINITY;
         };
         let (values, vectors) = (eigen.S().column_vector(), eigen.U());
-        let scale = cc.iter().copied().fold(0.0, f64::max);
+        let scale = columns.iter().map(|c| c.cc).fold(0.0, f64::max);
         let mut explained = 0.0;
         for k in 0..n {
             if values[k] > 1e-12 * scale {
@@ -154,11 +151,106 @@ impl SmoothingFit {
         }
         ((self.rss0 - explained).max(0.0) / self.rows.max(1) as f64).sqrt()
     }
+
+    /// The RMS residual of the fit with `Fc_j·tanh(q̇_j/ε_j)` (`epsilon`: one per
+    /// joint).
+    pub(crate) fn rms(&self, epsilon: &[f64]) -> f64 {
+        let columns: Vec<Column> = (0..self.joints.len()).map(|j| self.column(j, epsilon[j])).collect();
+        self.rms_of(&columns)
+    }
+
+    /// One `ε` per joint, each within [`EPSILON_RANGE`], by the fit residual: the
+    /// best common `ε` first ([`best_epsilon`]), then each joint's in turn with the
+    /// others held, [`EPSILON_SWEEPS`] times over the joints. A joint's `ε` changes
+    /// only where it lowers the residual.
+    pub(crate) fn best_epsilons(&self) -> Vec<f64> {
+        let n = self.joints.len();
+        let (common, mut best) = best_epsilon(|e| self.rms(&vec![e; n]));
+        let mut epsilons = vec![common; n];
+        let mut columns: Vec<Column> = (0..n).map(|j| self.column(j, common)).collect();
+        for _ in 0..EPSILON_SWEEPS {
+            for j in 0..n {
+                let (e, r) = best_epsilon(|e| {
+                    let mut trial = columns.clone();
+                    trial[j] = self.column(j, e);
+                    self.rms_of(&trial)
+                });
+                if r < best {
+                    (epsilons[j], best) = (e, r);
+                    columns[j] = self.column(j, e);
+                }
+            }
+        }
+        epsilons
+    }
+}
+
+/// Sweeps over the joints of [`SmoothingFit::best_epsilons`].
+pub const EPSILON_SWEEPS: usize = 2;
+
+/// A Coulomb column's products: `w = Σ_r⁻¹V_rᵀA₀ᵀc`, `cᵀc`, `cᵀy`.
+#[derive(Clone)]
+struct Column {
+    w: Vec<f64>,
+    cc: f64,
+    f: f64,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The residual from the factored columns equals a direct least-squares fit of
+    /// every column, rank-deficient `A₀` included.
+    #[test]
+    fn the_factored_residual_is_that_of_the_direct_fit() {
+        use dyngen_model::sample::SplitMix64;
+        let (n, p, samples) = (3, 9, 200);
+        let mut rng = SplitMix64::new(4);
+        let mut joints: Vec<JointRows> = (0..n)
+            .map(|_| JointRows {
+                rows: Vec::new(),
+                v: Vec::new(),
+                tau: Vec::new(),
+            })
+            .collect();
+        let mut acc = crate::Accumulator::new(p);
+        // The Coulomb columns are 5, 6, 7 (one per joint); column 8 is column 0 +
+        // column 1.
+        let coulomb = |j: usize| 5 + j;
+        for _ in 0..samples {
+            for joint in joints.iter_mut() {
+                let mut row: Vec<f64> = (0..p).map(|_| rng.uniform(-1.0, 1.0)).collect();
+                for c in 5..8 {
+                    row[c] = 0.0;
+                }
+                row[8] = row[0] + row[1];
+                let v = rng.uniform(-0.3, 0.3);
+                let tau = row.iter().sum::<f64>() + 2.0 * (v / 0.05).tanh() + rng.uniform(-0.1, 0.1);
+                acc.push_row(&row, tau).unwrap();
+                joint.rows.extend_from_slice(&row);
+                joint.v.push(v);
+                joint.tau.push(tau);
+            }
+        }
+        let fit = SmoothingFit::new(joints, &acc, &crate::Options::default()).unwrap();
+        for epsilon in [[0.05, 0.05, 0.05], [0.01, 0.2, 0.05], [0.3, 0.002, 0.1]] {
+            let mut direct = crate::Accumulator::new(p);
+            for (j, joint) in fit.joints.iter().enumerate() {
+                for (k, row) in joint.rows.chunks_exact(p).enumerate() {
+                    let mut row = row.to_vec();
+                    row[coulomb(j)] = (joint.v[k] / epsilon[j]).tanh();
+                    direct.push_row(&row, joint.tau[k]).unwrap();
+                }
+            }
+            let direct = direct.ols(&crate::Options::default()).unwrap();
+            let rss = direct.residuals.sum_of_squares;
+            let factored = fit.rms(&epsilon).powi(2) * (n * samples) as f64;
+            assert!((factored / rss - 1.0).abs() < 1e-9, "{epsilon:?}: {factored} {rss}");
+        }
+        let best = fit.best_epsilons();
+        assert!(best.iter().all(|e| (e / 0.05 - 1.0).abs() < 0.2), "{best:?}");
+    }
 
     #[test]
     fn finds_the_minimum_of_a_smooth_residual() {

@@ -75,7 +75,7 @@ pub fn identify_gains(
     // solution and, through its per-joint Gram matrices, the alternation.
     let p = pa + n + 1;
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(n))?;
-    let regressor = TorqueRegressor::StandardAndJoints(coulomb, crate::extras::ExtraTerms::NONE);
+    let regressor = TorqueRegressor::StandardAndJoints(coulomb.into());
     let mut y = vec![0.0; n * pa];
     let mut row = Mat::<f64>::zeros(n, p);
     let mut rhs = vec![0.0; n];

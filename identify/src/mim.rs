@@ -59,6 +59,7 @@ use dyngen_reference::Dynamics;
 use nalgebra::DMatrix;
 use std::fmt;
 use std::ops::Range;
+use std::sync::Arc;
 
 /// Names of the four principal parameters of a body.
 pub use dyngen_model::names::PRINCIPAL as THETA_NAMES;
@@ -523,8 +524,56 @@ pub fn whole_robot(
 /// [`dyngen::Regressors::principal_base_regressor`] for `f64`.
 pub type RegressorFn = fn(&[f64], &[f64], &[f64], &mut [f64]);
 
+/// What the joints add to the rigid bodies' torques in
+/// [`TorqueRegressor::StandardAndJoints`]: the Coulomb model (with, for the
+/// smoothing, one `ε` per joint where `epsilons` gives them), and the extra terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointModel {
+    pub coulomb: Coulomb,
+    /// `ε` of `tanh(q̇_j/ε_j)` per joint, in place of the Coulomb model's (one
+    /// per velocity coordinate).
+    pub epsilons: Option<Arc<[f64]>>,
+    pub extras: ExtraTerms,
+}
+
+impl JointModel {
+    /// The same Coulomb model on every joint.
+    pub fn new(coulomb: Coulomb, extras: ExtraTerms) -> Self {
+        JointModel {
+            coulomb,
+            epsilons: None,
+            extras,
+        }
+    }
+
+    /// `Fc·tanh(q̇_j/ε_j)` with `epsilons[j]` on joint `j`.
+    pub fn per_joint(epsilons: &[f64], extras: ExtraTerms) -> Self {
+        JointModel {
+            coulomb: Coulomb::Smooth {
+                epsilon: epsilons.first().copied().unwrap_or(1.0),
+            },
+            epsilons: Some(epsilons.into()),
+            extras,
+        }
+    }
+
+    /// Joint `j`'s Coulomb model.
+    pub fn coulomb(&self, j: usize) -> Coulomb {
+        match &self.epsilons {
+            Some(e) => Coulomb::Smooth { epsilon: e[j] },
+            None => self.coulomb,
+        }
+    }
+}
+
+impl From<Coulomb> for JointModel {
+    fn from(coulomb: Coulomb) -> Self {
+        JointModel::new(coulomb, ExtraTerms::NONE)
+    }
+}
+
 /// The regressor a [`TorqueEstimate`] was computed with.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub enum TorqueRegressor {
     /// `Y` (`n × 10n`), standard parameters.
     Standard,
@@ -537,7 +586,7 @@ pub enum TorqueRegressor {
     /// ([`dyngen_model::joint_params`]): the model of a real robot's joint torques;
     /// then per joint the `e` columns of the extra terms ([`crate::extras`]), none
     /// with [`ExtraTerms::NONE`].
-    StandardAndJoints(Coulomb, ExtraTerms),
+    StandardAndJoints(JointModel),
 }
 
 impl fmt::Debug for TorqueRegressor {
@@ -546,8 +595,16 @@ impl fmt::Debug for TorqueRegressor {
             TorqueRegressor::Standard => write!(f, "Standard"),
             TorqueRegressor::Principal => write!(f, "Principal"),
             TorqueRegressor::PrincipalBase { columns, .. } => write!(f, "PrincipalBase({columns})"),
-            TorqueRegressor::StandardAndJoints(c, e) if e.is_empty() => write!(f, "StandardAndJoints({c:?})"),
-            TorqueRegressor::StandardAndJoints(c, e) => write!(f, "StandardAndJoints({c:?}, {e})"),
+            TorqueRegressor::StandardAndJoints(m) => {
+                match &m.epsilons {
+                    Some(e) => write!(f, "StandardAndJoints(tanh, ε {e:?}")?,
+                    None => write!(f, "StandardAndJoints({:?}", m.coulomb)?,
+                }
+                if !m.extras.is_empty() {
+                    write!(f, ", {}", m.extras)?;
+                }
+                write!(f, ")")
+            }
         }
     }
 }
@@ -563,7 +620,7 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => 10 * bodies,
             TorqueRegressor::Principal => 4 * bodies,
             TorqueRegressor::PrincipalBase { columns, .. } => *columns,
-            TorqueRegressor::StandardAndJoints(_, e) => 10 * bodies + (PER_JOINT + e.per_joint()) * nv,
+            TorqueRegressor::StandardAndJoints(m) => 10 * bodies + (PER_JOINT + m.extras.per_joint()) * nv,
         }
     }
 
@@ -575,7 +632,8 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => standard_param_names(bodies),
             TorqueRegressor::Principal => principal_param_names(bodies),
             TorqueRegressor::PrincipalBase { columns, .. } => (1..=*columns).map(|k| format!("β{k}")).collect(),
-            TorqueRegressor::StandardAndJoints(_, e) => {
+            TorqueRegressor::StandardAndJoints(m) => {
+                let e = m.extras;
                 let mut names = standard_param_names(bodies);
                 names.extend(dyngen_model::joint_params::joint_param_names(nv));
                 names.extend(e.names(nv));
@@ -624,7 +682,8 @@ impl TorqueRegressor {
                         .filter(|&i| model.supports(j, i))
                         .flat_map(|i| per_body * (i - 1)..per_body * i)
                         .collect();
-                    if let TorqueRegressor::StandardAndJoints(_, e) = self {
+                    if let TorqueRegressor::StandardAndJoints(m) = self {
+                        let e = m.extras;
                         let at = 10 * n + PER_JOINT * (j - 1);
                         cols.extend(at..at + PER_JOINT);
                         let (e, at) = (e.per_joint(), 10 * n + PER_JOINT * n + e.per_joint() * (j - 1));
@@ -643,7 +702,8 @@ impl TorqueRegressor {
             TorqueRegressor::Standard => dynamics.joint_torque_regressor(q, v, a, y),
             TorqueRegressor::Principal => dynamics.principal_regressor(q, v, a, y),
             TorqueRegressor::PrincipalBase { regressor, .. } => regressor(q, v, a, y),
-            TorqueRegressor::StandardAndJoints(coulomb, extras) => {
+            TorqueRegressor::StandardAndJoints(model) => {
+                let extras = model.extras;
                 let (n, rigid, e) = (v.len(), dynamics.nparams(), extras.per_joint());
                 let p = rigid + (PER_JOINT + e) * n;
                 // The rigid-body rows land packed at the front of `y`; each is then
@@ -654,10 +714,11 @@ impl TorqueRegressor {
                     y.copy_within(j * rigid..(j + 1) * rigid, j * p);
                     y[j * p + rigid..(j + 1) * p].fill(0.0);
                     let at = j * p + rigid + PER_JOINT * j;
-                    y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], *coulomb));
+                    let coulomb = model.coulomb(j);
+                    y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], coulomb));
                     if e > 0 {
                         let at = j * p + rigid + PER_JOINT * n + e * j;
-                        extras.row(q[j], v[j], 0.0, *coulomb, &mut y[at..at + e]);
+                        extras.row(q[j], v[j], 0.0, coulomb, &mut y[at..at + e]);
                     }
                 }
             }
@@ -669,15 +730,16 @@ impl TorqueRegressor {
     /// `rigid` (`10` per body): `|Y_j π|·s(q̇_j)` in row `j`. Nothing to do without
     /// that term.
     pub fn fill_load(&self, model: &Model, v: &[f64], rigid: &[f64], y: &mut [f64]) {
-        let TorqueRegressor::StandardAndJoints(coulomb, extras) = self else {
+        let TorqueRegressor::StandardAndJoints(joints) = self else {
             return;
         };
+        let extras = joints.extras;
         let Some(c) = extras.load_column() else { return };
         let (n, p, e, r) = (v.len(), self.columns(model), extras.per_joint(), 10 * model.dof());
         let first = r + PER_JOINT * n;
         for j in 0..n {
             let load = crate::dense::dot(&y[j * p..j * p + r], rigid);
-            y[j * p + first + e * j + c] = ExtraTerms::load_entry(load, v[j], *coulomb);
+            y[j * p + first + e * j + c] = ExtraTerms::load_entry(load, v[j], joints.coulomb(j));
         }
     }
 }

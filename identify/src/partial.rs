@@ -156,7 +156,7 @@ const SIGNATURE_TOLERANCE: f64 = 1e-9;
 
 impl RobotIdentity {
     /// The identity of `dynamics` with the columns of `regressor`.
-    fn of(dynamics: &dyn Dynamics, regressor: TorqueRegressor, parameters: Vec<String>) -> Self {
+    fn of(dynamics: &dyn Dynamics, regressor: &TorqueRegressor, parameters: Vec<String>) -> Self {
         let model = dynamics.model();
         let n = dynamics.nv();
         let [q, v, a] = signature_state(n);
@@ -382,7 +382,7 @@ impl Partial {
         let rows = RowOptions::of(options, recipe)?;
         let regressor = pipeline::torque_regressor(options);
         let names = regressor.names(dynamics.model());
-        let accumulator = pipeline::accumulate_recording(dynamics, traj, regressor, options)?
+        let accumulator = pipeline::accumulate_recording(dynamics, traj, &regressor, options)?
             .to_state()
             .map_err(PipelineError::from)?;
         if accumulator
@@ -396,7 +396,7 @@ impl Partial {
         }
         Ok(Partial {
             schema: PARTIAL_SCHEMA.into(),
-            robot: RobotIdentity::of(dynamics, regressor, names),
+            robot: RobotIdentity::of(dynamics, &regressor, names),
             rows,
             recordings: vec![span],
             accumulator,
@@ -490,9 +490,9 @@ impl Partial {
         options.check()?;
         let regressor = pipeline::torque_regressor(&options);
         let names = regressor.names(dynamics.model());
-        self.robot.compare(&RobotIdentity::of(dynamics, regressor, names))?;
+        self.robot.compare(&RobotIdentity::of(dynamics, &regressor, names))?;
         let acc = self.accumulator()?;
-        let mut identified = pipeline::from_accumulator(dynamics.model(), &acc, regressor, &options)?;
+        let mut identified = pipeline::from_accumulator(dynamics.model(), &acc, &regressor, &options)?;
         if let Some(pre) = identified
             .report
             .prediction

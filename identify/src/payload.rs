@@ -157,7 +157,7 @@ pub fn identify(
                 });
             }
             known.extend_from_slice(joint_params);
-            TorqueRegressor::StandardAndJoints(coulomb, crate::extras::ExtraTerms::NONE)
+            TorqueRegressor::StandardAndJoints(coulomb.into())
         }
     };
     let p = regressor.columns(robot.dynamics.model());

@@ -24,7 +24,7 @@
 
 use crate::data::{DataError, Loaded, Location, Recipe, RecipeError, Trajectory};
 use crate::extras::ExtraTerms;
-use crate::mim::{self, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
+use crate::mim::{self, JointModel, MimEstimate, MimOptions, TorqueEstimate, TorqueRegressor};
 use crate::report::{
     self, CoulombReport, JointParams, JointParamsFile, MergedLinks, NonPhysical, ParamReport, ParamStatus,
     ParameterReport, Parameterisation, PredictionModel, Preprocessing, ReportError, JOINT_PARAMS_SCHEMA,
@@ -470,19 +470,15 @@ fn from_torques(
     traj: &Trajectory,
     options: &IdentifyOptions,
 ) -> Result<Identification, PipelineError> {
-    let mut chosen_epsilon = None;
     let regressor = match options.joints {
         JointTerms::FrictionAuto if options.mode == Mode::Standard => {
-            let search = smoothing_fit(dynamics, traj, options)?;
-            let n = dynamics.nv();
-            let (epsilon, _) = crate::friction::best_epsilon(|epsilon| search.rms(&vec![epsilon; n]));
-            chosen_epsilon = Some(epsilon);
-            TorqueRegressor::StandardAndJoints(Coulomb::Smooth { epsilon }, options.extras)
+            let epsilons = smoothing_fit(dynamics, traj, options)?.best_epsilons();
+            TorqueRegressor::StandardAndJoints(JointModel::per_joint(&epsilons, options.extras))
         }
         _ => torque_regressor(options),
     };
-    let mut acc = accumulate(dynamics, traj, regressor, 1, None, options)?;
-    let fit = TorqueFit::new(dynamics.model(), regressor, options);
+    let mut acc = accumulate(dynamics, traj, &regressor, 1, None, options)?;
+    let fit = TorqueFit::new(dynamics.model(), regressor.clone(), options);
     let (mut estimate, mut warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
     if options.extras.load {
         // The load of each row from the rigid-body parameters of the fit before
@@ -490,7 +486,7 @@ fn from_torques(
         let rigid = 10 * dynamics.model().dof();
         for _ in 0..LOAD_ROUNDS {
             let previous = estimate.solution.clone();
-            acc = accumulate(dynamics, traj, regressor, 1, Some(&previous[..rigid]), options)?;
+            acc = accumulate(dynamics, traj, &regressor, 1, Some(&previous[..rigid]), options)?;
             (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
             let change = estimate
                 .solution
@@ -510,7 +506,7 @@ fn from_torques(
                 nonnegative: options.estimator == Estimator::Consistent,
             };
             let (estimate, stribeck) = crate::stribeck::refine(dynamics, traj, coulomb, constraints, estimate, |t| {
-                let acc = accumulate(dynamics, t, regressor, 1, None, options)?;
+                let acc = accumulate(dynamics, t, &regressor, 1, None, options)?;
                 Ok::<_, PipelineError>(fit.solve(&acc)?)
             })?;
             let finite = estimate.solution.iter().all(|x| x.is_finite())
@@ -525,27 +521,24 @@ fn from_torques(
         }
         _ => (estimate, None),
     };
-    Ok(fit.identification(
-        (estimate, warnings),
-        acc.excluded_per_channel(),
-        stribeck,
-        chosen_epsilon,
-    ))
+    Ok(fit.identification((estimate, warnings), acc.excluded_per_channel(), stribeck))
 }
 
 /// The regressor `options` ask for, but for [`JointTerms::FrictionAuto`], whose ε
-/// the data choose (it gets `Fc·sign(q̇)` here).
+/// the data choose per joint (it gets `Fc·sign(q̇)` here).
 pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
     match (options.mode, options.joints) {
         (Mode::Principal | Mode::Mim, _) => TorqueRegressor::Principal,
         (Mode::Standard, JointTerms::None) if options.rotor_inertia == Some(true) => {
-            TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE)
+            TorqueRegressor::StandardAndJoints(Coulomb::Sign.into())
         }
         (Mode::Standard, JointTerms::None) => TorqueRegressor::Standard,
         (Mode::Standard, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
-            TorqueRegressor::StandardAndJoints(coulomb, options.extras)
+            TorqueRegressor::StandardAndJoints(JointModel::new(coulomb, options.extras))
         }
-        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(Coulomb::Sign, options.extras),
+        (Mode::Standard, JointTerms::FrictionAuto) => {
+            TorqueRegressor::StandardAndJoints(JointModel::new(Coulomb::Sign, options.extras))
+        }
     }
 }
 
@@ -555,12 +548,12 @@ pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
 pub(crate) fn from_accumulator(
     model: &Model,
     acc: &Accumulator,
-    regressor: TorqueRegressor,
+    regressor: &TorqueRegressor,
     options: &IdentifyOptions,
 ) -> Result<Identification, PipelineError> {
-    let fit = TorqueFit::new(model, regressor, options);
+    let fit = TorqueFit::new(model, regressor.clone(), options);
     let first = fit.first(acc, || None)?;
-    Ok(fit.identification(first, acc.excluded_per_channel(), None, None))
+    Ok(fit.identification(first, acc.excluded_per_channel(), None))
 }
 
 /// The estimator and the report of an identification from joint torques, on a
@@ -587,7 +580,7 @@ impl<'a> TorqueFit<'a> {
             nominal.resize(regressor.columns(model), 0.0);
         }
         let fitted = fitted_joint_terms(options);
-        let excluded = excluded_columns(regressor, model, fitted);
+        let excluded = excluded_columns(&regressor, model, fitted);
         for &c in &excluded {
             // Ridge pulls a term left out toward 0, where it is held.
             nominal[c] = 0.0;
@@ -623,7 +616,7 @@ impl<'a> TorqueFit<'a> {
             Estimator::Consistent => {
                 let sopts = StandardOptions {
                     prior: Some(self.nominal.clone()),
-                    ..consistent_options(self.regressor, self.model, self.fitted)
+                    ..consistent_options(&self.regressor, self.model, self.fitted)
                 };
                 acc.standard_consistent(&sopts, opts)
             }
@@ -696,23 +689,25 @@ impl<'a> TorqueFit<'a> {
         (estimate, mut warnings): (crate::Estimate, Vec<String>),
         excluded_rows: Vec<usize>,
         stribeck: Option<StribeckFit>,
-        chosen_epsilon: Option<f64>,
     ) -> Identification {
-        let (model, regressor, options) = (self.model, self.regressor, self.options);
+        let (model, options) = (self.model, self.options);
+        let regressor = self.regressor.clone();
         let (bodies, n) = (model.dof(), model.nv());
         let names = regressor.names(model);
         let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
         // One joint per velocity coordinate (a joint that follows another has none).
         let joint_names: Vec<&str> = model.own_joints().map(|j| j.name.as_str()).collect();
-        let extras = match regressor {
-            TorqueRegressor::StandardAndJoints(_, e) => e,
-            _ => ExtraTerms::NONE,
+        let joint_model = match &regressor {
+            TorqueRegressor::StandardAndJoints(m) => Some(m),
+            _ => None,
         };
-        let (parameterisation, coulomb) = match regressor {
-            TorqueRegressor::Principal => (Parameterisation::Principal, None),
-            TorqueRegressor::StandardAndJoints(c, _) => (
+        let extras = joint_model.map_or(ExtraTerms::NONE, |m| m.extras);
+        let epsilons = joint_model.and_then(|m| m.epsilons.as_deref().map(<[f64]>::to_vec));
+        let (parameterisation, coulomb) = match (&regressor, joint_model) {
+            (TorqueRegressor::Principal, _) => (Parameterisation::Principal, None),
+            (_, Some(m)) => (
                 Parameterisation::StandardAndJoints,
-                Some(match c {
+                Some(match m.coulomb {
                     Coulomb::Sign => CoulombReport::Sign,
                     Coulomb::Smooth { epsilon } => CoulombReport::Tanh { epsilon },
                 }),
@@ -721,7 +716,7 @@ impl<'a> TorqueFit<'a> {
         };
         let mut report =
             ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
-        let nonphysical = match regressor {
+        let nonphysical = match &regressor {
             TorqueRegressor::StandardAndJoints(..) => {
                 let values: Vec<Option<f64>> = report.parameters[10 * bodies..10 * bodies + PER_JOINT * n]
                     .iter()
@@ -756,13 +751,14 @@ impl<'a> TorqueFit<'a> {
             JointTerms::None => (None, "none"),
             JointTerms::Friction(Coulomb::Sign) => (None, "sign"),
             JointTerms::Friction(Coulomb::Smooth { epsilon }) => (Some(epsilon), "smooth"),
-            JointTerms::FrictionAuto => (chosen_epsilon, "auto"),
+            JointTerms::FrictionAuto => (None, "auto"),
             JointTerms::Stribeck(Coulomb::Sign) => (None, "stribeck"),
             JointTerms::Stribeck(Coulomb::Smooth { epsilon }) => (Some(epsilon), "stribeck_smooth"),
         };
         report.prediction = Some(PredictionModel {
             regressor: parameterisation,
             coulomb,
+            epsilons: epsilons.clone(),
             extras,
             solution: estimate.solution.clone(),
             stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
@@ -771,9 +767,10 @@ impl<'a> TorqueFit<'a> {
                 low_pass_states: Some(options.low_pass_states),
                 friction: Some(friction.to_string()),
                 coulomb_epsilon,
+                coulomb_epsilons: epsilons,
                 epsilon_auto: Some(options.joints == JointTerms::FrictionAuto),
                 exclude_below: options.exclude_below,
-                rotor_inertia: matches!(regressor, TorqueRegressor::StandardAndJoints(..)).then_some(self.fitted[0]),
+                rotor_inertia: joint_model.is_some().then_some(self.fitted[0]),
                 ..Preprocessing::default()
             }),
             nonphysical,
@@ -860,7 +857,7 @@ pub fn fitted_joint_terms(options: &IdentifyOptions) -> [bool; PER_JOINT] {
 /// The columns of the joint terms `[Ia, Fv, Fc, F0]` (term `k` of each velocity
 /// coordinate) for which `pick(k)` holds, for `regressor`: after the 10 standard
 /// parameters per body, 4 per coordinate; none without joint terms.
-fn joint_term_columns(regressor: TorqueRegressor, model: &Model, pick: impl Fn(usize) -> bool) -> Vec<usize> {
+fn joint_term_columns(regressor: &TorqueRegressor, model: &Model, pick: impl Fn(usize) -> bool) -> Vec<usize> {
     if !matches!(regressor, TorqueRegressor::StandardAndJoints(..)) {
         return Vec::new();
     }
@@ -873,14 +870,14 @@ fn joint_term_columns(regressor: TorqueRegressor, model: &Model, pick: impl Fn(u
 }
 
 /// The columns of the joint terms held at 0 for `regressor`.
-fn excluded_columns(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> Vec<usize> {
+fn excluded_columns(regressor: &TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> Vec<usize> {
     joint_term_columns(regressor, model, |k| !fitted[k])
 }
 
 /// The standard-form consistent estimator's options for `regressor`: the body
 /// blocks first, then per coordinate `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0` (those
 /// fitted).
-fn consistent_options(regressor: TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> StandardOptions {
+fn consistent_options(regressor: &TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> StandardOptions {
     StandardOptions {
         layout: Some(Layout {
             first: 0,
@@ -897,7 +894,7 @@ fn consistent_options(regressor: TorqueRegressor, model: &Model, fitted: [bool; 
 pub(crate) fn accumulate_recording(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
-    regressor: TorqueRegressor,
+    regressor: &TorqueRegressor,
     options: &IdentifyOptions,
 ) -> Result<Accumulator, PipelineError> {
     if traj.dof() != dynamics.nv() {
@@ -916,7 +913,7 @@ pub(crate) fn accumulate_recording(
 fn accumulate(
     dynamics: &dyn Dynamics,
     traj: &Trajectory,
-    regressor: TorqueRegressor,
+    regressor: &TorqueRegressor,
     stride: usize,
     load: Option<&[f64]>,
     options: &IdentifyOptions,
@@ -1010,12 +1007,12 @@ fn smoothing_fit(
     options: &IdentifyOptions,
 ) -> Result<crate::friction::SmoothingFit, PipelineError> {
     let model = dynamics.model();
-    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign, options.extras);
+    let regressor = TorqueRegressor::StandardAndJoints(JointModel::new(Coulomb::Sign, options.extras));
     let (n, p) = (dynamics.nv(), regressor.columns(model));
     let samples = SMOOTHING_SAMPLES.min(SMOOTHING_VALUES / (n * p).max(1)).max(1);
     let stride = traj.len().div_ceil(samples).max(1);
     let rigid = 10 * model.dof();
-    let mut zeroed = excluded_columns(regressor, model, fitted_joint_terms(options));
+    let mut zeroed = excluded_columns(&regressor, model, fitted_joint_terms(options));
     zeroed.extend((0..n).map(|j| rigid + PER_JOINT * j + 2));
     let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
     let mut joints: Vec<crate::friction::JointRows> = (0..n)
@@ -1146,7 +1143,7 @@ pub fn predict_with(
     let regressor = match (prediction.regressor, prediction.coulomb) {
         (Parameterisation::Standard, None) => TorqueRegressor::Standard,
         (Parameterisation::Principal, None) => TorqueRegressor::Principal,
-        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(
+        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(JointModel::new(
             match c {
                 CoulombReport::Sign => Coulomb::Sign,
                 CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
@@ -1158,13 +1155,41 @@ pub fn predict_with(
                 }
             },
             prediction.extras,
-        ),
+        )),
         (r, c) => {
             return Err(PipelineError::InvalidOption {
                 option: "prediction",
                 reason: format!("a {r:?} regressor with Coulomb model {c:?} is not a model dyngen predicts with"),
             })
         }
+    };
+    let regressor = match (regressor, &prediction.epsilons) {
+        (TorqueRegressor::StandardAndJoints(m), Some(epsilons)) => {
+            if epsilons.len() != n {
+                return Err(PipelineError::InvalidOption {
+                    option: "prediction",
+                    reason: format!("{} Coulomb smoothings ε for {n} joints", epsilons.len()),
+                });
+            }
+            if let Some(j) = epsilons.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
+                return Err(PipelineError::InvalidOption {
+                    option: "prediction",
+                    reason: format!(
+                        "joint {}'s Coulomb smoothing must be positive, got {}",
+                        j + 1,
+                        epsilons[j]
+                    ),
+                });
+            }
+            TorqueRegressor::StandardAndJoints(JointModel::per_joint(epsilons, m.extras))
+        }
+        (_, Some(_)) => {
+            return Err(PipelineError::InvalidOption {
+                option: "prediction",
+                reason: "Coulomb smoothings per joint need the standard_and_joints regressor".into(),
+            })
+        }
+        (regressor, None) => regressor,
     };
     let p = regressor.columns(dynamics.model());
     if prediction.solution.len() != p {
@@ -1191,9 +1216,10 @@ pub fn predict_with(
             reason: "extra joint terms need the standard_and_joints regressor without Stribeck terms".into(),
         });
     }
-    let stribeck = match (&prediction.stribeck, regressor) {
+    let stribeck = match (&prediction.stribeck, &regressor) {
         (None, _) => None,
-        (Some(s), TorqueRegressor::StandardAndJoints(coulomb, _)) => {
+        (Some(s), TorqueRegressor::StandardAndJoints(m)) => {
+            let coulomb = m.coulomb;
             crate::stribeck::check(s, n).map_err(|e| PipelineError::InvalidOption {
                 option: "prediction",
                 reason: format!("stribeck: {e}"),
@@ -1450,6 +1476,7 @@ impl Identification {
                     name: joint.name.clone(),
                     in_urdf: in_urdf.contains(&joint.name.as_str()),
                     parameters,
+                    epsilon: prediction.epsilons.as_ref().map(|e| e[j]),
                 }
             })
             .collect();

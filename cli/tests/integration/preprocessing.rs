@@ -235,15 +235,22 @@ fn non_physical_joint_parameters_and_the_chosen_epsilon_are_reported() {
         "{err}"
     );
 
+    // One ε per joint, chosen by the fit, in the JSON (the prediction's and the
+    // preprocessing's) and printed.
     let Some(CoulombReport::Tanh { epsilon }) = prediction.coulomb else {
         panic!("{:?}", prediction.coulomb)
     };
+    let epsilons = prediction.epsilons.as_ref().unwrap();
+    assert_eq!(epsilons.len(), 6);
+    assert_eq!(epsilon, epsilons[0]);
     let pre = prediction.preprocessing.as_ref().unwrap();
-    assert_eq!(pre.coulomb_epsilon, Some(epsilon));
+    assert_eq!(pre.coulomb_epsilons.as_ref(), Some(epsilons));
+    assert_eq!(pre.coulomb_epsilon, None);
     assert_eq!(pre.epsilon_auto, Some(true));
     let said = line(&out, "--friction auto: ");
+    let list: Vec<String> = epsilons.iter().map(|e| format!("{e:.4e}")).collect();
     assert!(
-        said.contains(&format!("ε = {epsilon:.4e} rad/s")) && said.contains("one ε for all joints"),
+        said.contains(&format!("ε per joint {} rad/s", list.join(", "))),
         "{out}"
     );
 }

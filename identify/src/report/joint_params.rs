@@ -60,8 +60,13 @@ pub struct JointParams {
     pub name: String,
     /// `Fv` and `Fc` were written to the joint's `<dynamics>` in the URDF.
     pub in_urdf: bool,
-    /// `Ia, Fv, Fc, F0`, then `Fs, vs` with Stribeck friction.
+    /// `Ia, Fv, Fc, F0`, then `Fs, vs` with Stribeck friction, or the extra terms
+    /// (`Fva, Ts1, Tc1, Fcs1, Fcc1, …, Fcl`) with them.
     pub parameters: Vec<ParamReport>,
+    /// `ε` of this joint's `tanh(q̇/ε)` where the fit chose one per joint (`coulomb`
+    /// then has the first joint's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epsilon: Option<f64>,
 }
 
 impl JointParamsFile {

@@ -92,6 +92,10 @@ pub struct PredictionModel {
     /// For `standard_and_joints`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coulomb: Option<CoulombReport>,
+    /// For `standard_and_joints` with the smoothing chosen per joint: `ε_j` of
+    /// `tanh(q̇_j/ε_j)`, in place of `coulomb`'s one `ε`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epsilons: Option<Vec<f64>>,
     /// For `standard_and_joints`: the joint terms past friction, whose parameters
     /// follow the `[Ia, Fv, Fc, F0]` of every joint in the solution
     /// ([`crate::extras`]).
@@ -137,9 +141,11 @@ pub struct Preprocessing {
     pub gravity: Option<[f64; 3]>,
     /// `none`, `sign`, `smooth`, `auto`, `stribeck` or `stribeck_smooth`.
     pub friction: Option<String>,
-    /// ε of the Coulomb smoothing `tanh(q̇/ε)` (rad/s), when smoothed.
+    /// ε of the Coulomb smoothing `tanh(q̇/ε)` (rad/s), when smoothed with one ε.
     pub coulomb_epsilon: Option<f64>,
-    /// `true` when ε was chosen by the fit (one for all joints).
+    /// ε of `tanh(q̇_j/ε_j)` per joint, when the fit chose them (`auto`).
+    pub coulomb_epsilons: Option<Vec<f64>>,
+    /// `true` when ε was chosen by the fit (one per joint).
     pub epsilon_auto: Option<bool>,
     /// Rows of a joint slower than this (rad/s) left out of the fit.
     pub exclude_below: Option<f64>,

@@ -53,7 +53,7 @@ fn noise_free_identification_recovers_friction_and_rotor_inertia() {
         &robot,
         &rec,
         0..rec.len(),
-        TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE),
+        TorqueRegressor::StandardAndJoints(Coulomb::Sign.into()),
         None,
         Weighting::Ols,
         &Options::default(),
@@ -113,7 +113,7 @@ fn identification_through_a_real_looking_log_meets_its_targets() {
     let sigma = add_torque_noise(&mut rec, &mut noise);
     let loaded = read_log(&logger.write(&rec), Some("14,13,12,9,8.5,8"));
     let traj = &loaded;
-    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign, ExtraTerms::NONE);
+    let regressor = TorqueRegressor::StandardAndJoints(Coulomb::Sign.into());
     let p = regressor.columns(robot.model());
     let mut acc = Accumulator::with_channels(p, Channels::Interleaved(6)).unwrap();
     let mut y = vec![0.0; 6 * p];

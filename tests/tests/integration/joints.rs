@@ -59,7 +59,7 @@ fn check<R: Robot>(seed: u64) -> [f64; 7] {
 
         let mut tau = vec![0.0; n];
         R::rnea_joints(q, v, a, &params, &jp, coulomb, &mut tau);
-        let widened = TorqueRegressor::StandardAndJoints(model_coulomb, dyngen_identify::extras::ExtraTerms::NONE);
+        let widened = TorqueRegressor::StandardAndJoints(model_coulomb.into());
         let mut y_ref = vec![0.0; n * w];
         let want = widened.predict(&reference, q, v, a, &x, &mut y_ref);
         let e = rel_err(&tau, &want, 1e-9);

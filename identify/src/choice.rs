@@ -26,6 +26,10 @@ use std::fmt;
 /// Time blocks of the cross-validation.
 pub const BLOCKS: usize = 4;
 
+/// The choice is made on at most this many samples, spread evenly over the
+/// recording (the identification that follows uses all of them).
+pub const CHOICE_SAMPLES: usize = 20_000;
+
 /// The relative drop of the held-out error an extra term must bring to be kept.
 pub const MIN_GAIN: f64 = 0.01;
 
@@ -185,6 +189,20 @@ pub fn choose(
             reason: "chooses the joint model of the standard mode".into(),
         });
     }
+    // At most CHOICE_SAMPLES samples, spread over the recording.
+    let stride = traj.len().div_ceil(CHOICE_SAMPLES).max(1);
+    let sampled;
+    let traj = if stride > 1 {
+        sampled = traj
+            .select(|k| k % stride == 0)
+            .map_err(|e| PipelineError::InvalidOption {
+                option: "friction",
+                reason: e.to_string(),
+            })?;
+        &sampled
+    } else {
+        traj
+    };
     let len = traj.len();
     let block = |k: usize| k * BLOCKS / len;
     let folds: Folds = (0..BLOCKS)

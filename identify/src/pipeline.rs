@@ -482,12 +482,14 @@ fn from_torques(
     let (mut estimate, mut warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
     if options.extras.load {
         // The load of each row from the rigid-body parameters of the fit before
-        // (the first fit has no load term), until the load coefficients settle.
+        // (the first fit has no load term), until the parameters settle: on at most
+        // SMOOTHING_SAMPLES samples spread over the recording, then once on all.
         let rigid = 10 * dynamics.model().dof();
+        let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
         for _ in 0..LOAD_ROUNDS {
             let previous = estimate.solution.clone();
-            acc = accumulate(dynamics, traj, &regressor, 1, Some(&previous[..rigid]), options)?;
-            (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
+            let sampled = accumulate(dynamics, traj, &regressor, stride, Some(&previous[..rigid]), options)?;
+            (estimate, _) = fit.first(&sampled, || Some(largest_input(traj)))?;
             let change = estimate
                 .solution
                 .iter()
@@ -498,6 +500,15 @@ fn from_torques(
                 break;
             }
         }
+        acc = accumulate(
+            dynamics,
+            traj,
+            &regressor,
+            1,
+            Some(&estimate.solution[..rigid]),
+            options,
+        )?;
+        (estimate, warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
     }
     let (estimate, stribeck) = match options.joints {
         JointTerms::Stribeck(coulomb) if options.mode == Mode::Standard => {
@@ -690,8 +701,7 @@ impl<'a> TorqueFit<'a> {
         excluded_rows: Vec<usize>,
         stribeck: Option<StribeckFit>,
     ) -> Identification {
-        let (model, options) = (self.model, self.options);
-        let regressor = self.regressor.clone();
+        let (model, options, regressor) = (self.model, self.options, self.regressor);
         let (bodies, n) = (model.dof(), model.nv());
         let names = regressor.names(model);
         let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();

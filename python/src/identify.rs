@@ -166,9 +166,9 @@ impl Choices<'_> {
 ///     `validate` a dict `validation`: `samples`, `joint_names`, per joint `rms`
 ///     (of the prediction error), `measured_rms`, `relative` (‖τ̂ − τ‖ / ‖τ‖), and
 ///     `overall` (over every joint and sample); with `friction="best"` a dict
-///     `model_choice`: `chosen` (the candidate's label: `"auto + asymmetric,load"`, say) and `held_out` (each
-///     candidate's overall relative error on the held-out blocks, None where it
-///     could not be fitted).
+///     `model_choice`: `chosen` (the candidate's label: `"auto + asymmetric,load"`,
+///     say) and `held_out` (each candidate's overall relative error on the held-out
+///     blocks, None where it could not be fitted).
 ///
 /// Raises:
 ///     LoadError: the robot does not load.

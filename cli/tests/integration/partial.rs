@@ -144,6 +144,87 @@ fn merged_partials_of_pieces_identify_as_the_whole_file() {
     }
 }
 
+/// The extra joint terms (but the load term, which needs a fit of the rows) go
+/// through partial factors: the merge equals the one-file identification, and the
+/// merged parameters predict with the terms.
+#[test]
+fn partials_carry_the_extra_joint_terms() {
+    let dir = temp_dir("dyngen-cli", "partial-extras");
+    let flags = [
+        "--coulomb",
+        "2",
+        "--damping",
+        "1",
+        "--extra-terms",
+        "asymmetric",
+        "--extra-params",
+        "0.5",
+    ];
+    let csv = simulate_ur5(&dir, 400, &[&flags[..], &["--noise", "0.01"]].concat());
+    let pieces = split(&csv, &dir, &[150]);
+    let model = [
+        "--raw-states",
+        "--friction",
+        "sign",
+        "--extra-terms",
+        "asymmetric,ripple=1",
+    ];
+    let robot = ur5();
+    let robot = robot.to_str().unwrap();
+    let one = dir.join("one.json");
+    let args = [
+        &["identify", robot, csv.to_str().unwrap()][..],
+        &model,
+        &["--params-json", one.to_str().unwrap()],
+    ]
+    .concat();
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+    assert_ok(&common::dyngen(&args));
+    let parts: Vec<PathBuf> = pieces
+        .iter()
+        .enumerate()
+        .map(|(i, piece)| {
+            let part = dir.join(format!("{i}.part"));
+            let args = [
+                &["identify", robot, piece.to_str().unwrap()][..],
+                &model,
+                &["--partial", part.to_str().unwrap()],
+            ]
+            .concat();
+            let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+            assert_ok(&common::dyngen(&args));
+            part
+        })
+        .collect();
+    let merged = dir.join("merged.json");
+    assert_ok(&run!(
+        "identify",
+        ur5(),
+        "--merge",
+        &parts[0],
+        &parts[1],
+        "--params-json",
+        &merged
+    ));
+    let diff = max_difference(&merged, &one);
+    assert!(diff <= 1e-12, "{diff:e}");
+    let extras = ParameterReport::read(&merged).unwrap().prediction.unwrap().extras;
+    assert_eq!(extras.to_string(), "asymmetric,ripple=1");
+    // Another list on the command line than the partials'.
+    assert_error(
+        &run!(
+            "identify",
+            ur5(),
+            "--merge",
+            &parts[0],
+            &parts[1],
+            "--extra-terms",
+            "asymmetric"
+        ),
+        "--extra-terms: the partials were made with asymmetric,ripple=1, the command line gives asymmetric",
+    );
+}
+
 #[test]
 fn partials_that_do_not_merge_are_refused_naming_both_files() {
     let dir = temp_dir("dyngen-cli", "partial-mismatch");

@@ -253,7 +253,7 @@ pub struct IdentifyArgs {
     /// or auto: a comma-separated list of `asymmetric` (direction-dependent viscous
     /// friction Fva·|q̇|), `ripple=H` (H harmonics of the joint angle: torque ripple
     /// and position-dependent Coulomb friction) and `load` (Coulomb friction growing
-    /// with the transmitted torque, Fcl·|τ|·s(q̇)). With --friction best: the terms
+    /// with the links' load, Fcl·|τ_rigid|·s(q̇)). With --friction best: the terms
     /// it may add (default asymmetric,ripple=2,load; `none` for none).
     #[arg(long, value_name = "LIST", value_parser = crate::ranges::extra_terms)]
     pub extra_terms: Option<ExtraTerms>,

@@ -53,7 +53,7 @@ pub struct ExtraTerms {
     /// Harmonics of the joint angle, `k = 1..=harmonics`: torque ripple and
     /// position-dependent Coulomb friction, 4 columns each.
     pub harmonics: u8,
-    /// Load-dependent Coulomb friction `Fcl·|τ|·s(q̇)`.
+    /// Load-dependent Coulomb friction `Fcl·|τ_rigid|·s(q̇)`, `τ_rigid` the links' load.
     pub load: bool,
 }
 

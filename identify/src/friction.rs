@@ -185,7 +185,7 @@ impl SmoothingFit {
     }
 }
 
-/// Sweeps over the joints of [`SmoothingFit::best_epsilons`].
+/// Sweeps over the joints of the per-joint `ε` search (`auto` friction).
 pub const EPSILON_SWEEPS: usize = 2;
 
 /// A Coulomb column's products: `w = Σ_r⁻¹V_rᵀA₀ᵀc`, `cᵀc`, `cᵀy`.

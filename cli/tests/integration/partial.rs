@@ -169,30 +169,22 @@ fn partials_carry_the_extra_joint_terms() {
         "--extra-terms",
         "asymmetric,ripple=1",
     ];
-    let robot = ur5();
-    let robot = robot.to_str().unwrap();
+    let ur5_path = ur5();
+    // `identify DATA <model> FLAG OUT`.
+    let identify = |data: &Path, flag: &str, out: &Path| {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["identify".as_ref(), ur5_path.as_os_str(), data.as_os_str()];
+        args.extend(model.iter().map(std::ffi::OsStr::new));
+        args.extend([std::ffi::OsStr::new(flag), out.as_os_str()]);
+        assert_ok(&common::dyngen(&args));
+    };
     let one = dir.join("one.json");
-    let args = [
-        &["identify", robot, csv.to_str().unwrap()][..],
-        &model,
-        &["--params-json", one.to_str().unwrap()],
-    ]
-    .concat();
-    let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
-    assert_ok(&common::dyngen(&args));
+    identify(&csv, "--params-json", &one);
     let parts: Vec<PathBuf> = pieces
         .iter()
         .enumerate()
         .map(|(i, piece)| {
             let part = dir.join(format!("{i}.part"));
-            let args = [
-                &["identify", robot, piece.to_str().unwrap()][..],
-                &model,
-                &["--partial", part.to_str().unwrap()],
-            ]
-            .concat();
-            let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
-            assert_ok(&common::dyngen(&args));
+            identify(piece, "--partial", &part);
             part
         })
         .collect();

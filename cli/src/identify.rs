@@ -55,8 +55,9 @@ by the fit on the others) by 1 % and stays physical (Fc, Fv not negative, Fs and
 determined); otherwise it falls back to sign friction, and one line per joint says
 which was kept and why. --extra-terms asymmetric,ripple=2,load (any of them) adds
 per joint direction-dependent viscous friction Fva·|q̇|, harmonics of the joint angle
-(torque ripple and position-dependent Coulomb friction) and Coulomb friction growing
-with the links' load Fcl·|τ_rigid|·s(q̇), with --friction sign, smooth or auto.
+(torque ripple and position-dependent Coulomb friction), harmonics of the motor angle
+(motor-ripple=H, with --gear-ratios) and Coulomb friction growing with the links'
+load Fcl·|τ_rigid|·s(q̇), with --friction sign, smooth or auto.
 --friction best fits none, sign (without and with Ia), auto and stribeck on three of
 four time blocks of the recording, scores each on the block left out, adds extra
 terms to the best linear model one at a time while each lowers the held-out error by
@@ -252,11 +253,18 @@ pub struct IdentifyArgs {
     /// Joint terms past viscous and Coulomb friction, with --friction sign, smooth
     /// or auto: a comma-separated list of `asymmetric` (direction-dependent viscous
     /// friction Fva·|q̇|), `ripple=H` (H harmonics of the joint angle: torque ripple
-    /// and position-dependent Coulomb friction) and `load` (Coulomb friction growing
+    /// and position-dependent Coulomb friction), `motor-ripple=H` (H harmonics of the
+    /// motor angle, with --gear-ratios) and `load` (Coulomb friction growing
     /// with the links' load, Fcl·|τ_rigid|·s(q̇)). With --friction best: the terms
     /// it may add (default asymmetric,ripple=2,load; `none` for none).
     #[arg(long, value_name = "LIST", value_parser = crate::ranges::extra_terms)]
     pub extra_terms: Option<ExtraTerms>,
+
+    /// Each joint's gear ratio N (one for all joints or one per joint), for
+    /// --extra-terms motor-ripple=H: harmonics of the motor angle N·q, the ripple of
+    /// cogging and gears, which repeats many times per joint turn.
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub gear_ratios: Option<String>,
 
     /// --friction smooth and stribeck-smooth: ε of Fc·tanh(q̇/ε), rad/s (m/s for
     /// prismatic joints), 0 < ε ≤ 1000.
@@ -593,13 +601,18 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         .data
         .as_deref()
         .ok_or_else(|| CliError::usage("give the recording DATA, or --merge PART…"))?;
-    let options = args.options();
-    options.check().map_err(|e| pipeline_error(data, e))?;
+    let mut options = args.options();
     check_outputs(args)?;
     let model = load_moving_model(&args.urdf, &args.recording.gravity)?;
     // The recording's joints: one per velocity coordinate (a joint that follows
     // another has none).
     let n = model.nv();
+    options.gear_ratios = args
+        .gear_ratios
+        .as_deref()
+        .map(|text| crate::ranges::per_joint("--gear-ratios", text, n))
+        .transpose()?;
+    options.check().map_err(|e| pipeline_error(data, e))?;
     let recipe = args.recording.recipe.recipe()?;
     // Drive gains first: the recordings are then read as torques, with them.
     let recipe = match &args.drive.drive_gains {

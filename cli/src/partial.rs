@@ -31,6 +31,14 @@ fn check_flags(args: &IdentifyArgs) -> Result<()> {
     if args.svg.is_some() {
         refused.push(("--svg", format!("it plots the recording's torques: {needs_samples}")));
     }
+    if args.gear_ratios.is_some() {
+        refused.push((
+            "--gear-ratios",
+            "it serves --extra-terms motor-ripple, which partial factors cannot carry (a partial does not keep the \
+             gear ratios); identify from one recording"
+                .into(),
+        ));
+    }
     if writing {
         let no_estimate = |what: &str| format!("it {what}, which --partial does not make; {to_merge_run}");
         if args.method.is_some() {

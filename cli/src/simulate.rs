@@ -121,6 +121,12 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "VALUES", allow_hyphen_values = true, requires = "extra_terms")]
     pub extra_params: Option<String>,
 
+    /// Each joint's gear ratio N (one for all joints or one per joint), for
+    /// --extra-terms motor-ripple=H (harmonics of the motor angle N·q: Tms·sin(mNq) +
+    /// Tmc·cos(mNq)).
+    #[arg(long, value_name = "N", allow_hyphen_values = true, requires = "extra_terms")]
+    pub gear_ratios: Option<String>,
+
     /// Write the recording as a robot's logger does: sampled every DT seconds with
     /// jittered steps, some rows duplicated or stale, columns t, q, v and tau (or
     /// motor currents with --current-gains); no accelerations or wrenches. The
@@ -299,7 +305,7 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     let joint_params: Vec<f64> = (0..n).flat_map(|j| [ia[j], fv[j], fc[j], f0[j]]).collect();
     let extras = match (args.extra_terms, &args.extra_params) {
         (Some(extras), Some(text)) => {
-            if extras.harmonics > 0 && model.nq() != n {
+            if (extras.harmonics > 0 || extras.motor_harmonics > 0) && model.nq() != n {
                 return Err(CliError::usage(format!(
                     "--extra-terms: ripple harmonics are of each joint's one angle; `{}` has {} position and {n} \
                      velocity coordinates",
@@ -308,7 +314,17 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
                 )));
             }
             let params = crate::ranges::per_joint_sets("--extra-params", text, n, extras.per_joint())?;
-            Some((extras, params))
+            let ratios = args
+                .gear_ratios
+                .as_deref()
+                .map(|t| per_joint("--gear-ratios", t, n))
+                .transpose()?;
+            if extras.motor_harmonics > 0 && ratios.is_none() {
+                return Err(CliError::usage(
+                    "--extra-terms motor-ripple needs each joint's gear ratio: give --gear-ratios",
+                ));
+            }
+            Some((extras, params, ratios))
         }
         _ => None,
     };
@@ -359,8 +375,8 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
         );
     }
     // The load-dependent friction's load is the rigid-body torque: first.
-    if let Some((extras, params)) = &extras {
-        add_extra_terms(&mut clean, *extras, params, Coulomb::Sign).map_err(CliError::failed)?;
+    if let Some((extras, params, ratios)) = &extras {
+        add_extra_terms(&mut clean, *extras, params, Coulomb::Sign, ratios.as_deref()).map_err(CliError::failed)?;
     }
     if joint_params.iter().any(|&x| x != 0.0) {
         add_joint_terms(&mut clean, &joint_params, Coulomb::Sign);

@@ -9,8 +9,9 @@
 //! Then the extra joint terms ([`crate::extras`]) are added to the best linear
 //! friction model (sign, with or without rotor inertia, or the fitted smoothing)
 //! one at a time, forward selection: each round tries every term not yet in
-//! (direction-dependent viscous friction, one more ripple harmonic, load-dependent
-//! friction) and keeps the one that lowers the held-out error most, if it lowers it
+//! (direction-dependent viscous friction, one more ripple harmonic of the joint
+//! angle, one more of the motor angle where the gear ratios are given,
+//! load-dependent friction) and keeps the one that lowers the held-out error most, if it lowers it
 //! by at least [`MIN_GAIN`]. The fitted smoothing's ε are searched again with the
 //! extra terms, on the training blocks only.
 
@@ -38,6 +39,7 @@ pub const MIN_GAIN: f64 = 0.01;
 pub const DEFAULT_EXTRAS: ExtraTerms = ExtraTerms {
     asymmetric: true,
     harmonics: 2,
+    motor_harmonics: 0,
     load: true,
 };
 
@@ -267,6 +269,10 @@ pub fn choose(
                 }),
                 (current.harmonics < allowed.harmonics).then_some(ExtraTerms {
                     harmonics: current.harmonics + 1,
+                    ..current
+                }),
+                (current.motor_harmonics < allowed.motor_harmonics).then_some(ExtraTerms {
+                    motor_harmonics: current.motor_harmonics + 1,
                     ..current
                 }),
                 (allowed.load && !current.load).then_some(ExtraTerms { load: true, ..current }),

@@ -8,10 +8,13 @@
 //! τ_j += Fva_j·|q̇_j|                                    direction-dependent viscous friction
 //!      + Σ_k  Ts_k·sin(k q_j) + Tc_k·cos(k q_j)          torque ripple (position-dependent torque)
 //!      + Σ_k (Fcs_k·sin(k q_j) + Fcc_k·cos(k q_j))·s(q̇_j) position-dependent Coulomb friction
+//!      + Σ_m Tms_m·sin(m N_j q_j) + Tmc_m·cos(m N_j q_j)  ripple of the motor angle
 //!      + Fcl_j·|τ_j^rigid|·s(q̇_j)                       load-dependent Coulomb friction
 //! ```
 //!
-//! for `k = 1..=harmonics`, in this order. Direction-dependent *Coulomb* friction
+//! for `k = 1..=harmonics` and `m = 1..=motor_harmonics`, in this order; `N_j` is
+//! the joint's gear ratio (motor angle `N_j q_j`: cogging and gear ripple repeat
+//! many times per joint turn, so a joint that moves a little sweeps many periods). Direction-dependent *Coulomb* friction
 //! needs no new term: `Fc·s(q̇) + F0` is `Fc + F0` forward and `Fc − F0` backward.
 //! Likewise `Fv·q̇ + Fva·|q̇|` is `Fv + Fva` forward and `Fv − Fva` backward.
 //!
@@ -53,6 +56,9 @@ pub struct ExtraTerms {
     /// Harmonics of the joint angle, `k = 1..=harmonics`: torque ripple and
     /// position-dependent Coulomb friction, 4 columns each.
     pub harmonics: u8,
+    /// Harmonics of the motor angle (the joint angle times the gear ratio),
+    /// `m = 1..=motor_harmonics`: torque ripple, 2 columns each.
+    pub motor_harmonics: u8,
     /// Load-dependent Coulomb friction `Fcl·|τ_rigid|·s(q̇)`, `τ_rigid` the links' load.
     pub load: bool,
 }
@@ -65,6 +71,7 @@ impl ExtraTerms {
     pub const NONE: ExtraTerms = ExtraTerms {
         asymmetric: false,
         harmonics: 0,
+        motor_harmonics: 0,
         load: false,
     };
 
@@ -74,7 +81,10 @@ impl ExtraTerms {
 
     /// Columns per joint.
     pub fn per_joint(&self) -> usize {
-        usize::from(self.asymmetric) + 4 * usize::from(self.harmonics) + usize::from(self.load)
+        usize::from(self.asymmetric)
+            + 4 * usize::from(self.harmonics)
+            + 2 * usize::from(self.motor_harmonics)
+            + usize::from(self.load)
     }
 
     /// The load term's column within a joint's block.
@@ -82,7 +92,8 @@ impl ExtraTerms {
         self.load.then(|| self.per_joint() - 1)
     }
 
-    /// One joint's names, without the joint number: `Fva, Ts1, Tc1, Fcs1, Fcc1, …, Fcl`.
+    /// One joint's names, without the joint number: `Fva, Ts1, Tc1, Fcs1, Fcc1, …,
+    /// Tms1, Tmc1, …, Fcl`.
     fn joint_names(&self) -> Vec<String> {
         let mut names = Vec::with_capacity(self.per_joint());
         if self.asymmetric {
@@ -90,6 +101,9 @@ impl ExtraTerms {
         }
         for k in 1..=self.harmonics {
             names.extend(["Ts", "Tc", "Fcs", "Fcc"].map(|s| format!("{s}{k}")));
+        }
+        for m in 1..=self.motor_harmonics {
+            names.extend(["Tms", "Tmc"].map(|s| format!("{s}{m}")));
         }
         if self.load {
             names.push("Fcl".to_string());
@@ -106,10 +120,10 @@ impl ExtraTerms {
             .collect()
     }
 
-    /// One joint's regressor entries at position `q`, velocity `v`, with `load`
-    /// the load column's value ([`ExtraTerms::load_entry`]), into `out`
-    /// (`per_joint()` entries).
-    pub fn row(&self, q: f64, v: f64, load: f64, coulomb: Coulomb, out: &mut [f64]) {
+    /// One joint's regressor entries at position `q`, velocity `v` and motor angle
+    /// `motor` (`N q`), with `load` the load column's value
+    /// ([`ExtraTerms::load_entry`]), into `out` (`per_joint()` entries).
+    pub fn row(&self, q: f64, v: f64, motor: f64, load: f64, coulomb: Coulomb, out: &mut [f64]) {
         let s = coulomb.eval(v);
         let mut at = 0;
         if self.asymmetric {
@@ -120,6 +134,11 @@ impl ExtraTerms {
             let (sin, cos) = (f64::from(k) * q).sin_cos();
             out[at..at + 4].copy_from_slice(&[sin, cos, s * sin, s * cos]);
             at += 4;
+        }
+        for m in 1..=self.motor_harmonics {
+            let (sin, cos) = (f64::from(m) * motor).sin_cos();
+            out[at..at + 2].copy_from_slice(&[sin, cos]);
+            at += 2;
         }
         if self.load {
             out[at] = load;
@@ -142,6 +161,9 @@ impl fmt::Display for ExtraTerms {
         if self.harmonics > 0 {
             parts.push(format!("ripple={}", self.harmonics));
         }
+        if self.motor_harmonics > 0 {
+            parts.push(format!("motor-ripple={}", self.motor_harmonics));
+        }
         if self.load {
             parts.push("load".to_string());
         }
@@ -155,11 +177,22 @@ impl fmt::Display for ExtraTerms {
 impl FromStr for ExtraTerms {
     type Err = String;
 
-    /// A comma-separated list of `asymmetric`, `ripple=H` (`H` harmonics, 1 to
-    /// [`MAX_HARMONICS`]; `ripple` alone is 1) and `load`, or `none`.
+    /// A comma-separated list of `asymmetric`, `ripple=H` and `motor-ripple=H` (`H`
+    /// harmonics, 1 to [`MAX_HARMONICS`]; alone 1) and `load`, or `none`.
     fn from_str(text: &str) -> Result<Self, String> {
         let mut extras = ExtraTerms::NONE;
-        let valid = "valid: a comma-separated list of asymmetric, ripple=H (H harmonics, 1 to 8) and load, or none";
+        let valid = "valid: a comma-separated list of asymmetric, ripple=H, motor-ripple=H (H harmonics, 1 to 8) \
+                     and load, or none";
+        let harmonics = |k: usize, part: &str, h: Option<&str>| match h {
+            None => Ok(1),
+            Some(h) => match h.parse::<u8>() {
+                Ok(h) if (1..=MAX_HARMONICS).contains(&h) => Ok(h),
+                _ => Err(format!(
+                    "term {} `{part}`: the harmonics must be 1 to 8; {valid}",
+                    k + 1
+                )),
+            },
+        };
         for (k, part) in text.split(',').map(str::trim).enumerate() {
             match part
                 .split_once('=')
@@ -168,20 +201,8 @@ impl FromStr for ExtraTerms {
                 ("none", None) if text.trim() == "none" => {}
                 ("asymmetric", None) if !extras.asymmetric => extras.asymmetric = true,
                 ("load", None) if !extras.load => extras.load = true,
-                ("ripple", h) if extras.harmonics == 0 => {
-                    extras.harmonics = match h {
-                        None => 1,
-                        Some(h) => match h.parse::<u8>() {
-                            Ok(h) if (1..=MAX_HARMONICS).contains(&h) => h,
-                            _ => {
-                                return Err(format!(
-                                    "term {} `{part}`: the harmonics must be 1 to 8; {valid}",
-                                    k + 1
-                                ))
-                            }
-                        },
-                    }
-                }
+                ("ripple", h) if extras.harmonics == 0 => extras.harmonics = harmonics(k, part, h)?,
+                ("motor-ripple", h) if extras.motor_harmonics == 0 => extras.motor_harmonics = harmonics(k, part, h)?,
                 _ => return Err(format!("term {} `{part}` is unknown or repeated; {valid}", k + 1)),
             }
         }
@@ -195,7 +216,13 @@ mod tests {
 
     #[test]
     fn parses_and_prints_the_same_list() {
-        for text in ["none", "asymmetric", "ripple=3", "load", "asymmetric,ripple=2,load"] {
+        for text in [
+            "none",
+            "asymmetric",
+            "ripple=3",
+            "load",
+            "asymmetric,ripple=2,motor-ripple=1,load",
+        ] {
             assert_eq!(text.parse::<ExtraTerms>().unwrap().to_string(), text);
         }
         assert_eq!("ripple".parse::<ExtraTerms>().unwrap().harmonics, 1);
@@ -220,11 +247,17 @@ mod tests {
             ["Fva1", "Ts1_1", "Tc1_1", "Fcs1_1", "Fcc1_1", "Ts2_1", "Tc2_1", "Fcs2_1", "Fcc2_1", "Fcl1"]
         );
         assert_eq!(extras.names(2)[10], "Fva2");
+        let motor: ExtraTerms = "motor-ripple=2".parse().unwrap();
+        assert_eq!(motor.names(1), ["Tms1_1", "Tmc1_1", "Tms2_1", "Tmc2_1"]);
+        let mut row = [0.0; 4];
+        motor.row(0.3, 0.1, 30.0, 0.0, Coulomb::Sign, &mut row);
+        assert_eq!(row, [30f64.sin(), 30f64.cos(), 60f64.sin(), 60f64.cos()]);
         let mut row = [0.0; 10];
         let (q, v) = (0.3, -0.5);
         extras.row(
             q,
             v,
+            0.0,
             ExtraTerms::load_entry(-4.0, v, Coulomb::Sign),
             Coulomb::Sign,
             &mut row,

@@ -534,6 +534,9 @@ pub struct JointModel {
     /// per velocity coordinate).
     pub epsilons: Option<Arc<[f64]>>,
     pub extras: ExtraTerms,
+    /// The gear ratio `N_j` of each joint (motor angle `N_j q_j`), for the motor
+    /// ripple of the extra terms.
+    pub gear_ratios: Option<Arc<[f64]>>,
 }
 
 impl JointModel {
@@ -543,7 +546,19 @@ impl JointModel {
             coulomb,
             epsilons: None,
             extras,
+            gear_ratios: None,
         }
+    }
+
+    /// The same with the joints' gear ratios (one per joint).
+    pub fn with_gear_ratios(mut self, ratios: Option<&[f64]>) -> Self {
+        self.gear_ratios = ratios.map(Into::into);
+        self
+    }
+
+    /// Joint `j`'s motor angle at joint angle `q` (0 without gear ratios).
+    pub fn motor_angle(&self, j: usize, q: f64) -> f64 {
+        self.gear_ratios.as_ref().map_or(0.0, |n| n[j] * q)
     }
 
     /// `Fc·tanh(q̇_j/ε_j)` with `epsilons[j]` on joint `j`.
@@ -554,6 +569,7 @@ impl JointModel {
             },
             epsilons: Some(epsilons.into()),
             extras,
+            gear_ratios: None,
         }
     }
 
@@ -718,7 +734,7 @@ impl TorqueRegressor {
                     y[at..at + PER_JOINT].copy_from_slice(&joint_regressor_row(v[j], a[j], coulomb));
                     if e > 0 {
                         let at = j * p + rigid + PER_JOINT * n + e * j;
-                        extras.row(q[j], v[j], 0.0, coulomb, &mut y[at..at + e]);
+                        extras.row(q[j], v[j], model.motor_angle(j, q[j]), 0.0, coulomb, &mut y[at..at + e]);
                     }
                 }
             }

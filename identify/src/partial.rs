@@ -257,6 +257,13 @@ impl RowOptions {
                      partial does not keep; use --friction sign or smooth with partial factors",
                 ),
             };
+        if options.extras.motor_harmonics > 0 {
+            return refuse(
+                "extra-terms",
+                "motor-ripple cannot be written as a partial factor: a partial does not keep the gear ratios its \
+                 rows were made with; use the other extra terms with partial factors",
+            );
+        }
         if options.extras.load {
             return refuse(
                 "extra-terms",

@@ -137,6 +137,9 @@ pub struct IdentifyOptions {
     /// Joint terms past viscous and Coulomb friction ([`crate::extras`]): with
     /// [`JointTerms::Friction`] or [`JointTerms::FrictionAuto`] only.
     pub extras: ExtraTerms,
+    /// Each joint's gear ratio `N_j` (motor angle `N_j q_j`), for the extra terms'
+    /// motor ripple, which needs them.
+    pub gear_ratios: Option<Vec<f64>>,
     /// How the torque rows are compressed (MIM accumulates by QR).
     pub accumulation: Accumulation,
     /// Leave a joint's torque rows out of its equations at the samples where its
@@ -166,6 +169,7 @@ impl Default for IdentifyOptions {
             joints: JointTerms::None,
             rotor_inertia: None,
             extras: ExtraTerms::NONE,
+            gear_ratios: None,
             accumulation: Accumulation::Qr,
             exclude_below: None,
             cutoff_hz: 10.0,
@@ -246,6 +250,23 @@ impl IdentifyOptions {
                     )
                 }
             }
+        }
+        match &self.gear_ratios {
+            None if self.extras.motor_harmonics > 0 => {
+                return invalid(
+                    "extra-terms",
+                    "motor-ripple needs each joint's gear ratio (--gear-ratios)".into(),
+                )
+            }
+            Some(r) => {
+                if let Some(j) = r.iter().position(|n| !(n.is_finite() && *n != 0.0)) {
+                    return invalid(
+                        "gear-ratios",
+                        format!("joint {}'s gear ratio must be finite and not 0, got {}", j + 1, r[j]),
+                    );
+                }
+            }
+            None => {}
         }
         if let Some(speed) = self.exclude_below {
             if !(speed.is_finite() && speed > 0.0) {
@@ -434,7 +455,13 @@ pub fn identify(
     }
     need_derivatives(trajectory)?;
     let model = dynamics.model();
-    if options.extras.harmonics > 0 && model.nq() != model.nv() {
+    if let Some(r) = options.gear_ratios.as_ref().filter(|r| r.len() != model.nv()) {
+        return Err(PipelineError::InvalidOption {
+            option: "gear-ratios",
+            reason: format!("{} values for {} joints; give one per joint", r.len(), model.nv()),
+        });
+    }
+    if (options.extras.harmonics > 0 || options.extras.motor_harmonics > 0) && model.nq() != model.nv() {
         return Err(PipelineError::InvalidOption {
             option: "extra-terms",
             reason: format!(
@@ -473,7 +500,9 @@ fn from_torques(
     let regressor = match options.joints {
         JointTerms::FrictionAuto if options.mode == Mode::Standard => {
             let epsilons = smoothing_fit(dynamics, traj, options)?.best_epsilons();
-            TorqueRegressor::StandardAndJoints(JointModel::per_joint(&epsilons, options.extras))
+            TorqueRegressor::StandardAndJoints(
+                JointModel::per_joint(&epsilons, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
+            )
         }
         _ => torque_regressor(options),
     };
@@ -545,11 +574,13 @@ pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
         }
         (Mode::Standard, JointTerms::None) => TorqueRegressor::Standard,
         (Mode::Standard, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
-            TorqueRegressor::StandardAndJoints(JointModel::new(coulomb, options.extras))
+            TorqueRegressor::StandardAndJoints(
+                JointModel::new(coulomb, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
+            )
         }
-        (Mode::Standard, JointTerms::FrictionAuto) => {
-            TorqueRegressor::StandardAndJoints(JointModel::new(Coulomb::Sign, options.extras))
-        }
+        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(
+            JointModel::new(Coulomb::Sign, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
+        ),
     }
 }
 
@@ -713,6 +744,9 @@ impl<'a> TorqueFit<'a> {
         };
         let extras = joint_model.map_or(ExtraTerms::NONE, |m| m.extras);
         let epsilons = joint_model.and_then(|m| m.epsilons.as_deref().map(<[f64]>::to_vec));
+        let gear_ratios = joint_model
+            .filter(|m| m.extras.motor_harmonics > 0)
+            .and_then(|m| m.gear_ratios.as_deref().map(<[f64]>::to_vec));
         let (parameterisation, coulomb) = match (&regressor, joint_model) {
             (TorqueRegressor::Principal, _) => (Parameterisation::Principal, None),
             (_, Some(m)) => (
@@ -770,6 +804,7 @@ impl<'a> TorqueFit<'a> {
             coulomb,
             epsilons: epsilons.clone(),
             extras,
+            gear_ratios,
             solution: estimate.solution.clone(),
             stribeck: stribeck.as_ref().map(|f| f.joints.clone()),
             preprocessing: Some(Preprocessing {
@@ -1017,7 +1052,9 @@ fn smoothing_fit(
     options: &IdentifyOptions,
 ) -> Result<crate::friction::SmoothingFit, PipelineError> {
     let model = dynamics.model();
-    let regressor = TorqueRegressor::StandardAndJoints(JointModel::new(Coulomb::Sign, options.extras));
+    let regressor = TorqueRegressor::StandardAndJoints(
+        JointModel::new(Coulomb::Sign, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
+    );
     let (n, p) = (dynamics.nv(), regressor.columns(model));
     let samples = SMOOTHING_SAMPLES.min(SMOOTHING_VALUES / (n * p).max(1)).max(1);
     let stride = traj.len().div_ceil(samples).max(1);
@@ -1200,6 +1237,20 @@ pub fn predict_with(
             })
         }
         (regressor, None) => regressor,
+    };
+    // The motor ripple's gear ratios, one per joint.
+    let regressor = match (regressor, &prediction.gear_ratios) {
+        (TorqueRegressor::StandardAndJoints(m), ratios) if m.extras.motor_harmonics > 0 => {
+            let ratios = ratios
+                .as_deref()
+                .filter(|r| r.len() == n && r.iter().all(|x| x.is_finite() && *x != 0.0))
+                .ok_or_else(|| PipelineError::InvalidOption {
+                    option: "prediction",
+                    reason: format!("the motor ripple needs {n} finite, non-zero gear ratios"),
+                })?;
+            TorqueRegressor::StandardAndJoints(m.with_gear_ratios(Some(ratios)))
+        }
+        (regressor, _) => regressor,
     };
     let p = regressor.columns(dynamics.model());
     if prediction.solution.len() != p {

@@ -142,7 +142,8 @@ impl Choices<'_> {
 ///         `"auto"`: a comma-separated list of `"asymmetric"` (direction-dependent
 ///         viscous friction), `"ripple=H"` (`H` harmonics of the joint angle: torque
 ///         ripple and position-dependent Coulomb friction) and `"load"` (Coulomb
-///         friction growing with the links' load). With `"best"`: the terms
+///         friction growing with the links' load); `"motor-ripple=H"` needs gear
+///         ratios, which only the command line takes. With `"best"`: the terms
 ///         it may add (default `"asymmetric,ripple=2,load"`; `"none"` for none).
 ///     ridge_lambda: the scale-free weight of `"ridge"`.
 ///     cutoff: low-pass cutoff (Hz) of the velocities and accelerations estimated

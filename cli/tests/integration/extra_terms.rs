@@ -58,6 +58,81 @@ fn extra_terms_go_from_simulate_through_identify_to_validate() {
     assert!(with < 0.012 && without > 1.8 * with, "{with} {without}");
 }
 
+/// Motor ripple through the gear ratios: simulated, identified, recorded with the
+/// ratios in the parameters file, and predicted by `validate` as by `identify`.
+#[test]
+fn motor_ripple_needs_and_keeps_the_gear_ratios() {
+    let dir = temp_dir("dyngen-cli-extra-terms", "motor");
+    let ripple = ["--extra-terms", "motor-ripple=1", "--gear-ratios", "101"];
+    let csv = simulate_ur5(
+        &dir,
+        800,
+        &[&ripple[..], &["--extra-params", "0.3,-0.2", "--coulomb", "1"]].concat(),
+    );
+    let params = dir.join("p.json");
+    let o = run!(
+        "identify",
+        ur5(),
+        &csv,
+        "--friction",
+        "sign",
+        ripple[0],
+        ripple[1],
+        ripple[2],
+        ripple[3],
+        "--params-json",
+        &params,
+        "--validate",
+        &csv
+    );
+    assert_ok(&o);
+    let out = stdout(&o);
+    assert!(out.contains("Tms1_1") && out.contains("Tmc1_6"), "{out}");
+    let o = run!("validate", ur5(), &params, &csv);
+    assert_ok(&o);
+    assert_eq!(overall(&stdout(&o)), overall(&out));
+    assert_error(
+        &run!(
+            "identify",
+            ur5(),
+            &csv,
+            "--friction",
+            "sign",
+            "--extra-terms",
+            "motor-ripple=1"
+        ),
+        "motor-ripple needs each joint's gear ratio (--gear-ratios)",
+    );
+    assert_error(
+        &run!(
+            "identify",
+            ur5(),
+            &csv,
+            "--friction",
+            "sign",
+            ripple[0],
+            ripple[1],
+            "--gear-ratios",
+            "101,0"
+        ),
+        "--gear-ratios: 2 values for 6 joints",
+    );
+    assert_error(
+        &run!(
+            "identify",
+            ur5(),
+            &csv,
+            "--friction",
+            "sign",
+            ripple[0],
+            ripple[1],
+            "--gear-ratios",
+            "0"
+        ),
+        "joint 1's gear ratio must be finite and not 0, got 0",
+    );
+}
+
 #[test]
 fn bad_extra_terms_are_refused() {
     let dir = temp_dir("dyngen-cli-extra-terms", "refused");

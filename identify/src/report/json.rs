@@ -101,6 +101,9 @@ pub struct PredictionModel {
     /// ([`crate::extras`]).
     #[serde(default, skip_serializing_if = "ExtraTerms::is_empty")]
     pub extras: ExtraTerms,
+    /// With the extras' motor ripple: each joint's gear ratio.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gear_ratios: Option<Vec<f64>>,
     pub solution: Vec<f64>,
     /// For `standard_and_joints` with Stribeck friction: per joint the static
     /// friction `fs` and Stribeck velocity `vs`; row `j` of the prediction gains

@@ -37,13 +37,15 @@ pub fn add_joint_terms(recording: &mut Recording, joint_params: &[f64], coulomb:
 /// joint, [`crate::extras`]) to the recorded joint torques. The load-dependent
 /// friction's load is the rigid-body torque, which the recording holds as
 /// [`record_trajectory`](super::record_trajectory) made it: call this before
-/// [`add_joint_terms`] and any other torque. Refuses a length other than one set
-/// per joint.
+/// [`add_joint_terms`] and any other torque. The motor ripple needs each joint's
+/// gear ratio (`gear_ratios`). Refuses a length other than one set per joint, and
+/// motor ripple without one gear ratio per joint.
 pub fn add_extra_terms(
     recording: &mut Recording,
     extras: ExtraTerms,
     params: &[f64],
     coulomb: Coulomb,
+    gear_ratios: Option<&[f64]>,
 ) -> Result<(), String> {
     let (n, e) = (recording.joint_names.len(), extras.per_joint());
     if params.len() != e * n {
@@ -53,11 +55,18 @@ pub fn add_extra_terms(
             e * n
         ));
     }
+    let ratios = match gear_ratios {
+        Some(r) if r.len() == n => r,
+        Some(r) => return Err(format!("{} gear ratios for {n} joints", r.len())),
+        None if extras.motor_harmonics > 0 => return Err("motor ripple needs the joints' gear ratios".into()),
+        None => &[][..],
+    };
     let mut row = vec![0.0; e];
     for s in &mut recording.samples {
         for j in 0..n {
             let load = ExtraTerms::load_entry(s.tau[j], s.v[j], coulomb);
-            extras.row(s.q[j], s.v[j], load, coulomb, &mut row);
+            let motor = ratios.get(j).map_or(0.0, |n| n * s.q[j]);
+            extras.row(s.q[j], s.v[j], motor, load, coulomb, &mut row);
             s.tau[j] += row
                 .iter()
                 .zip(&params[e * j..e * (j + 1)])

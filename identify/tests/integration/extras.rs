@@ -19,6 +19,7 @@ use dyngen_reference::Reference;
 const ALL: ExtraTerms = ExtraTerms {
     asymmetric: true,
     harmonics: 2,
+    motor_harmonics: 0,
     load: true,
 };
 
@@ -51,7 +52,7 @@ fn recording(robot: &Reference, motion_seed: u64, noise_seed: u64, extras: bool)
     let times: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64).collect();
     let mut rec = record_trajectory(robot, &robot.model().standard_params(), &motion(motion_seed), &times);
     if extras {
-        add_extra_terms(&mut rec, ALL, &extras_truth(), Coulomb::Sign).unwrap();
+        add_extra_terms(&mut rec, ALL, &extras_truth(), Coulomb::Sign, None).unwrap();
     }
     add_joint_terms(&mut rec, &joint_truth(), Coulomb::Sign);
     add_torque_noise(&mut rec, &mut Gaussian::new(noise_seed));
@@ -175,4 +176,79 @@ fn extra_terms_refuse_what_they_cannot_extend() {
         let e = pipeline::identify(&robot, &traj, &opts).unwrap_err();
         assert!(e.to_string().starts_with(says), "{e}");
     }
+}
+
+/// Ripple of the motor angle (gear ratio 101, two harmonics) on every joint: the
+/// joints sweep hundreds of motor periods, so each harmonic is determined, and the
+/// parameters file keeps the gear ratios.
+#[test]
+fn motor_ripple_is_identified_through_the_gear_ratios() {
+    let robot = ur5();
+    let ratios = vec![101.0; 6];
+    let motor: ExtraTerms = "motor-ripple=2".parse().unwrap();
+    // Tms1, Tmc1, Tms2, Tmc2 per joint.
+    let truth: Vec<f64> = (0..6)
+        .flat_map(|j| {
+            let s = [1.0, 1.0, 0.7, 0.25, 0.25, 0.25][j];
+            [0.4 * s, -0.3 * s, 0.2 * s, 0.15 * s]
+        })
+        .collect();
+    let make = |motion_seed: u64, noise_seed: u64| {
+        let times: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64).collect();
+        let mut rec = record_trajectory(&robot, &robot.model().standard_params(), &motion(motion_seed), &times);
+        add_extra_terms(&mut rec, motor, &truth, Coulomb::Sign, Some(&ratios)).unwrap();
+        add_joint_terms(&mut rec, &joint_truth(), Coulomb::Sign);
+        add_torque_noise(&mut rec, &mut Gaussian::new(noise_seed));
+        rec.to_trajectory().unwrap()
+    };
+    let (traj, check) = (make(1, 5), make(2, 6));
+    let geared = IdentifyOptions {
+        gear_ratios: Some(ratios.clone()),
+        ..options(motor)
+    };
+    let with = pipeline::identify(&robot, &traj, &geared).unwrap();
+    let Prediction::Regressor(estimate) = &with.prediction else {
+        panic!("a regressor estimate")
+    };
+    let first = 60 + PER_JOINT * 6;
+    // To 15 % (OLS pools one noise level over the joints, so the shoulder's σ is
+    // too small to judge it by).
+    for (k, truth) in truth.iter().enumerate() {
+        let value = estimate.estimate.params[first + k].value.unwrap();
+        println!("{}: {value:.4} (truth {truth})", estimate.names[first + k]);
+        assert!(
+            (value - truth).abs() < 0.15 * truth.abs(),
+            "{}: {value} against {truth}",
+            estimate.names[first + k]
+        );
+    }
+    let plain = pipeline::identify(&robot, &traj, &options(ExtraTerms::NONE)).unwrap();
+    let (e_with, e_without) = (
+        overall_error(&robot, &with, &check),
+        overall_error(&robot, &plain, &check),
+    );
+    println!("held-out error: with the motor ripple {e_with:.5}, without {e_without:.5}");
+    assert!(e_with < 0.0105 && e_without > 1.5 * e_with, "{e_with} {e_without}");
+    // The parameters file keeps the gear ratios: it predicts as the identification.
+    let json = ParameterReport::from_json(&with.report.to_json().unwrap()).unwrap();
+    let prediction = json.prediction.as_ref().unwrap();
+    assert_eq!(prediction.gear_ratios.as_deref(), Some(&ratios[..]));
+    let from_json = pipeline::predict_with(prediction, &robot, &check).unwrap();
+    let direct = with.predict(&robot, &check).unwrap();
+    for (a, b) in from_json.iter().flatten().zip(direct.iter().flatten()) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} {b}");
+    }
+    // Without gear ratios, and with fewer than joints.
+    let e = pipeline::identify(&robot, &traj, &options(motor)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("motor-ripple needs each joint's gear ratio (--gear-ratios)"),
+        "{e}"
+    );
+    let short = IdentifyOptions {
+        gear_ratios: Some(vec![101.0; 5]),
+        ..options(motor)
+    };
+    let e = pipeline::identify(&robot, &traj, &short).unwrap_err();
+    assert!(e.to_string().contains("5 values for 6 joints"), "{e}");
 }

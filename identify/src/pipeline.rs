@@ -574,14 +574,17 @@ pub(crate) fn torque_regressor(options: &IdentifyOptions) -> TorqueRegressor {
         }
         (Mode::Standard, JointTerms::None) => TorqueRegressor::Standard,
         (Mode::Standard, JointTerms::Friction(coulomb) | JointTerms::Stribeck(coulomb)) => {
-            TorqueRegressor::StandardAndJoints(
-                JointModel::new(coulomb, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
-            )
+            TorqueRegressor::StandardAndJoints(joint_model(options, coulomb))
         }
-        (Mode::Standard, JointTerms::FrictionAuto) => TorqueRegressor::StandardAndJoints(
-            JointModel::new(Coulomb::Sign, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
-        ),
+        (Mode::Standard, JointTerms::FrictionAuto) => {
+            TorqueRegressor::StandardAndJoints(joint_model(options, Coulomb::Sign))
+        }
     }
+}
+
+/// The joint model of `options` (extra terms, gear ratios) with `coulomb`.
+fn joint_model(options: &IdentifyOptions, coulomb: Coulomb) -> JointModel {
+    JointModel::new(coulomb, options.extras).with_gear_ratios(options.gear_ratios.as_deref())
 }
 
 /// Identifies from accumulated joint-torque rows of `regressor` (standard or
@@ -1052,9 +1055,7 @@ fn smoothing_fit(
     options: &IdentifyOptions,
 ) -> Result<crate::friction::SmoothingFit, PipelineError> {
     let model = dynamics.model();
-    let regressor = TorqueRegressor::StandardAndJoints(
-        JointModel::new(Coulomb::Sign, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
-    );
+    let regressor = TorqueRegressor::StandardAndJoints(joint_model(options, Coulomb::Sign));
     let (n, p) = (dynamics.nv(), regressor.columns(model));
     let samples = SMOOTHING_SAMPLES.min(SMOOTHING_VALUES / (n * p).max(1)).max(1);
     let stride = traj.len().div_ceil(samples).max(1);
@@ -1190,19 +1191,9 @@ pub fn predict_with(
     let regressor = match (prediction.regressor, prediction.coulomb) {
         (Parameterisation::Standard, None) => TorqueRegressor::Standard,
         (Parameterisation::Principal, None) => TorqueRegressor::Principal,
-        (Parameterisation::StandardAndJoints, Some(c)) => TorqueRegressor::StandardAndJoints(JointModel::new(
-            match c {
-                CoulombReport::Sign => Coulomb::Sign,
-                CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
-                CoulombReport::Tanh { epsilon } => {
-                    return Err(PipelineError::InvalidOption {
-                        option: "prediction",
-                        reason: format!("the Coulomb smoothing must be positive, got {epsilon}"),
-                    })
-                }
-            },
-            prediction.extras,
-        )),
+        (Parameterisation::StandardAndJoints, Some(c)) => {
+            TorqueRegressor::StandardAndJoints(recorded_joint_model(prediction, c, n)?)
+        }
         (r, c) => {
             return Err(PipelineError::InvalidOption {
                 option: "prediction",
@@ -1210,48 +1201,12 @@ pub fn predict_with(
             })
         }
     };
-    let regressor = match (regressor, &prediction.epsilons) {
-        (TorqueRegressor::StandardAndJoints(m), Some(epsilons)) => {
-            if epsilons.len() != n {
-                return Err(PipelineError::InvalidOption {
-                    option: "prediction",
-                    reason: format!("{} Coulomb smoothings ε for {n} joints", epsilons.len()),
-                });
-            }
-            if let Some(j) = epsilons.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
-                return Err(PipelineError::InvalidOption {
-                    option: "prediction",
-                    reason: format!(
-                        "joint {}'s Coulomb smoothing must be positive, got {}",
-                        j + 1,
-                        epsilons[j]
-                    ),
-                });
-            }
-            TorqueRegressor::StandardAndJoints(JointModel::per_joint(epsilons, m.extras))
-        }
-        (_, Some(_)) => {
-            return Err(PipelineError::InvalidOption {
-                option: "prediction",
-                reason: "Coulomb smoothings per joint need the standard_and_joints regressor".into(),
-            })
-        }
-        (regressor, None) => regressor,
-    };
-    // The motor ripple's gear ratios, one per joint.
-    let regressor = match (regressor, &prediction.gear_ratios) {
-        (TorqueRegressor::StandardAndJoints(m), ratios) if m.extras.motor_harmonics > 0 => {
-            let ratios = ratios
-                .as_deref()
-                .filter(|r| r.len() == n && r.iter().all(|x| x.is_finite() && *x != 0.0))
-                .ok_or_else(|| PipelineError::InvalidOption {
-                    option: "prediction",
-                    reason: format!("the motor ripple needs {n} finite, non-zero gear ratios"),
-                })?;
-            TorqueRegressor::StandardAndJoints(m.with_gear_ratios(Some(ratios)))
-        }
-        (regressor, _) => regressor,
-    };
+    if prediction.epsilons.is_some() && !matches!(regressor, TorqueRegressor::StandardAndJoints(..)) {
+        return Err(PipelineError::InvalidOption {
+            option: "prediction",
+            reason: "Coulomb smoothings per joint need the standard_and_joints regressor".into(),
+        });
+    }
     let p = regressor.columns(dynamics.model());
     if prediction.solution.len() != p {
         return Err(PipelineError::InvalidOption {
@@ -1306,6 +1261,55 @@ pub fn predict_with(
             tau
         })
         .collect())
+}
+
+/// The joint model a parameters file records for the `standard_and_joints`
+/// regressor (`coulomb`, and the ε per joint, extra terms and gear ratios of
+/// `prediction`), checked against `n` joints.
+fn recorded_joint_model(
+    prediction: &PredictionModel,
+    coulomb: CoulombReport,
+    n: usize,
+) -> Result<JointModel, PipelineError> {
+    let invalid = |reason: String| PipelineError::InvalidOption {
+        option: "prediction",
+        reason,
+    };
+    let coulomb = match coulomb {
+        CoulombReport::Sign => Coulomb::Sign,
+        CoulombReport::Tanh { epsilon } if epsilon.is_finite() && epsilon > 0.0 => Coulomb::Smooth { epsilon },
+        CoulombReport::Tanh { epsilon } => {
+            return Err(invalid(format!(
+                "the Coulomb smoothing must be positive, got {epsilon}"
+            )))
+        }
+    };
+    let mut model = JointModel::new(coulomb, prediction.extras);
+    if let Some(epsilons) = &prediction.epsilons {
+        if epsilons.len() != n {
+            return Err(invalid(format!(
+                "{} Coulomb smoothings ε for {n} joints",
+                epsilons.len()
+            )));
+        }
+        if let Some(j) = epsilons.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
+            return Err(invalid(format!(
+                "joint {}'s Coulomb smoothing must be positive, got {}",
+                j + 1,
+                epsilons[j]
+            )));
+        }
+        model.epsilons = Some(epsilons.as_slice().into());
+    }
+    if prediction.extras.motor_harmonics > 0 {
+        let ratios = prediction
+            .gear_ratios
+            .as_deref()
+            .filter(|r| r.len() == n && r.iter().all(|x| x.is_finite() && *x != 0.0))
+            .ok_or_else(|| invalid(format!("the motor ripple needs {n} finite, non-zero gear ratios")))?;
+        model = model.with_gear_ratios(Some(ratios));
+    }
+    Ok(model)
 }
 
 /// An identified parameter against the model's value.

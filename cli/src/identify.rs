@@ -44,7 +44,7 @@ Examples:
 
 A real robot's joint torques carry friction and rotor inertia: --friction auto adds
 [Ia, Fv, Fc, F0] per joint (rotor inertia, viscous and Coulomb friction, offset) with
-the Coulomb term smoothed as the data best support; --rotor-inertia no leaves Ia out
+the Coulomb term smoothed per joint as held-out parts of the recording best support; --rotor-inertia no leaves Ia out
 (friction only), --rotor-inertia yes without --friction fits Ia alone. --friction
 stribeck replaces the Coulomb term by (Fc + (Fs − Fc)·exp(−(q̇/vs)²))·sign(q̇),
 static friction Fs >= 0 and Stribeck velocity vs per joint fitted by nonlinear least
@@ -144,7 +144,8 @@ pub enum Friction {
     Sign,
     /// The same with Fc·tanh(q̇/ε), ε from --epsilon.
     Smooth,
-    /// The same with the ε that fits the data best (a search on the fit residual).
+    /// The same with each joint's ε chosen by the error on held-out time blocks of
+    /// the recording.
     Auto,
     /// Sign, plus per joint a Stribeck term: static friction Fs at rest falling to
     /// Fc above the Stribeck velocity vs, fitted by nonlinear least squares; a joint
@@ -685,7 +686,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             let list: Vec<String> = epsilons.iter().map(|e| format!("{e:.4e}")).collect();
             outln!(
                 "--friction auto: Coulomb smoothing tanh(q̇_j/ε_j) with ε per joint {} rad/s (m/s for prismatic \
-                 joints), chosen by the fit residual",
+                 joints), chosen on held-out time blocks",
                 list.join(", ")
             );
         }

@@ -89,9 +89,9 @@ pub enum JointTerms {
     None,
     /// Friction and rotor inertia with the Coulomb term as given.
     Friction(Coulomb),
-    /// Friction and rotor inertia with `Fc·tanh(q̇/ε)`, `ε` chosen by the fit
-    /// residual ([`crate::friction::best_epsilon`], on at most
-    /// [`SMOOTHING_SAMPLES`] samples spread over the recording).
+    /// Friction and rotor inertia with `Fc·tanh(q̇_j/ε_j)`, each joint's `ε` chosen
+    /// by the error on held-out time blocks of the recording
+    /// ([`crate::choice::epsilons`]), or given ([`IdentifyOptions::epsilons`]).
     FrictionAuto,
     /// Friction and rotor inertia with the Coulomb term as given, and per joint a
     /// Stribeck term: static friction `Fs ≥ 0` and Stribeck velocity `vs` within a
@@ -116,8 +116,9 @@ pub const LOAD_ROUNDS: usize = 8;
 /// The alternation stops when no parameter changes by more than this fraction.
 pub const LOAD_TOLERANCE: f64 = 1e-6;
 
-/// Samples the search for the Coulomb smoothing fits on, at most.
-pub const SMOOTHING_SAMPLES: usize = 20_000;
+/// Samples the load-dependent friction's alternation runs on, at most (then it fits
+/// once on all).
+pub const LOAD_SAMPLES: usize = 20_000;
 
 /// Everything [`load`] and [`identify`] need besides the data and the robot.
 #[derive(Clone, Debug, PartialEq)]
@@ -126,6 +127,10 @@ pub struct IdentifyOptions {
     pub estimator: Estimator,
     /// Friction and rotor inertia ([`Mode::Standard`] only).
     pub joints: JointTerms,
+    /// With [`JointTerms::FrictionAuto`]: each joint's Coulomb smoothing `ε`, found
+    /// elsewhere (by the model choice, [`crate::choice`]). `None`: searched by the
+    /// fit residual.
+    pub epsilons: Option<Vec<f64>>,
     /// The rotor inertias `Ia` on their own ([`Mode::Standard`] only): `None` fits
     /// them with the friction terms, as [`IdentifyOptions::joints`] says;
     /// `Some(false)` leaves them out (friction without rotor inertia: the `Ia`
@@ -167,6 +172,7 @@ impl Default for IdentifyOptions {
             mode: Mode::Standard,
             estimator: Estimator::Ols,
             joints: JointTerms::None,
+            epsilons: None,
             rotor_inertia: None,
             extras: ExtraTerms::NONE,
             gear_ratios: None,
@@ -227,6 +233,20 @@ impl IdentifyOptions {
         {
             if !(epsilon.is_finite() && epsilon > 0.0) {
                 return invalid("friction", format!("the smoothing ε must be positive, got {epsilon}"));
+            }
+        }
+        if let Some(e) = &self.epsilons {
+            if self.joints != JointTerms::FrictionAuto {
+                return invalid(
+                    "epsilons",
+                    "give the Coulomb smoothing per joint with auto friction only".into(),
+                );
+            }
+            if let Some(j) = e.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
+                return invalid(
+                    "epsilons",
+                    format!("joint {}'s smoothing ε must be positive, got {}", j + 1, e[j]),
+                );
             }
         }
         if !self.extras.is_empty() {
@@ -499,7 +519,16 @@ fn from_torques(
 ) -> Result<Identification, PipelineError> {
     let regressor = match options.joints {
         JointTerms::FrictionAuto if options.mode == Mode::Standard => {
-            let epsilons = smoothing_fit(dynamics, traj, options)?.best_epsilons();
+            let epsilons = match &options.epsilons {
+                Some(e) if e.len() != dynamics.nv() => {
+                    return Err(PipelineError::InvalidOption {
+                        option: "epsilons",
+                        reason: format!("{} values for {} joints; give one per joint", e.len(), dynamics.nv()),
+                    })
+                }
+                Some(e) => e.clone(),
+                None => crate::choice::epsilons(dynamics, traj, options)?,
+            };
             TorqueRegressor::StandardAndJoints(
                 JointModel::per_joint(&epsilons, options.extras).with_gear_ratios(options.gear_ratios.as_deref()),
             )
@@ -512,9 +541,9 @@ fn from_torques(
     if options.extras.load {
         // The load of each row from the rigid-body parameters of the fit before
         // (the first fit has no load term), until the parameters settle: on at most
-        // SMOOTHING_SAMPLES samples spread over the recording, then once on all.
+        // LOAD_SAMPLES samples spread over the recording, then once on all.
         let rigid = 10 * dynamics.model().dof();
-        let stride = traj.len().div_ceil(SMOOTHING_SAMPLES).max(1);
+        let stride = traj.len().div_ceil(LOAD_SAMPLES).max(1);
         for _ in 0..LOAD_ROUNDS {
             let previous = estimate.solution.clone();
             let sampled = accumulate(dynamics, traj, &regressor, stride, Some(&previous[..rigid]), options)?;
@@ -1043,67 +1072,6 @@ fn accumulate(
     Ok(merged)
 }
 
-/// The data of the Coulomb smoothing's search ([`crate::friction::SmoothingFit`]):
-/// the regressor rows of at most [`SMOOTHING_SAMPLES`] samples spread over `traj`
-/// (fewer where their rows would pass [`SMOOTHING_VALUES`] numbers), every Coulomb
-/// column at 0, with the columns held at 0 and the rows left out below a speed as
-/// `options` say. The load-dependent friction's column stays 0 (the search takes
-/// the fit without it).
-fn smoothing_fit(
-    dynamics: &dyn Dynamics,
-    traj: &Trajectory,
-    options: &IdentifyOptions,
-) -> Result<crate::friction::SmoothingFit, PipelineError> {
-    let model = dynamics.model();
-    let regressor = TorqueRegressor::StandardAndJoints(joint_model(options, Coulomb::Sign));
-    let (n, p) = (dynamics.nv(), regressor.columns(model));
-    let samples = SMOOTHING_SAMPLES.min(SMOOTHING_VALUES / (n * p).max(1)).max(1);
-    let stride = traj.len().div_ceil(samples).max(1);
-    let rigid = 10 * model.dof();
-    let mut zeroed = excluded_columns(&regressor, model, fitted_joint_terms(options));
-    zeroed.extend((0..n).map(|j| rigid + PER_JOINT * j + 2));
-    let mut acc = Accumulator::with_accumulation(p, Channels::Interleaved(n), options.accumulation)?;
-    let mut joints: Vec<crate::friction::JointRows> = (0..n)
-        .map(|_| crate::friction::JointRows {
-            rows: Vec::new(),
-            v: Vec::new(),
-            tau: Vec::new(),
-        })
-        .collect();
-    let mut y = vec![0.0; n * p];
-    let mut keep = vec![true; n];
-    for k in (0..traj.len()).step_by(stride) {
-        let (q, v, a) = state(traj, k);
-        let tau = traj.tau(k);
-        regressor.eval(dynamics, q, v, a, &mut y);
-        for row in y.chunks_exact_mut(p) {
-            for &c in &zeroed {
-                row[c] = 0.0;
-            }
-        }
-        if let Some(speed) = options.exclude_below {
-            for (keep, v) in keep.iter_mut().zip(v) {
-                *keep = v.abs() >= speed;
-            }
-        }
-        acc.push_rows_masked(faer::MatRef::from_row_major_slice(&y, n, p), tau, &keep)
-            .map_err(|error| PipelineError::Identify {
-                at: Some(traj.location(k)),
-                error,
-            })?;
-        for (j, joint) in joints.iter_mut().enumerate().filter(|(j, _)| keep[*j]) {
-            joint.rows.extend_from_slice(&y[j * p..(j + 1) * p]);
-            joint.v.push(v[j]);
-            joint.tau.push(tau[j]);
-        }
-    }
-    Ok(crate::friction::SmoothingFit::new(joints, &acc, &options.tolerances)?)
-}
-
-/// At most this many regressor entries are held for the Coulomb smoothing's search
-/// (16 M: 128 MB).
-const SMOOTHING_VALUES: usize = 1 << 24;
-
 /// Contiguous parts of the samples accumulated independently ([`accumulate`]).
 const PARTS: usize = 8;
 
@@ -1162,7 +1130,7 @@ fn need_derivatives(trajectory: &Trajectory) -> Result<(), PipelineError> {
 }
 
 /// `(q, v, a)` of sample `k`; [`identify`] checked that `v` and `a` exist.
-fn state(traj: &Trajectory, k: usize) -> (&[f64], &[f64], &[f64]) {
+pub(crate) fn state(traj: &Trajectory, k: usize) -> (&[f64], &[f64], &[f64]) {
     (traj.q(k), traj.v(k).unwrap_or(&[]), traj.a(k).unwrap_or(&[]))
 }
 

@@ -61,6 +61,34 @@ impl Validation {
             }
             samples += 1;
         }
+        Validation::from_sums(joint_names, samples, &err2, &tau2)
+    }
+
+    /// From the sums over `samples` samples, per joint, of the squared prediction
+    /// errors `err2` and the squared measured torques `tau2`. Errors: no samples, a
+    /// sum that is not finite, or a joint whose measured torque is zero throughout.
+    pub fn from_sums(
+        joint_names: &[String],
+        samples: usize,
+        err2: &[f64],
+        tau2: &[f64],
+    ) -> Result<Validation, IdentifyError> {
+        let n = joint_names.len();
+        for (what, sums) in [("prediction errors", err2), ("measured torques", tau2)] {
+            if sums.len() != n {
+                return Err(IdentifyError::DimensionMismatch {
+                    what,
+                    expected: n,
+                    found: sums.len(),
+                });
+            }
+            if let Some(j) = sums.iter().position(|x| !x.is_finite()) {
+                return Err(IdentifyError::InvalidArgument {
+                    what,
+                    reason: format!("the sum of joint {} is not finite", j + 1),
+                });
+            }
+        }
         if samples == 0 {
             return Err(IdentifyError::Empty);
         }
@@ -79,7 +107,7 @@ impl Validation {
             samples,
             rms: err2.iter().map(|e| (e / s).sqrt()).collect(),
             measured_rms: tau2.iter().map(|t| (t / s).sqrt()).collect(),
-            relative: err2.iter().zip(&tau2).map(|(e, t)| (e / t).sqrt()).collect(),
+            relative: err2.iter().zip(tau2).map(|(e, t)| (e / t).sqrt()).collect(),
             overall: (err2.iter().sum::<f64>() / tau2.iter().sum::<f64>()).sqrt(),
         })
     }

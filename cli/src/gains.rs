@@ -137,7 +137,7 @@ fn numbers(flag: &str, text: &str, counts: &[usize]) -> Result<Vec<f64>> {
 /// from `data` and `loaded` (read through `recipe`, the currents as they are),
 /// prints them, and returns `recipe` with them.
 pub fn identify(args: &IdentifyArgs, model: &Model, data: &Path, loaded: &Path, recipe: &Recipe) -> Result<Recipe> {
-    let coulomb = match args.friction {
+    let coulomb = match args.friction() {
         Friction::Sign => Coulomb::Sign,
         Friction::Smooth => Coulomb::Smooth { epsilon: args.epsilon },
         _ => {

@@ -4,7 +4,7 @@
 
 use crate::common::{check_overwrite, load_moving_model, out, outln, with_spinner, ModelArgs, Progress, Result};
 use crate::error::CliError;
-use dyngen_identify::choice::DEFAULT_EXTRAS;
+use dyngen_identify::choice::{DEFAULT_EXTRAS, MIN_SAMPLES};
 use dyngen_identify::data::{Recipe, Trajectory};
 use dyngen_identify::extras::ExtraTerms;
 use dyngen_identify::pipeline::{
@@ -240,10 +240,11 @@ pub struct IdentifyArgs {
     pub accumulation: AccumulationArg,
 
     /// Friction and rotor inertia per joint (--mode standard): 4 more parameters per
-    /// joint, [Ia, Fv, Fc, F0]. Real robots need them; `auto` is the choice for a
-    /// real recording.
-    #[arg(long, value_enum, default_value_t = Friction::None)]
-    pub friction: Friction,
+    /// joint, [Ia, Fv, Fc, F0], and more. Default: `best` (the data choose, `none`
+    /// among the candidates) for one recording in --mode standard without
+    /// --rotor-inertia and --drive-gains; `none` otherwise.
+    #[arg(long, value_enum)]
+    pub friction: Option<Friction>,
 
     /// Rotor inertia Ia per joint (--mode standard), on its own: `no` fits the
     /// --friction terms without it (Ia held at 0), `yes` fits it, also without
@@ -526,6 +527,24 @@ pub fn pipeline_error(data: &Path, e: PipelineError) -> CliError {
 }
 
 impl IdentifyArgs {
+    /// The friction model: as given, or by default `best` where it can choose (one
+    /// recording in the standard mode, the rotor inertia not fixed, no drive gains
+    /// to identify), `none` otherwise.
+    pub fn friction(&self) -> Friction {
+        self.friction.unwrap_or(
+            if self.mode == Mode::Standard
+                && self.partial.is_none()
+                && self.merge.is_empty()
+                && self.rotor_inertia.is_none()
+                && self.drive.drive_gains.is_none()
+            {
+                Friction::Best
+            } else {
+                Friction::None
+            },
+        )
+    }
+
     pub fn options(&self) -> IdentifyOptions {
         IdentifyOptions {
             mode: match self.mode {
@@ -545,7 +564,7 @@ impl IdentifyArgs {
                 AccumulationArg::Qr => Accumulation::Qr,
                 AccumulationArg::NormalEquations => Accumulation::NormalEquations,
             },
-            joints: match self.friction {
+            joints: match self.friction() {
                 Friction::None => JointTerms::None,
                 Friction::Sign => JointTerms::Friction(Coulomb::Sign),
                 Friction::Smooth => JointTerms::Friction(Coulomb::Smooth { epsilon: self.epsilon }),
@@ -557,7 +576,7 @@ impl IdentifyArgs {
             },
             rotor_inertia: self.rotor_inertia.map(|r| r == YesNo::Yes),
             // With best, the terms the choice may add (`run`).
-            extras: match self.friction {
+            extras: match self.friction() {
                 Friction::Best => ExtraTerms::NONE,
                 _ => self.extra_terms.unwrap_or(ExtraTerms::NONE),
             },
@@ -581,7 +600,7 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             "--accumulation applies to --mode standard and principal; MIM accumulates by QR",
         ));
     }
-    if args.friction == Friction::Best {
+    if args.friction == Some(Friction::Best) {
         if args.partial.is_some() || !args.merge.is_empty() {
             return Err(CliError::usage(
                 "--friction best cannot be written as or solved from partial factors: it fits every candidate \
@@ -649,7 +668,13 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         outln!("training: {}", describe_span(&training));
     }
     let robot = Reference::new(&model);
-    let options = if args.friction == Friction::Best {
+    let options = if args.friction.is_none() && args.friction() == Friction::Best && traj.len() < MIN_SAMPLES {
+        // Too short to choose on time blocks: the rigid bodies alone, by default.
+        IdentifyOptions {
+            joints: JointTerms::None,
+            ..options
+        }
+    } else if args.friction() == Friction::Best {
         let choice = with_spinner(progress, "choosing the joint model", || {
             let allowed = args.extra_terms.unwrap_or(DEFAULT_EXTRAS);
             dyngen_identify::choice::choose(&robot, &traj, &options, allowed)
@@ -762,7 +787,7 @@ pub fn print_identification(
             if let Some(fit) = &identified.stribeck {
                 out!("{fit}");
             }
-            if args.mode == Mode::Standard && args.friction == Friction::None {
+            if args.mode == Mode::Standard && args.friction() == Friction::None {
                 if let Some(traj) = traj {
                     hint_friction(&torque.estimate, traj)?;
                 }
@@ -836,7 +861,7 @@ pub fn check_outputs(args: &IdentifyArgs) -> Result<()> {
 
 /// Whether the identification has joint terms (friction or rotor inertia).
 fn has_joint_terms(args: &IdentifyArgs) -> bool {
-    args.mode == Mode::Standard && (args.friction != Friction::None || args.rotor_inertia == Some(YesNo::Yes))
+    args.mode == Mode::Standard && (args.friction() != Friction::None || args.rotor_inertia == Some(YesNo::Yes))
 }
 
 /// Where --urdf-out's companion file goes: beside the URDF, its name with
@@ -994,7 +1019,7 @@ fn hint_friction(estimate: &Estimate, traj: &Trajectory) -> Result<()> {
         if ratio > FRICTION_HINT {
             outln!(
                 "note: rigid bodies alone leave {:.0} % of joint {}'s torque unexplained; a real robot's joints add \
-                 friction and rotor inertia: try --friction auto",
+                 friction and rotor inertia: try --friction best (the default), which chooses them",
                 100.0 * ratio,
                 j + 1
             );

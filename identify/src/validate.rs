@@ -65,8 +65,8 @@ impl Validation {
     }
 
     /// From the sums over `samples` samples, per joint, of the squared prediction
-    /// errors `err2` and the squared measured torques `tau2`. Errors: no samples, a
-    /// sum that is not finite, or a joint whose measured torque is zero throughout.
+    /// errors `err2` and the squared measured torques `tau2`. Errors: no samples, or
+    /// a joint whose measured torque is zero throughout.
     pub fn from_sums(
         joint_names: &[String],
         samples: usize,
@@ -80,12 +80,6 @@ impl Validation {
                     what,
                     expected: n,
                     found: sums.len(),
-                });
-            }
-            if let Some(j) = sums.iter().position(|x| !x.is_finite()) {
-                return Err(IdentifyError::InvalidArgument {
-                    what,
-                    reason: format!("the sum of joint {} is not finite", j + 1),
                 });
             }
         }

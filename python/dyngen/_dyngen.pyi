@@ -29,7 +29,7 @@ def identify(
     *,
     mode: str = "standard",
     method: str = "ols",
-    friction: str = "none",
+    friction: Optional[str] = None,
     epsilon: float = 0.01,
     extra_terms: Optional[str] = None,
     ridge_lambda: float = 1e-6,
@@ -46,7 +46,8 @@ def identify(
     ``"ols"``, ``"wls"``, ``"tls"``, ``"tls-unscaled"``, ``"ridge"``, ``"consistent"``;
     ``friction`` ``"none"``, ``"sign"``, ``"smooth"``, ``"auto"``, ``"stribeck"``,
     ``"stribeck-smooth"``, ``"best"`` (the model that predicts held-out time blocks
-    of the recording best; the errors in ``model_choice``). ``extra_terms``: joint
+    of the recording best; the errors in ``model_choice``); by default ``"best"`` in
+    the standard mode, ``"none"`` otherwise. ``extra_terms``: joint
     terms past friction (``"asymmetric"``, ``"ripple=H"``, ``"load"``, comma-separated)
     with ``"sign"``, ``"smooth"`` or ``"auto"``; with ``"best"`` the terms it may add
     (default ``"asymmetric,ripple=2,load"``, ``"none"`` for none). ``report``: write ``dyngen identify --report``'s SVG there
@@ -55,7 +56,7 @@ def identify(
     ``sigma_percent``, ``status``, ``rank``, ``condition_number``, ``residual_rms``,
     ``channels``, ``combinations``, ``combination_matrix``, ``combination_values``, ``combination_sigma``,
     ``warnings``, and with ``friction="best"`` ``model_choice`` (``chosen``,
-    ``held_out``). Raises :class:`LoadError` or ``ValueError``."""
+    ``held_out``, ``epsilons``). Raises :class:`LoadError` or ``ValueError``."""
 
 def identify_partial(
     robot_path: Union[str, "os.PathLike[str]"],

@@ -132,11 +132,13 @@ impl Choices<'_> {
 ///     method: the estimator of the standard and principal modes: `"ols"` (default),
 ///         `"wls"`, `"tls"`, `"tls-unscaled"`, `"ridge"` (with `ridge_lambda`),
 ///         `"consistent"`.
-///     friction: joint terms of the standard mode: `"none"` (default), `"sign"`,
+///     friction: joint terms of the standard mode: `"none"`, `"sign"`,
 ///         `"smooth"` (`tanh(v/epsilon)`), `"auto"`, `"stribeck"`, `"stribeck-smooth"`,
 ///         `"best"` (the one of `"none"`, `"sign"` without and with rotor inertia,
 ///         `"auto"` and `"stribeck"` that predicts held-out time blocks of the
-///         recording best; each candidate's error is in `model_choice`).
+///         recording best, with the extra terms that do; each candidate's error is
+///         in `model_choice`). Default: `"best"` in the standard mode (`"none"`
+///         for a recording too short for its time blocks), `"none"` otherwise.
 ///     epsilon: the Coulomb smoothing of `"smooth"` friction, rad/s.
 ///     extra_terms: joint terms past friction, with `"sign"`, `"smooth"` or
 ///         `"auto"`: a comma-separated list of `"asymmetric"` (direction-dependent
@@ -168,8 +170,9 @@ impl Choices<'_> {
 ///     (of the prediction error), `measured_rms`, `relative` (‖τ̂ − τ‖ / ‖τ‖), and
 ///     `overall` (over every joint and sample); with `friction="best"` a dict
 ///     `model_choice`: `chosen` (the candidate's label: `"auto + asymmetric,load"`,
-///     say) and `held_out` (each candidate's overall relative error on the held-out
-///     blocks, None where it could not be fitted).
+///     say), `held_out` (each candidate's overall relative error on the held-out
+///     blocks, None where it could not be fitted) and `epsilons` (`"auto"`'s
+///     Coulomb smoothing per joint chosen on the blocks, or None).
 ///
 /// Raises:
 ///     LoadError: the robot does not load.
@@ -182,7 +185,7 @@ impl Choices<'_> {
     *,
     mode = "standard",
     method = "ols",
-    friction = "none",
+    friction = None,
     epsilon = 0.01,
     extra_terms = None,
     ridge_lambda = 1e-6,
@@ -201,7 +204,7 @@ pub fn identify<'py>(
     data_path: PathBuf,
     mode: &str,
     method: &str,
-    friction: &str,
+    friction: Option<&str>,
     epsilon: f64,
     extra_terms: Option<&str>,
     ridge_lambda: f64,
@@ -218,6 +221,9 @@ pub fn identify<'py>(
             "identify: `validate_recipe` is the recipe of the `validate` recording; give `validate` too",
         ));
     }
+    // By default the data choose the joint model in the standard mode.
+    let defaulted = friction.is_none();
+    let friction = friction.unwrap_or(if mode == "standard" { "best" } else { "none" });
     let choices = Choices {
         function: "identify",
         mode,
@@ -242,7 +248,15 @@ pub fn identify<'py>(
     let robot = Reference::new(&model);
     let (identified, validation, choice) = py.detach(|| {
         let loaded = pipeline::load(&data_path, &recipe, model.nv(), &options).map_err(|e| failed(&data_path, e))?;
-        let (options, choice) = if friction == "best" {
+        let too_short = loaded.trajectory.len() < dyngen_identify::choice::MIN_SAMPLES;
+        let (options, choice) = if friction == "best" && defaulted && too_short {
+            // Too short to choose on time blocks: the rigid bodies alone.
+            let options = pipeline::IdentifyOptions {
+                joints: pipeline::JointTerms::None,
+                ..options
+            };
+            (options, None)
+        } else if friction == "best" {
             let choice = dyngen_identify::choice::choose(&robot, &loaded.trajectory, &options, allowed_extras)
                 .map_err(|e| failed(&data_path, e))?;
             (choice.apply(&options), Some(choice))
@@ -299,6 +313,7 @@ pub fn identify<'py>(
         let d = PyDict::new(py);
         d.set_item("chosen", choice.chosen().label())?;
         d.set_item("held_out", held_out)?;
+        d.set_item("epsilons", choice.epsilons.clone())?;
         out.set_item("model_choice", d)?;
     }
     let json = match identified.mim {

@@ -44,7 +44,7 @@ def max_difference(a, b):
 @pytest.mark.parametrize("method", ["ols", "wls"])
 def test_merged_partials_identify_as_one_file(recordings, method):
     parts, whole = recordings
-    one = dyngen.identify(UR5, whole, method=method, raw_states=True)
+    one = dyngen.identify(UR5, whole, method=method, friction="none", raw_states=True)
     partials = [dyngen.identify_partial(UR5, p, raw_states=True) for p in parts]
     merged = dyngen.merge_partials(partials)
     assert merged.recordings == [str(p) for p in parts]
@@ -74,7 +74,7 @@ def test_a_partial_pickles_and_saves_exactly(recordings, tmp_path):
 def test_dask_map_reduce_on_a_local_cluster(recordings):
     distributed = pytest.importorskip("dask.distributed")
     parts, whole = recordings
-    one = dyngen.identify(UR5, whole, method="wls", raw_states=True)
+    one = dyngen.identify(UR5, whole, method="wls", friction="none", raw_states=True)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:
             result, partial = fleet_dask.fleet_identify(client, UR5, parts, method="wls", raw_states=True)

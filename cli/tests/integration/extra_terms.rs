@@ -146,7 +146,7 @@ fn bad_extra_terms_are_refused() {
         "`ripple=9`: the harmonics must be 1 to 8",
     );
     assert_error(
-        &run!("identify", ur5(), &csv, "--extra-terms", "load"),
+        &run!("identify", ur5(), &csv, "--friction", "none", "--extra-terms", "load"),
         "--extra-terms load extends the friction model: give --friction sign, smooth or auto as well",
     );
     assert_error(

@@ -97,6 +97,8 @@ fn friction_identification_predicts_the_mujoco_recording_better_than_the_baselin
         "identify",
         ur5(),
         fixture("ur5_identify.csv"),
+        "--friction",
+        "none",
         "--validate",
         fixture("ur5_validate.csv")
     );
@@ -105,7 +107,7 @@ fn friction_identification_predicts_the_mujoco_recording_better_than_the_baselin
     assert!(rigid > 5.0 * with_friction, "{rigid} vs {with_friction}");
     assert!(stdout(&o).contains("(no better than zero)"), "{}", stdout(&o));
     // ...and `identify` says what to do about it.
-    assert!(stdout(&o).contains("try --friction auto"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("try --friction best"), "{}", stdout(&o));
 }
 
 #[test]
@@ -532,7 +534,8 @@ fn the_best_joint_model_is_chosen_on_held_out_blocks() {
         .map(|l| l.split_whitespace().nth(1).and_then(|x| x.parse().ok()).unwrap())
         .collect();
     let chosen = table.iter().position(|l| l.ends_with("<- chosen")).expect("a choice");
-    assert!(errors.iter().all(|&e| e >= errors[chosen]), "{out}");
+    // A more complex model is chosen where it lowers the error by 1 %.
+    assert!(errors.iter().all(|&e| e >= 0.99 * errors[chosen]), "{out}");
     assert!(["auto", "stribeck"].contains(&names[chosen]), "{out}");
     // Sign friction predicts this recording at 3.52 % (README).
     let best = overall(&out);

@@ -31,7 +31,7 @@ use faer::prelude::Solve;
 use faer::{Mat, Side};
 
 /// The ridge on the normal equations, relative to their diagonal.
-const RIDGE: f64 = 1e-10;
+const RIDGE: f64 = 1e-12;
 
 /// One joint's rows in one time block: the regressor on the columns the joint's
 /// rows can be non-zero in, then the torque.

@@ -44,6 +44,9 @@ use std::fmt;
 /// Time blocks of the cross-validation.
 pub const BLOCKS: usize = 4;
 
+/// The fewest samples the choice takes: 2 per block.
+pub const MIN_SAMPLES: usize = 2 * BLOCKS;
+
 /// The choice is made on at most this many samples, spread evenly over the
 /// recording (the identification that follows uses all of them).
 pub const CHOICE_SAMPLES: usize = 20_000;
@@ -51,6 +54,11 @@ pub const CHOICE_SAMPLES: usize = 20_000;
 /// At most this many numbers of the wide regressor's rows are held (16 M: 128 MB);
 /// fewer samples are taken where they would pass it.
 const CHOICE_VALUES: usize = 1 << 24;
+
+/// A held-out error below this is exact for any purpose: no model replaces one
+/// that predicts so well (on noise-free data every candidate's error is rounding
+/// and the ridge's bias, and which is lowest means nothing).
+pub const EXACT: f64 = 1e-6;
 
 /// Values of `auto`'s `ε` tried per joint, evenly spaced in `log ε` over
 /// [`EPSILON_RANGE`] (neighbours 27 % apart).
@@ -199,7 +207,7 @@ impl fmt::Display for ModelChoice {
         writeln!(
             f,
             "joint model chosen by the error on held-out data ({BLOCKS} time blocks, each predicted by the fit on \
-             the others; an extra term is kept where it lowers the error by {:.0} %):",
+             the others; a more complex model or an extra term where it lowers the error by {:.0} %):",
             100.0 * MIN_GAIN
         )?;
         for (i, s) in self.scores.iter().enumerate() {
@@ -298,7 +306,8 @@ pub fn choose(
         held_out: scoring.stribeck(&data),
     });
     // The lowest error among the scores `among`; a later (more complex) one must be
-    // lower by the fraction `margin`.
+    // lower by the fraction `margin`, and nothing replaces a model that predicts to
+    // rounding (EXACT).
     let best = |scores: &[Score], among: &dyn Fn(&Candidate) -> bool, margin: f64| {
         scores
             .iter()
@@ -306,7 +315,7 @@ pub fn choose(
             .filter(|(_, s)| among(&s.candidate))
             .filter_map(|(i, s)| s.held_out.as_ref().ok().map(|v| (i, v.overall)))
             .fold(None, |best: Option<(usize, f64)>, (i, e)| match best {
-                Some((_, b)) if e > (1.0 - margin) * b => best,
+                Some((_, b)) if e > (1.0 - margin) * b || b < EXACT => best,
                 _ => Some((i, e)),
             })
     };
@@ -380,13 +389,13 @@ pub fn choose(
                 scores.push(Score { candidate, held_out });
             }
             match best(&scores[first..], &|_| true, 0.0) {
-                Some((i, e)) if e <= (1.0 - MIN_GAIN) * error => {
+                Some((i, e)) if error >= EXACT && e <= (1.0 - MIN_GAIN) * error => {
                     (kept, error, current) = (first + i, e, trials[i]);
                 }
                 _ => break,
             }
         }
-        if error < overall_error {
+        if error < overall_error && overall_error >= EXACT {
             chosen = kept;
         }
     }
@@ -532,6 +541,9 @@ impl Scoring {
         added: &dyn Fn(usize) -> Vec<Option<&'c JointColumn>>,
     ) -> Result<Validation, String> {
         let (err2, tau2) = folds.held_out_sums(solutions, added);
+        if err2.iter().chain(&tau2).any(|x| !x.is_finite()) {
+            return Err("the held-out errors are not finite (values too large)".into());
+        }
         Validation::from_sums(&self.names, self.samples, &err2, &tau2).map_err(|e| e.to_string())
     }
 

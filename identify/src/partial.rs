@@ -14,7 +14,7 @@
 //!
 //! What needs the rows themselves cannot be formed from merged factors, and is
 //! refused when a partial is made ([`Partial::from_trajectory`]): the Coulomb
-//! smoothing ε chosen on the fit residual (`FrictionAuto`), the nonlinear Stribeck
+//! smoothing ε chosen on held-out time blocks (`FrictionAuto`), the nonlinear Stribeck
 //! fit with its held-out blocks, and MIM (body by body from the joint wrenches).
 //! A partial holds no estimate, so predicting or plotting recordings is left to the
 //! merged result.

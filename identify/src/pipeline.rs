@@ -128,8 +128,8 @@ pub struct IdentifyOptions {
     /// Friction and rotor inertia ([`Mode::Standard`] only).
     pub joints: JointTerms,
     /// With [`JointTerms::FrictionAuto`]: each joint's Coulomb smoothing `ε`, found
-    /// elsewhere (by the model choice, [`crate::choice`]). `None`: searched by the
-    /// fit residual.
+    /// elsewhere (by the model choice, [`crate::choice::choose`]). `None`: chosen on
+    /// held-out time blocks of the recording ([`crate::choice::epsilons`]).
     pub epsilons: Option<Vec<f64>>,
     /// The rotor inertias `Ia` on their own ([`Mode::Standard`] only): `None` fits
     /// them with the friction terms, as [`IdentifyOptions::joints`] says;

@@ -49,7 +49,7 @@ pub const MIN_SAMPLES: usize = 2 * BLOCKS;
 
 /// The choice is made on at most this many samples, spread evenly over the
 /// recording (the identification that follows uses all of them).
-pub const CHOICE_SAMPLES: usize = 20_000;
+pub const CHOICE_SAMPLES: usize = 10_000;
 
 /// At most this many numbers of the wide regressor's rows are held (16 M: 128 MB);
 /// fewer samples are taken where they would pass it.
@@ -522,7 +522,7 @@ impl Layout {
 }
 
 /// A function of a joint's velocity: one column of a grid.
-type OfVelocity = Box<dyn Fn(f64) -> f64>;
+type OfVelocity = Box<dyn Fn(f64) -> f64 + Send + Sync>;
 
 /// What every candidate's score needs besides the rows.
 struct Scoring {
@@ -613,15 +613,14 @@ impl Scoring {
         Ok((at, validation))
     }
 
-    /// Each joint's columns `functions` of its velocity.
-    fn grids(&self, data: &Blocks, functions: impl Fn(usize) -> Vec<OfVelocity>) -> Vec<Vec<JointColumn>> {
-        (0..self.layout.n)
-            .map(|j| {
-                let functions = functions(j);
-                let refs: Vec<&dyn Fn(f64) -> f64> = functions.iter().map(|f| f.as_ref()).collect();
-                data.columns_of_velocity(j, &refs)
-            })
-            .collect()
+    /// Each joint's columns `functions` of its velocity, the joints spread over
+    /// the cores.
+    fn grids(&self, data: &Blocks, functions: impl Fn(usize) -> Vec<OfVelocity> + Sync) -> Vec<Vec<JointColumn>> {
+        in_parallel(self.layout.n, |j| {
+            let functions = functions(j);
+            let refs: Vec<&dyn Fn(f64) -> f64> = functions.iter().map(|f| f.as_ref() as &dyn Fn(f64) -> f64).collect();
+            data.columns_of_velocity(j, &refs)
+        })
     }
 
     /// `auto`: `candidate`'s columns but the Coulomb ones, which are

@@ -249,7 +249,7 @@ pub fn fit_joint(
     coulomb: Coulomb,
     range: (f64, f64),
     constraints: JointConstraints,
-    starts: Starts<'_>,
+    starts: Starts,
     options: &LmOptions,
 ) -> JointFit {
     let (lo, hi) = range;
@@ -285,7 +285,6 @@ pub fn fit_joint(
         Starts::Grid => (0..=GRID)
             .map(|k| lo * (hi / lo).powf(k as f64 / GRID as f64))
             .collect(),
-        Starts::These(vs) => vs.iter().map(|v| v.clamp(lo, hi)).collect(),
     };
     for vs in candidates {
         if let Some(q) = linear_at(v, a, target, vs, coulomb, constraints) {
@@ -350,13 +349,11 @@ pub fn fit_joint(
 
 /// Values of `vs` [`fit_joint`] tries before its Levenberg–Marquardt iterations.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Starts<'a> {
+pub enum Starts {
     /// Only the start.
     None,
     /// A grid of 17 log-spaced values over the range.
     Grid,
-    /// These (clamped to the range).
-    These(&'a [f64]),
 }
 
 /// Points of the `vs` grid in [`fit_joint`], minus one (log-spaced over the range).
@@ -752,10 +749,10 @@ impl fmt::Display for StribeckFit {
 ///
 /// The kept terms are then refined with the whole fit. A long recording is fitted
 /// first on at most [`ROUND_SAMPLES`] samples spread over it (the rounds, each a
-/// linear fit, are then cheap), and the result carried to every sample by one
-/// linear fit and at most [`FINAL_ROUNDS`] more rounds; a round is accepted only
-/// where it lowers the cost over every sample, so the fit is never worse than
-/// `start`. A joint whose refined term fails the physical check falls back, and the
+/// linear fit, are then cheap), and each joint's `Fs − Fc` and `vs` carried to
+/// every sample by one linear fit with them held, kept only where it lowers the
+/// cost over every sample (a round on the part, likewise, where it lowers the cost
+/// there), so the fit is never worse than `start`. A joint whose refined term fails the physical check falls back, and the
 /// refinement runs again without it.
 pub fn refine<E>(
     dynamics: &dyn Dynamics,
@@ -960,7 +957,7 @@ fn refine_allowed<E>(
     if !allowed.iter().any(|&a| a) {
         // Nothing to refine: the linear fit as it is.
     } else if stride == 1 {
-        state = rounds(dynamics, traj, full, &setup, state, None, MAX_ROUNDS, linear_fit)?;
+        state = rounds(dynamics, traj, full, &setup, state, MAX_ROUNDS, linear_fit)?;
     } else if let Some(part) = every(traj, stride) {
         let columns = Columns::new(&part, n);
         let estimate = linear_fit(&part)?;
@@ -976,16 +973,30 @@ fn refine_allowed<E>(
                 rigid,
                 ..state.clone()
             },
-            None,
             MAX_ROUNDS,
             linear_fit,
         )?;
-        // Each joint's vs carried to every sample: the first round there starts
-        // from it (Fs and the linear terms fitted for it), rounds counted on.
-        let vs: Vec<f64> = found.stribeck.iter().map(|s| s.vs).collect();
-        state.rounds = found.rounds;
-        state.iterations = found.iterations;
-        state = rounds(dynamics, traj, full, &setup, state, Some(&vs), FINAL_ROUNDS, linear_fit)?;
+        // Each joint's Fs − Fc and vs carried to every sample by one linear fit
+        // with them held, kept if it lowers the cost there. The σ of Fs and vs,
+        // from the part, scale as 1/√samples to every sample.
+        let excess: Vec<f64> = (0..n)
+            .map(|j| found.stribeck[j].fs - joint_linear(&found.estimate.solution, n, j)[2])
+            .collect();
+        if let Some((estimate, stribeck)) = relinearise(traj, full, coulomb, &excess, &found.stribeck, linear_fit)? {
+            let (cost, rigid) = total_cost(dynamics, traj, &estimate.solution, &stribeck, coulomb);
+            if cost < state.cost {
+                let scale = (part.len() as f64 / traj.len() as f64).sqrt();
+                state = State {
+                    estimate,
+                    stribeck,
+                    sigma: found.sigma.iter().map(|s| s.map(|x| x.map(|x| x * scale))).collect(),
+                    iterations: found.iterations,
+                    rounds: found.rounds,
+                    cost,
+                    rigid,
+                };
+            }
+        }
     }
     let fc = (0..n)
         .map(|j| joint_linear(&state.estimate.solution, n, j)[2])
@@ -1023,9 +1034,6 @@ struct Setup<'a> {
 
 /// Samples the rounds of [`refine`] run on, at most.
 pub const ROUND_SAMPLES: usize = 20_000;
-
-/// Rounds of [`refine`] on every sample of a recording longer than [`ROUND_SAMPLES`].
-pub const FINAL_ROUNDS: usize = 2;
 
 /// Where [`refine`] is: the linear fit, the Stribeck terms, and the cost with the
 /// rigid-body torques it was computed with (row-major, samples × joints).
@@ -1107,7 +1115,7 @@ fn relinearise<E>(
 
 /// Up to `max` alternating rounds from `state`, each accepted only if it lowers the
 /// cost: (1) every joint's Levenberg–Marquardt fit with the rigid-body torques held
-/// (from a grid of `vs` in the first round when `grid`), (2) the linear fit with each
+/// (from a grid of `vs` in the first round), (2) the linear fit with each
 /// joint's `Fs − Fc` and `vs` held.
 #[allow(clippy::too_many_arguments)]
 fn rounds<E>(
@@ -1116,7 +1124,6 @@ fn rounds<E>(
     columns: &Columns,
     setup: &Setup<'_>,
     mut state: State,
-    hint: Option<&[f64]>,
     max: usize,
     linear_fit: &mut impl FnMut(&Trajectory) -> Result<Estimate, E>,
 ) -> Result<State, E> {
@@ -1139,11 +1146,7 @@ fn rounds<E>(
                     coulomb,
                     range,
                     setup.constraints,
-                    match (round, hint) {
-                        (0, None) => Starts::Grid,
-                        (0, Some(vs)) => Starts::These(&vs[j..j + 1]),
-                        _ => Starts::None,
-                    },
+                    if round == 0 { Starts::Grid } else { Starts::None },
                     &ROUND_LM,
                 ),
                 _ => {

@@ -43,6 +43,20 @@ pub(crate) fn norm(a: &[f64]) -> f64 {
 }
 
 /// `xᵀ C x` for a square matrix `C`.
+/// `‖new − old‖ / ‖new‖` (0 where both are 0).
+pub(crate) fn relative_change(new: &[f64], old: &[f64]) -> f64 {
+    let (mut change, mut size) = (0.0, 0.0);
+    for (a, b) in new.iter().zip(old) {
+        change += (a - b) * (a - b);
+        size += a * a;
+    }
+    if size > 0.0 {
+        (change / size).sqrt()
+    } else {
+        change.sqrt()
+    }
+}
+
 pub(crate) fn quadratic_form(c: MatRef<'_, f64>, x: &[f64]) -> f64 {
     dot(x, &mat_vec(c, x))
 }

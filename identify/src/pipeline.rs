@@ -113,12 +113,13 @@ pub enum JointTerms {
 
 /// Refits of the load-dependent friction's alternation, at most.
 pub const LOAD_ROUNDS: usize = 8;
-/// The alternation stops when no parameter changes by more than this fraction.
-pub const LOAD_TOLERANCE: f64 = 1e-6;
+/// The alternation stops when the links' load (every row's rigid-body torque)
+/// changes by less than this fraction (relative RMS).
+pub const LOAD_CHANGE: f64 = 1e-4;
 
 /// Samples the load-dependent friction's alternation runs on, at most (then it fits
 /// once on all).
-pub const LOAD_SAMPLES: usize = 20_000;
+pub const LOAD_SAMPLES: usize = 10_000;
 
 /// Everything [`load`] and [`identify`] need besides the data and the robot.
 #[derive(Clone, Debug, PartialEq)]
@@ -535,26 +536,45 @@ fn from_torques(
         }
         _ => torque_regressor(options),
     };
-    let mut acc = accumulate(dynamics, traj, &regressor, 1, None, options)?;
     let fit = TorqueFit::new(dynamics.model(), regressor.clone(), options);
+    // With the load-dependent friction, the load of each row from the rigid-body
+    // parameters of the fit before (the first fit has no load term), until the
+    // load settles: on at most LOAD_SAMPLES samples spread over the recording, then
+    // once on all.
+    let stride = match options.extras.load {
+        true => traj.len().div_ceil(LOAD_SAMPLES).max(1),
+        false => 1,
+    };
+    let mut acc = accumulate(dynamics, traj, &regressor, stride, None, options)?;
     let (mut estimate, mut warnings) = fit.first(&acc, || Some(largest_input(traj)))?;
     if options.extras.load {
-        // The load of each row from the rigid-body parameters of the fit before
-        // (the first fit has no load term), until the parameters settle: on at most
-        // LOAD_SAMPLES samples spread over the recording, then once on all.
         let rigid = 10 * dynamics.model().dof();
-        let stride = traj.len().div_ceil(LOAD_SAMPLES).max(1);
+        let loads = |params: &[f64]| -> Vec<f64> {
+            let mut tau = vec![0.0; dynamics.nv()];
+            (0..traj.len())
+                .step_by(stride)
+                .flat_map(|k| {
+                    let (q, v, a) = state(traj, k);
+                    dynamics.rnea(q, v, a, &params[..rigid], &mut tau);
+                    tau.clone()
+                })
+                .collect()
+        };
+        let mut load = loads(&estimate.solution);
         for _ in 0..LOAD_ROUNDS {
-            let previous = estimate.solution.clone();
-            let sampled = accumulate(dynamics, traj, &regressor, stride, Some(&previous[..rigid]), options)?;
+            let sampled = accumulate(
+                dynamics,
+                traj,
+                &regressor,
+                stride,
+                Some(&estimate.solution[..rigid]),
+                options,
+            )?;
             (estimate, _) = fit.first(&sampled, || Some(largest_input(traj)))?;
-            let change = estimate
-                .solution
-                .iter()
-                .zip(&previous)
-                .map(|(a, b)| (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE))
-                .fold(0.0, f64::max);
-            if change < LOAD_TOLERANCE {
+            let next = loads(&estimate.solution);
+            let change = crate::dense::relative_change(&next, &load);
+            load = next;
+            if change < LOAD_CHANGE {
                 break;
             }
         }

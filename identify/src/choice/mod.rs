@@ -34,7 +34,7 @@ use crate::data::Trajectory;
 use crate::extras::ExtraTerms;
 use crate::friction::EPSILON_RANGE;
 use crate::mim::{JointModel, TorqueRegressor};
-use crate::pipeline::{IdentifyOptions, JointTerms, Mode, PipelineError, LOAD_ROUNDS};
+use crate::pipeline::{IdentifyOptions, JointTerms, Mode, PipelineError, LOAD_CHANGE, LOAD_ROUNDS};
 use crate::validate::Validation;
 use blocks::{Blocks, Folds, JointColumn, Solution};
 use dyngen_model::joint_params::{Coulomb, PER_JOINT};
@@ -67,10 +67,6 @@ pub const EPSILON_GRID: usize = 25;
 /// Values of the Stribeck velocity tried per joint, evenly spaced in `log vs` over
 /// the joint's range ([`crate::stribeck::velocity_range`]).
 pub const VS_GRID: usize = 16;
-
-/// The load-dependent friction's alternation stops, in the choice, when the links'
-/// load changes by less than this fraction.
-const LOAD_CHANGE: f64 = 1e-4;
 
 /// Sweeps over the joints of the per-joint searches.
 const SWEEPS: usize = 2;
@@ -710,13 +706,10 @@ impl Scoring {
                     break;
                 }
                 let next = loads(&solution);
-                let (mut change, mut size) = (0.0, 0.0);
-                for (a, b) in next.iter().flatten().flatten().zip(load.iter().flatten().flatten()) {
-                    change += (a - b) * (a - b);
-                    size += a * a;
-                }
+                let flat = |l: &[Vec<Vec<f64>>]| -> Vec<f64> { l.iter().flatten().flatten().copied().collect() };
+                let change = crate::dense::relative_change(&flat(&next), &flat(&load));
                 load = next;
-                if change <= LOAD_CHANGE * LOAD_CHANGE * size {
+                if change < LOAD_CHANGE {
                     break;
                 }
             }

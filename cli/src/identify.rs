@@ -14,6 +14,8 @@ use dyngen_identify::report::{self, DataSpan, MergedLinks, Parameterisation};
 use dyngen_identify::{Accumulation, Estimate};
 use dyngen_model::joint_params::Coulomb;
 use dyngen_model::Model;
+use dyngen_nim::residual::{fit_residual, ResidualOptions};
+use dyngen_nim::NimError;
 use dyngen_reference::Reference;
 use std::path::{Path, PathBuf};
 
@@ -277,6 +279,15 @@ pub struct IdentifyArgs {
     /// with the identified model and print the errors per joint and overall.
     #[arg(long, value_name = "CSV")]
     pub validate: Option<PathBuf>,
+
+    /// Train a learned residual on what the identified model leaves in the torques:
+    /// a small network over the joint state (q, sin q, cos q, q̇, q̈ per joint),
+    /// trained on the first 75 % of the recording and kept, written to FILE (the
+    /// network's JSON), only if it lowers the error on the last 25 % by 1 %. The
+    /// physical parameters are those identified either way. --validate then
+    /// predicts with and without it; `dyngen validate --residual FILE` adds it.
+    #[arg(long, value_name = "FILE")]
+    pub residual: Option<PathBuf>,
 
     /// With --validate: use only the validation recording's samples with
     /// t0 ≤ t ≤ t1 (s). The training --window (or the recipe's window and rows) is
@@ -615,6 +626,12 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
         }
     }
     if args.partial.is_some() || !args.merge.is_empty() {
+        if args.residual.is_some() {
+            return Err(CliError::usage(
+                "--residual trains on the recording's samples, which partial factors do not keep; train it on one \
+                 recording",
+            ));
+        }
         return crate::partial::run(args, progress);
     }
     let data = args
@@ -730,6 +747,28 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
     if let Some(path) = &args.svg {
         write_svg(args, data, path, &robot, &traj, &identified, progress)?;
     }
+    let residual = match &args.residual {
+        None => None,
+        Some(path) => {
+            let predicted = identified.predict(&robot, &traj).map_err(|e| pipeline_error(data, e))?;
+            let fit = with_spinner(progress, "training the residual network", || {
+                fit_residual(&traj, &predicted, &ResidualOptions::default())
+            })
+            .map_err(|e| CliError::failed(format!("--residual: {e}")))?;
+            outln!("{fit}");
+            if fit.kept {
+                fit.net.save(path, args.force).map_err(|e| match e {
+                    NimError::AlreadyExists { .. } => CliError::OutputExists(path.clone()),
+                    e => CliError::output(path, e),
+                })?;
+                outln!("wrote the residual network to {}", path.display());
+                Some(fit.net)
+            } else {
+                outln!("--residual: {} not written", path.display());
+                None
+            }
+        }
+    };
     if let Some(path) = &args.validate {
         let other = load_recording(path, &validation_recipe, n, cutoff, low_pass_states)?;
         let how = match (&args.validate_recipe, &args.validate_window) {
@@ -755,6 +794,15 @@ pub fn run(args: &IdentifyArgs, progress: &Progress) -> Result<()> {
             path.display(),
             crate::validate::exact_overall(&validation)
         );
+        if let Some(net) = &residual {
+            let with = crate::validate::with_residual(net, &other, predicted, path)?;
+            let validation = crate::validate::validation(&model, &other, &with, None)?;
+            outln!(
+                "prediction of {} with the learned residual:\n{validation}\n{}",
+                path.display(),
+                crate::validate::exact_overall(&validation)
+            );
+        }
     }
     Ok(())
 }
@@ -840,6 +888,7 @@ pub fn check_outputs(args: &IdentifyArgs) -> Result<()> {
         ("--svg", &args.svg),
         ("--urdf-out", &args.urdf_out),
         ("--urdf-out's joint parameters", &beside),
+        ("--residual", &args.residual),
     ]
     .into_iter()
     .filter_map(|(flag, p)| p.as_ref().map(|p| (flag, p)))

@@ -10,6 +10,7 @@ use dyngen_identify::pipeline;
 use dyngen_identify::report::{self, ParameterReport};
 use dyngen_identify::validate::Validation;
 use dyngen_model::Model;
+use dyngen_nim::residual::ResidualNet;
 use dyngen_reference::Reference;
 use std::path::{Path, PathBuf};
 
@@ -41,6 +42,11 @@ pub struct ValidateArgs {
     /// Write measured against predicted torque per joint as SVG.
     #[arg(long, value_name = "FILE")]
     pub svg: Option<PathBuf>,
+
+    /// Add the learned residual that `dyngen identify --residual FILE` wrote to
+    /// the parameters' prediction.
+    #[arg(long, value_name = "FILE")]
+    pub residual: Option<PathBuf>,
 
     /// Replace an existing SVG.
     #[arg(long)]
@@ -89,6 +95,23 @@ pub fn validation(
 }
 
 /// The overall relative error to full precision, for comparing two runs exactly.
+/// `predicted` (one row per sample of `data`) plus the residual network's torques;
+/// `path` names the recording in errors.
+pub fn with_residual(
+    net: &ResidualNet,
+    data: &Trajectory,
+    mut predicted: Vec<Vec<f64>>,
+    path: &Path,
+) -> Result<Vec<Vec<f64>>> {
+    let residual = net.predict_all(data).map_err(|e| CliError::input(path, e))?;
+    for (row, r) in predicted.iter_mut().zip(&residual) {
+        for (p, r) in row.iter_mut().zip(r) {
+            *p += r;
+        }
+    }
+    Ok(predicted)
+}
+
 pub fn exact_overall(v: &Validation) -> String {
     format!("(as a fraction, full precision: {:?})", v.overall)
 }
@@ -293,6 +316,14 @@ pub fn run(args: &ValidateArgs, _progress: &Progress) -> Result<()> {
         pipeline::PipelineError::InvalidOption { reason, .. } => CliError::input(&args.params, reason),
         e => pipeline_error(&args.data, e),
     })?;
+    let predicted = match &args.residual {
+        None => predicted,
+        Some(path) => {
+            let net = ResidualNet::load(path, model.nv()).map_err(|e| CliError::input(path, e))?;
+            outln!("with the learned residual of {}", path.display());
+            with_residual(&net, &data, predicted, &args.data)?
+        }
+    };
     let validation = validation(&model, &data, &predicted, Some(&args.params))?;
     outln!("{validation}\n{}", exact_overall(&validation));
     if let Some(path) = &args.svg {

@@ -68,6 +68,7 @@ mod identifier;
 mod mlp;
 pub mod online;
 mod paper;
+pub mod residual;
 mod train;
 mod window;
 

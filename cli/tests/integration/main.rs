@@ -15,5 +15,6 @@ mod logs;
 mod nim;
 mod partial;
 mod preprocessing;
+mod residual;
 mod robust;
 mod validate;

@@ -60,10 +60,13 @@ per joint direction-dependent viscous friction Fva·|q̇|, harmonics of the join
 (torque ripple and position-dependent Coulomb friction), harmonics of the motor angle
 (motor-ripple=H, with --gear-ratios) and Coulomb friction growing with the links'
 load Fcl·|τ_rigid|·s(q̇), with --friction sign, smooth or auto.
---friction best fits none, sign (without and with Ia), auto and stribeck on three of
-four time blocks of the recording, scores each on the block left out, adds extra
-terms to the best linear model one at a time while each lowers the held-out error by
-1 %, prints the errors and identifies with the best. --validate predicts a second
+--friction best, the default, fits none, sign (without and with Ia), auto and
+stribeck on three of four time blocks of the recording, scores each on the block
+left out (a more complex model must lower the error by 1 %), adds extra terms to the
+best linear model one at a time while each lowers the held-out error by 1 %, prints
+the errors and identifies with the best. --residual FILE adds a learned residual
+(one small network per joint) where it lowers the error on the recording's last
+quarter. --validate predicts a second
 recording with the result.
 --method consistent keeps every body physical and (with friction) Ia, Fv, Fc >= 0,
 with --friction stribeck too; --exclude-below SPEED leaves out a joint's rows where

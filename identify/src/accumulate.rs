@@ -763,7 +763,7 @@ pub(crate) fn cores() -> usize {
 
 /// `f(i)` for `i` in `0..n`, spread over the machine's cores (round robin), returned
 /// in index order; on one core (or for one item) without spawning a thread.
-pub(crate) fn in_parallel<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+pub fn in_parallel<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let threads = cores().clamp(1, n.max(1));
     if threads <= 1 {
         return (0..n).map(f).collect();

@@ -57,7 +57,9 @@ mod subspace;
 
 pub use faer;
 
-pub use accumulate::{Accumulation, Accumulator, AccumulatorState, ChannelState, NORMAL_EQUATIONS_RESOLUTION};
+pub use accumulate::{
+    in_parallel, Accumulation, Accumulator, AccumulatorState, ChannelState, NORMAL_EQUATIONS_RESOLUTION,
+};
 pub use error::{IdentifyError, Input};
 pub use estimate::{
     ActiveConstraint, Combination, ConstraintKind, Estimate, Method, ParamEstimate, Residuals, Status, Table,

@@ -345,23 +345,8 @@ pub fn fit_residual(
         };
         Ok(train(&sizes, &data, None, &options)?.0)
     };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |c| c.get())
-        .clamp(1, n.max(1));
-    let mut trained: Vec<(usize, Result<Mlp, NimError>)> = std::thread::scope(|s| {
-        let train_joint = &train_joint;
-        let handles: Vec<_> = (0..threads)
-            .map(|t| s.spawn(move || (t..n).step_by(threads).map(|j| (j, train_joint(j))).collect::<Vec<_>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    trained.sort_by_key(|(j, _)| *j);
-    let nets = trained
+    let nets = dyngen_identify::in_parallel(n, train_joint)
         .into_iter()
-        .map(|(_, net)| net)
         .collect::<Result<Vec<Mlp>, NimError>>()?;
     let net = ResidualNet::new(nets)?;
     // The held-out end: the physical model alone and with the residual.

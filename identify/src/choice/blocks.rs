@@ -30,7 +30,8 @@ use dyngen_reference::Dynamics;
 use faer::prelude::Solve;
 use faer::{Mat, Side};
 
-/// The ridge on the normal equations, relative to their diagonal.
+/// The ridge on the normal equations, relative to their diagonal (up to 10⁶ times
+/// more where rounding makes them indefinite).
 const RIDGE: f64 = 1e-12;
 
 /// One joint's rows in one time block: the regressor on the columns the joint's
@@ -311,7 +312,7 @@ impl Blocks {
             .map(|f| {
                 let mut g = Mat::<f64>::zeros(s, s);
                 let mut rhs = vec![0.0; s];
-                for (_, block) in self.fit.iter().enumerate().filter(|(b, _)| *b != f) {
+                for block in self.fit.iter().enumerate().filter(|(b, _)| *b != f).map(|(_, g)| g) {
                     for (i, &ci) in columns.iter().enumerate() {
                         for (k, &ck) in columns.iter().enumerate() {
                             g[(i, k)] += block[(ci, ck)];
@@ -319,15 +320,19 @@ impl Blocks {
                         rhs[i] += block[(ci, self.p)];
                     }
                 }
-                for i in 0..s {
-                    let d = g[(i, i)];
-                    g[(i, i)] = if d > 0.0 { d * (1.0 + RIDGE) } else { 1.0 };
-                }
-                let l = g
-                    .llt(Side::Lower)
-                    .map_err(|_| "the normal equations are not positive definite".to_string())?
-                    .L()
-                    .to_owned();
+                // A larger ridge where rounding leaves a pivot of a direction the
+                // data cannot see below zero.
+                let l = [RIDGE, 1e3 * RIDGE, 1e6 * RIDGE]
+                    .into_iter()
+                    .find_map(|ridge| {
+                        let mut g = g.clone();
+                        for i in 0..s {
+                            let d = g[(i, i)];
+                            g[(i, i)] = if d > 0.0 { d * (1.0 + ridge) } else { 1.0 };
+                        }
+                        g.llt(Side::Lower).ok().map(|llt| llt.L().to_owned())
+                    })
+                    .ok_or_else(|| "the normal equations are not positive definite".to_string())?;
                 let mut u = Mat::from_fn(s, 1, |i, _| rhs[i]);
                 l.solve_lower_triangular_in_place(u.as_mut());
                 Ok(Fold { l, u })
@@ -388,7 +393,7 @@ impl Folds<'_> {
         for (j, col) in added.iter().enumerate() {
             let Some(col) = col else { continue };
             let mut dd = 0.0;
-            for (_, cross) in col.fit.iter().enumerate().filter(|(b, _)| *b != f) {
+            for cross in col.fit.iter().enumerate().filter(|(b, _)| *b != f).map(|(_, c)| c) {
                 for (i, &c) in self.columns.iter().enumerate() {
                     a[(i, j)] += cross.xc[c];
                 }

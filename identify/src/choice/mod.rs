@@ -4,8 +4,8 @@
 //! the block left out, every block in turn. The candidate with the lowest error on
 //! the held-out blocks wins, a more complex one only where it lowers the error of
 //! the simpler by [`MIN_GAIN`]: a model that only fits the noise of its own data
-//! does not. Sign friction is a candidate, so the choice is never worse than it on
-//! the held-out blocks.
+//! does not. The choice is never worse than sign friction on the held-out blocks:
+//! where a simpler model within the margin would be, sign friction is chosen.
 //!
 //! Then the extra joint terms ([`crate::extras`]) are added to the best linear
 //! friction model (sign, with or without rotor inertia, or the fitted smoothing)
@@ -17,7 +17,7 @@
 //! those chosen without the extra terms.
 //!
 //! Every candidate is scored from one pass of one wide regressor over the sampled
-//! recording ([`blocks`]): a fit on three blocks and its error on the fourth come
+//! recording (module `blocks`): a fit on three blocks and its error on the fourth come
 //! from the blocks' Gram matrices, so the choice costs a regressor pass and a few
 //! hundred small factorisations, not a fit per candidate and block. Candidates are
 //! scored by least squares (the identification that follows uses the estimator
@@ -393,6 +393,14 @@ pub fn choose(
         }
         if error < overall_error && overall_error >= EXACT {
             chosen = kept;
+        }
+    }
+    // Never worse than sign friction on the held-out blocks (a simpler model within
+    // the margin of it may be).
+    let error_of = |i: usize| scores[i].held_out.as_ref().map_or(f64::INFINITY, |v| v.overall);
+    if let Some(sign) = scores.iter().position(|s| s.candidate == CANDIDATES[2]) {
+        if error_of(chosen) > error_of(sign) {
+            chosen = sign;
         }
     }
     Ok(ModelChoice {

@@ -68,7 +68,7 @@ the errors and identifies with the best. --residual FILE adds a learned residual
 (one small network per joint) where it lowers the error on the recording's last
 quarter. --validate predicts a second
 recording with the result.
---method consistent keeps every body physical and (with friction) Ia, Fv, Fc >= 0,
+--method consistent keeps every body physical and (with friction) Ia, Fv, Fc (and Fcl) >= 0,
 with --friction stribeck too; --exclude-below SPEED leaves out a joint's rows where
 it moves slower than SPEED (rad/s), where sticking defeats the Coulomb model.
 

@@ -813,8 +813,8 @@ impl<'a> TorqueFit<'a> {
         let mut report =
             ParameterReport::from_estimate(&model.name, parameterisation, &estimate, &name_refs, &joint_names);
         let nonphysical = match &regressor {
-            TorqueRegressor::StandardAndJoints(..) => {
-                let values: Vec<Option<f64>> = report.parameters[10 * bodies..10 * bodies + PER_JOINT * n]
+            TorqueRegressor::StandardAndJoints(m) => {
+                let values: Vec<Option<f64>> = report.parameters[10 * bodies..]
                     .iter()
                     .map(|p| match p.status {
                         // Not told apart from zero (or from the prior): not reported as identified.
@@ -822,7 +822,8 @@ impl<'a> TorqueFit<'a> {
                         _ => p.value,
                     })
                     .collect();
-                nonphysical_joint_terms(&values, &joint_names)
+                let (joint_terms, extra_terms) = values.split_at(PER_JOINT * n);
+                nonphysical_joint_terms(joint_terms, m.extras, extra_terms, &joint_names)
             }
             _ => Vec::new(),
         };
@@ -832,14 +833,14 @@ impl<'a> TorqueFit<'a> {
                 .map(|p| format!("{} = {:.4e} (`{}`)", p.parameter, p.value, p.joint))
                 .collect();
             let remedy = if options.estimator == Estimator::Consistent {
-                "--method consistent was used, which keeps Ia, Fv and Fc >= 0 only to its numerical tolerance: \
-                 treat these as zero"
+                "--method consistent was used, which keeps Ia, Fv, Fc (and Fcl) >= 0 only to its numerical \
+                 tolerance: treat these as zero"
             } else {
-                "--method consistent keeps every joint's Ia, Fv and Fc >= 0 (and every body physical): try it"
+                "--method consistent keeps every joint's Ia, Fv, Fc and Fcl >= 0 (and every body physical): try it"
             };
             warnings.push(format!(
-                "non-physical joint parameters reported: {} (a negative rotor inertia, viscous or Coulomb friction is \
-                 not physical); {remedy}",
+                "non-physical joint parameters reported: {} (a negative rotor inertia, viscous, Coulomb or \
+                 load-dependent friction, or |Fva| above Fv, is not physical); {remedy}",
                 list.join("; ")
             ));
         }
@@ -892,33 +893,69 @@ impl<'a> TorqueFit<'a> {
     }
 }
 
-/// The joint parameters among `values` (per joint `[Ia, Fv, Fc, F0]`, `None` where
-/// no value is reported) that are not physical: a negative rotor inertia `Ia`,
-/// viscous friction `Fv` or Coulomb friction `Fc` (the offset `F0` may have either
-/// sign). `joints` names the joints (missing names become `joint <j>`).
-pub fn nonphysical_joint_terms(values: &[Option<f64>], joints: &[&str]) -> Vec<NonPhysical> {
+/// The joint parameters among `values` (per joint `[Ia, Fv, Fc, F0]`) and
+/// `extra_values` (per joint the extra terms `extras`), `None` where no value is
+/// reported, that are not physical: a negative rotor inertia `Ia`, viscous
+/// friction `Fv`, Coulomb friction `Fc` or load-dependent friction `Fcl` (friction
+/// that falls as the load grows turns negative under a large load), or a
+/// direction-dependent viscous friction `|Fva|` above `Fv` (the viscous friction
+/// `Fv ± Fva` is then negative in one direction). The offset `F0`, the ripple and
+/// the position-dependent Coulomb terms may have either sign. `joints` names the
+/// joints (missing names become `joint <j>`).
+pub fn nonphysical_joint_terms(
+    values: &[Option<f64>],
+    extras: ExtraTerms,
+    extra_values: &[Option<f64>],
+    joints: &[&str],
+) -> Vec<NonPhysical> {
     const WHAT: [&str; 3] = [
         "a negative rotor inertia",
         "a negative viscous friction",
         "a negative Coulomb friction",
     ];
-    values
-        .chunks(PER_JOINT)
-        .enumerate()
-        .flat_map(|(j, terms)| {
-            terms.iter().take(3).enumerate().filter_map(move |(k, v)| {
-                let v = (*v)?;
-                (v < 0.0).then(|| NonPhysical {
-                    joint: joints
-                        .get(j)
-                        .map_or_else(|| format!("joint {}", j + 1), |s| s.to_string()),
+    let joint = |j: usize| {
+        joints
+            .get(j)
+            .map_or_else(|| format!("joint {}", j + 1), |s| s.to_string())
+    };
+    let per_joint = extras.per_joint();
+    let mut flagged = Vec::new();
+    for (j, terms) in values.chunks(PER_JOINT).enumerate() {
+        for (k, v) in terms.iter().take(3).enumerate() {
+            if let Some(v) = v.filter(|v| *v < 0.0) {
+                flagged.push(NonPhysical {
+                    joint: joint(j),
                     parameter: dyngen_model::names::param_name(dyngen_model::joint_params::NAMES[k], j + 1),
                     value: v,
                     reason: format!("{} is not physical", WHAT[k]),
-                })
-            })
-        })
-        .collect()
+                });
+            }
+        }
+        let extra = |c: usize| extra_values.get(per_joint * j + c).copied().flatten();
+        if let Some(fva) = extra(0).filter(|_| extras.asymmetric) {
+            if terms.get(1).copied().flatten().is_some_and(|fv| fva.abs() > fv) {
+                flagged.push(NonPhysical {
+                    joint: joint(j),
+                    parameter: dyngen_model::names::param_name("Fva", j + 1),
+                    value: fva,
+                    reason: "|Fva| above Fv makes the viscous friction Fv ± Fva negative in one direction, which is \
+                             not physical"
+                        .into(),
+                });
+            }
+        }
+        if let Some(fcl) = extras.load_column().and_then(extra).filter(|v| *v < 0.0) {
+            flagged.push(NonPhysical {
+                joint: joint(j),
+                parameter: dyngen_model::names::param_name("Fcl", j + 1),
+                value: fcl,
+                reason: "a negative load-dependent friction (friction falling as the load grows, negative under a \
+                         large load) is not physical"
+                    .into(),
+            });
+        }
+    }
+    flagged
 }
 
 /// The input of `traj` of largest magnitude: its value, where it is and what it is.
@@ -975,12 +1012,20 @@ fn excluded_columns(regressor: &TorqueRegressor, model: &Model, fitted: [bool; P
 /// blocks first, then per coordinate `[Ia, Fv, Fc, F0]` with `Ia, Fv, Fc ≥ 0` (those
 /// fitted).
 fn consistent_options(regressor: &TorqueRegressor, model: &Model, fitted: [bool; PER_JOINT]) -> StandardOptions {
+    let mut nonnegative = joint_term_columns(regressor, model, |k| k < 3 && fitted[k]);
+    // The load-dependent friction's Fcl too.
+    if let TorqueRegressor::StandardAndJoints(m) = regressor {
+        if let Some(c) = m.extras.load_column() {
+            let first = 10 * model.dof() + PER_JOINT * model.nv();
+            nonnegative.extend((0..model.nv()).map(|j| first + m.extras.per_joint() * j + c));
+        }
+    }
     StandardOptions {
         layout: Some(Layout {
             first: 0,
             bodies: model.dof(),
         }),
-        nonnegative: joint_term_columns(regressor, model, |k| k < 3 && fitted[k]),
+        nonnegative,
         ..StandardOptions::default()
     }
 }
@@ -1677,7 +1722,7 @@ mod tests {
             None,
             Some(-1.0),
         ];
-        let flagged = nonphysical_joint_terms(&values, &["a", "b"]);
+        let flagged = nonphysical_joint_terms(&values, ExtraTerms::NONE, &[], &["a", "b"]);
         let got: Vec<(&str, &str, f64)> = flagged
             .iter()
             .map(|p| (p.joint.as_str(), p.parameter.as_str(), p.value))
@@ -1688,7 +1733,25 @@ mod tests {
         );
         assert!(flagged[0].reason.contains("viscous"), "{:?}", flagged[0]);
         assert!(flagged[1].reason.contains("rotor inertia"), "{:?}", flagged[1]);
-        assert!(nonphysical_joint_terms(&[Some(0.0); 8], &[]).is_empty());
+        assert!(nonphysical_joint_terms(&[Some(0.0); 8], ExtraTerms::NONE, &[], &[]).is_empty());
+        // The extra terms: |Fva| above Fv, and a negative Fcl; ripple of any sign.
+        let extras: ExtraTerms = "asymmetric,ripple=1,load".parse().unwrap();
+        let joint_terms = [
+            Some(0.1),
+            Some(2.0),
+            Some(1.0),
+            None,
+            Some(0.1),
+            Some(0.5),
+            Some(1.0),
+            None,
+        ];
+        let extra = |fva: f64, fcl: f64| [Some(fva), Some(-3.0), Some(3.0), Some(-1.0), Some(1.0), Some(fcl)];
+        let extra_values: Vec<Option<f64>> = [extra(-1.5, 0.02), extra(0.6, -0.01)].concat();
+        let flagged = nonphysical_joint_terms(&joint_terms, extras, &extra_values, &["a", "b"]);
+        let got: Vec<(&str, f64)> = flagged.iter().map(|p| (p.parameter.as_str(), p.value)).collect();
+        assert_eq!(got, [("Fva2", 0.6), ("Fcl2", -0.01)]);
+        assert!(flagged[0].reason.contains("Fv ± Fva"), "{:?}", flagged[0]);
     }
 
     #[test]

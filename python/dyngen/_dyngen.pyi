@@ -1,7 +1,7 @@
 """Type stubs of the native module ``dyngen._dyngen``."""
 
 import os
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -32,6 +32,7 @@ def identify(
     friction: Optional[str] = None,
     epsilon: float = 0.01,
     extra_terms: Optional[str] = None,
+    gear_ratios: Optional[Sequence[float]] = None,
     ridge_lambda: float = 1e-6,
     cutoff: float = 10.0,
     raw_states: bool = False,
@@ -49,7 +50,8 @@ def identify(
     of the recording best; the errors in ``model_choice``); by default ``"best"`` in
     the standard mode, ``"none"`` otherwise. ``extra_terms``: joint
     terms past friction (``"asymmetric"``, ``"ripple=H"``, ``"load"``, comma-separated)
-    with ``"sign"``, ``"smooth"`` or ``"auto"``; with ``"best"`` the terms it may add
+    and ``"motor-ripple=H"`` with ``gear_ratios`` (one per joint), with ``"sign"``,
+    ``"smooth"`` or ``"auto"``; with ``"best"`` the terms it may add
     (default ``"asymmetric,ripple=2,load"``, ``"none"`` for none). ``report``: write ``dyngen identify --report``'s SVG there
     (measured against predicted efforts per joint); an existing file raises
     ``FileExistsError`` unless ``overwrite``. Returns ``names``, ``values``, ``sigma``,

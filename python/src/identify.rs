@@ -31,6 +31,8 @@ struct Choices<'a> {
     raw_states: bool,
     /// `extra_terms` as given (`None`: not given).
     extra_terms: Option<&'a str>,
+    /// Each joint's gear ratio, for `motor-ripple=H`.
+    gear_ratios: Option<Vec<f64>>,
 }
 
 fn invalid(function: &str, option: &str, value: &str, valid: &[&str]) -> PyErr {
@@ -98,6 +100,7 @@ impl Choices<'_> {
             extras,
             cutoff_hz: self.cutoff,
             low_pass_states: !self.raw_states,
+            gear_ratios: self.gear_ratios.clone(),
             ..IdentifyOptions::default()
         };
         options
@@ -144,9 +147,12 @@ impl Choices<'_> {
 ///         `"auto"`: a comma-separated list of `"asymmetric"` (direction-dependent
 ///         viscous friction), `"ripple=H"` (`H` harmonics of the joint angle: torque
 ///         ripple and position-dependent Coulomb friction) and `"load"` (Coulomb
-///         friction growing with the links' load); `"motor-ripple=H"` needs gear
-///         ratios, which only the command line takes. With `"best"`: the terms
-///         it may add (default `"asymmetric,ripple=2,load"`; `"none"` for none).
+///         friction growing with the links' load) and `"motor-ripple=H"` (`H`
+///         harmonics of the motor angle, with `gear_ratios`). With `"best"`: the
+///         terms it may add (default `"asymmetric,ripple=2,load"`; `"none"` for
+///         none).
+///     gear_ratios: each joint's gear ratio `N_j` (motor angle `N_j q_j`), for
+///         `"motor-ripple=H"`.
 ///     ridge_lambda: the scale-free weight of `"ridge"`.
 ///     cutoff: low-pass cutoff (Hz) of the velocities and accelerations estimated
 ///         from positions, and of the measured states.
@@ -188,6 +194,7 @@ impl Choices<'_> {
     friction = None,
     epsilon = 0.01,
     extra_terms = None,
+    gear_ratios = None,
     ridge_lambda = 1e-6,
     cutoff = 10.0,
     raw_states = false,
@@ -207,6 +214,7 @@ pub fn identify<'py>(
     friction: Option<&str>,
     epsilon: f64,
     extra_terms: Option<&str>,
+    gear_ratios: Option<Vec<f64>>,
     ridge_lambda: f64,
     cutoff: f64,
     raw_states: bool,
@@ -234,6 +242,7 @@ pub fn identify<'py>(
         cutoff,
         raw_states,
         extra_terms,
+        gear_ratios,
     };
     let options = choices.options()?;
     let allowed_extras = choices.allowed_extras()?;
@@ -549,6 +558,7 @@ impl PyPartial {
             cutoff: 10.0,
             raw_states: false,
             extra_terms: None,
+            gear_ratios: None,
         }
         .options()?;
         let model = load_robot(&robot_path)?;
@@ -652,6 +662,7 @@ pub fn identify_partial(
         cutoff,
         raw_states,
         extra_terms: None,
+        gear_ratios: None,
     }
     .options()?;
     let failed =

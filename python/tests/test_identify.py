@@ -180,5 +180,15 @@ def test_best_friction_is_chosen_on_held_out_blocks(tmp_path):
     assert [name for name in result["names"] if name.startswith("Fva")] == [f"Fva{j}" for j in range(1, n + 1)]
     with pytest.raises(ValueError, match=re.escape("identify: extra_terms `bogus`: term 1 `bogus` is unknown")):
         dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="bogus")
+    # The motor angle's ripple with each joint's gear ratio, and without them.
+    ratios = [101.0, 101.0, 101.0, 51.0, 51.0, 51.0][:n]
+    result = dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="motor-ripple=1", gear_ratios=ratios,
+                             raw_states=True)
+    assert [name for name in result["names"] if name.startswith("Tms")] == [f"Tms1_{j}" for j in range(1, n + 1)]
+    assert '"gear_ratios"' in result["parameters_json"]
+    with pytest.raises(ValueError, match=re.escape("motor-ripple needs each joint's gear ratio")):
+        dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="motor-ripple=1")
+    with pytest.raises(ValueError, match=re.escape(f"2 values for {n} joints")):
+        dyngen.identify(ROBOTS[0][1], path, friction="sign", extra_terms="motor-ripple=1", gear_ratios=[1.0, 2.0])
     with pytest.raises(ValueError, match=re.escape("unknown friction `best`")):
         dyngen.identify_partial(ROBOTS[0][1], path, friction="best")

@@ -231,11 +231,11 @@ fn non_physical_joint_parameters_and_the_chosen_epsilon_are_reported() {
         assert!(err.contains(&format!("{name} = ")), "{err}");
     }
     assert!(
-        err.contains("--method consistent keeps every joint's Ia, Fv and Fc >= 0"),
+        err.contains("--method consistent keeps every joint's Ia, Fv, Fc and Fcl >= 0"),
         "{err}"
     );
 
-    // One ε per joint, chosen by the fit, in the JSON (the prediction's and the
+    // One ε per joint, chosen on held-out blocks, in the JSON (the prediction's and the
     // preprocessing's) and printed.
     let Some(CoulombReport::Tanh { epsilon }) = prediction.coulomb else {
         panic!("{:?}", prediction.coulomb)

@@ -5,7 +5,8 @@
 //! the held-out blocks wins, a more complex one only where it lowers the error of
 //! the simpler by [`MIN_GAIN`]: a model that only fits the noise of its own data
 //! does not. The choice is never worse than sign friction on the held-out blocks:
-//! where a simpler model within the margin would be, sign friction is chosen.
+//! where a simpler model within the margin would be, sign friction is chosen (but
+//! for one that predicts to rounding, [`EXACT`]).
 //!
 //! Then the extra joint terms ([`crate::extras`]) are added to the best linear
 //! friction model (sign, with or without rotor inertia, or the fitted smoothing)
@@ -396,10 +397,10 @@ pub fn choose(
         }
     }
     // Never worse than sign friction on the held-out blocks (a simpler model within
-    // the margin of it may be).
+    // the margin of it may be), but for a model that predicts to rounding.
     let error_of = |i: usize| scores[i].held_out.as_ref().map_or(f64::INFINITY, |v| v.overall);
     if let Some(sign) = scores.iter().position(|s| s.candidate == CANDIDATES[2]) {
-        if error_of(chosen) > error_of(sign) {
+        if error_of(chosen) > error_of(sign) && error_of(chosen) >= EXACT {
             chosen = sign;
         }
     }

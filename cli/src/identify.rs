@@ -284,9 +284,9 @@ pub struct IdentifyArgs {
     pub validate: Option<PathBuf>,
 
     /// Train a learned residual on what the identified model leaves in the torques:
-    /// a small network over the joint state (q, sin q, cos q, q̇, q̈ per joint),
-    /// trained on the first 75 % of the recording and kept, written to FILE (the
-    /// network's JSON), only if it lowers the error on the last 25 % by 1 %. The
+    /// per joint a small network over the joint's sin q, cos q and q̇, trained on
+    /// the first 75 % of the recording and kept, written to FILE (the networks'
+    /// JSON), only if it lowers the error on the last 25 % by 1 %. The
     /// physical parameters are those identified either way. --validate then
     /// predicts with and without it; `dyngen validate --residual FILE` adds it.
     #[arg(long, value_name = "FILE")]

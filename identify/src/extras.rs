@@ -14,8 +14,8 @@
 //!
 //! for `k = 1..=harmonics` and `m = 1..=motor_harmonics`, in this order; `N_j` is
 //! the joint's gear ratio (motor angle `N_j q_j`: cogging and gear ripple repeat
-//! many times per joint turn, so a joint that moves a little sweeps many periods). Direction-dependent *Coulomb* friction
-//! needs no new term: `Fc·s(q̇) + F0` is `Fc + F0` forward and `Fc − F0` backward.
+//! many times per joint turn, so a joint that moves a little sweeps many periods).
+//! Direction-dependent *Coulomb* friction needs no new term: `Fc·s(q̇) + F0` is `Fc + F0` forward and `Fc − F0` backward.
 //! Likewise `Fv·q̇ + Fva·|q̇|` is `Fv + Fva` forward and `Fv − Fva` backward.
 //!
 //! The load term's `τ_j^rigid` is the torque the links load the joint's

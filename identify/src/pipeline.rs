@@ -476,11 +476,13 @@ pub fn identify(
     }
     need_derivatives(trajectory)?;
     let model = dynamics.model();
-    if let Some(r) = options.gear_ratios.as_ref().filter(|r| r.len() != model.nv()) {
-        return Err(PipelineError::InvalidOption {
-            option: "gear-ratios",
-            reason: format!("{} values for {} joints; give one per joint", r.len(), model.nv()),
-        });
+    for (option, values) in [("gear-ratios", &options.gear_ratios), ("epsilons", &options.epsilons)] {
+        if let Some(r) = values.as_ref().filter(|r| r.len() != model.nv()) {
+            return Err(PipelineError::InvalidOption {
+                option,
+                reason: format!("{} values for {} joints; give one per joint", r.len(), model.nv()),
+            });
+        }
     }
     if (options.extras.harmonics > 0 || options.extras.motor_harmonics > 0) && model.nq() != model.nv() {
         return Err(PipelineError::InvalidOption {
@@ -520,13 +522,8 @@ fn from_torques(
 ) -> Result<Identification, PipelineError> {
     let regressor = match options.joints {
         JointTerms::FrictionAuto if options.mode == Mode::Standard => {
+            // Their number was checked by `identify`.
             let epsilons = match &options.epsilons {
-                Some(e) if e.len() != dynamics.nv() => {
-                    return Err(PipelineError::InvalidOption {
-                        option: "epsilons",
-                        reason: format!("{} values for {} joints; give one per joint", e.len(), dynamics.nv()),
-                    })
-                }
                 Some(e) => e.clone(),
                 None => crate::choice::epsilons(dynamics, traj, options)?,
             };

@@ -90,6 +90,16 @@ pub(crate) fn check_sizes(sizes: &[usize]) -> Result<(), NimError> {
     Ok(())
 }
 
+impl Workspace {
+    /// Room for nets whose widest layer is at most `width` wide.
+    pub(crate) fn with_width(width: usize) -> Workspace {
+        Workspace {
+            a: vec![0.0; width],
+            b: vec![0.0; width],
+        }
+    }
+}
+
 impl Mlp {
     /// A freshly initialised net with layer sizes `[n_in, h1, …, hk, n_out]`: He
     /// initialisation (every weight of layer `l` drawn from `N(0, 2 / sizes[l])`,
@@ -199,10 +209,7 @@ impl Mlp {
 
     /// Buffers for [`Mlp::predict`].
     pub fn workspace(&self) -> Workspace {
-        Workspace {
-            a: vec![0.0; self.width],
-            b: vec![0.0; self.width],
-        }
+        Workspace::with_width(self.width)
     }
 
     /// One sample through the net, in original units, without allocating: `input`

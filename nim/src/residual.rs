@@ -119,13 +119,13 @@ impl ResidualNet {
 
     /// A workspace that fits every joint's network.
     pub fn workspace(&self) -> Workspace {
-        self.nets
-            .iter()
-            .max_by_key(|n| n.sizes().iter().copied().max().unwrap_or(0))
-            .map_or_else(
-                || Mlp::new(&[1, 1], 0).expect("a valid net").workspace(),
-                Mlp::workspace,
-            )
+        Workspace::with_width(
+            self.nets
+                .iter()
+                .flat_map(|n| n.sizes().iter().copied())
+                .max()
+                .unwrap_or(0),
+        )
     }
 
     /// A joint's network inputs at `(q, q̇)`.

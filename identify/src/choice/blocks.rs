@@ -367,20 +367,15 @@ pub(crate) struct Solution {
     pub z: Vec<f64>,
 }
 
-impl Solution {
-    /// The coefficients on the wide regressor's `p` columns (0 off the candidate's).
-    pub(crate) fn wide(&self, columns: &[usize], p: usize) -> Vec<f64> {
-        let mut w = vec![0.0; p];
-        for (&c, &x) in columns.iter().zip(&self.x) {
+impl Folds<'_> {
+    /// `solution`'s coefficients on the wide regressor's columns (0 off these
+    /// folds' columns).
+    pub(crate) fn wide(&self, solution: &Solution) -> Vec<f64> {
+        let mut w = vec![0.0; self.blocks.p];
+        for (&c, &x) in self.columns.iter().zip(&solution.x) {
             w[c] = x;
         }
         w
-    }
-}
-
-impl Folds<'_> {
-    pub(crate) fn columns(&self) -> &[usize] {
-        &self.columns
     }
 
     /// The fit on every block but `f`, with each joint's own column `added[j]`.
@@ -514,10 +509,6 @@ impl Folds<'_> {
             }
         }
         (err, tau)
-    }
-
-    pub(crate) fn p(&self) -> usize {
-        self.blocks.p
     }
 }
 

@@ -683,7 +683,7 @@ impl Scoring {
         let none: Vec<Option<&JointColumn>> = vec![None; n];
         // Every row's rigid-body torque, [joint][block][row].
         let loads = |solution: &Solution| -> Vec<Vec<Vec<f64>>> {
-            let pi = solution.wide(folds.columns(), folds.p());
+            let pi = folds.wide(solution);
             (0..n)
                 .map(|j| {
                     (0..data.blocks())
